@@ -1,0 +1,50 @@
+// Dermis core — from a scene document and a loaded character to the two height maps: evaluates
+// the pose, measures each placement's joint angle, and runs the CPU height-map reference.
+//
+// Pure: the caller (a shell) loads the model and the pattern images and passes them in.
+#pragma once
+
+#include "heightmap.hpp"
+#include "model.hpp"
+#include "result.hpp"
+#include "rig.hpp"
+#include "scene.hpp"
+
+#include <map>
+#include <optional>
+#include <string>
+
+namespace dermis {
+
+/// The local pose a scene asks for: the clip (`pose.animation`, else the model's first clip, else
+/// rest) sampled at `timeOverride` or `pose.time` (clamped to the clip), then the `pose.joints`
+/// overrides (`rotation` replaces the local rotation; `axis_angles` sets q_rest·Rx·Ry·Rz).
+/// Fails (NotFound) on an unknown clip "/pose/animation" or joint "/pose/joints/<name>".
+Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
+                               std::optional<double> timeOverride = std::nullopt);
+
+/// The joint angle (degrees) that drives placement `p` under `pose` (SPEC §2 "Joint angle").
+/// Fails (NotFound) when the joint does not exist: field "/placements/<index>/joint".
+Result<double> placementAngle(const Model& model, const LocalPose& pose, const Placement& p,
+                              std::size_t index);
+
+/// Pattern images by the id used in placements (custom ids and built-in ids).
+using PatternImages = std::map<std::string, HeightImage>;
+
+/// Resolves every placement to a BakePlacement (pointers into `images`). Fails when the model
+/// has no TEXCOORD_0 ("/placements/<i>": why), a joint is unknown, or an image is missing.
+Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const Model& model,
+                                                     const LocalPose& pose,
+                                                     const PatternImages& images);
+
+struct SceneBakeOptions {
+    std::optional<double> time; ///< overrides pose.time
+    const HeightImage* base = nullptr;
+    int threads = 0;
+};
+
+/// evaluatePose → resolvePlacements → bakeHeightMaps at the scene's heightmap size.
+Result<HeightMaps> bakeScene(const Scene& scene, const Model& model, const PatternImages& images,
+                             const SceneBakeOptions& options = {});
+
+} // namespace dermis

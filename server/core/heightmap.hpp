@@ -1,0 +1,84 @@
+// Dermis core — height images, pattern placements in texture space, and the CPU reference of
+// the height-map stage (paper §4, first stage; SPEC §2 "Height maps" and "Conventions").
+//
+// Pure and deterministic: the same inputs give bit-identical maps for any thread count (each
+// texel sums its placements in document order; threads split rows).
+#pragma once
+
+#include "deform.hpp"
+#include "result.hpp"
+
+#include <glm/glm.hpp>
+
+#include <vector>
+
+namespace dermis {
+
+/// Largest height-map side (SPEC §2: default 1024², up to 4096²).
+constexpr int kMaxHeightmapSize = 4096;
+
+/// A single-channel float image, row 0 first (row 0 = v near 0).
+struct HeightImage {
+    int width = 0, height = 0;
+    std::vector<float> data; ///< width·height values
+
+    HeightImage() = default;
+    HeightImage(int w, int h, float fill = 0.0f)
+        : width(w), height(h), data(static_cast<std::size_t>(w) * h, fill) {}
+    float at(int i, int j) const { return data[static_cast<std::size_t>(j) * width + i]; }
+    float& at(int i, int j) { return data[static_cast<std::size_t>(j) * width + i]; }
+};
+
+/// Bilinear sample at normalised coordinates s ∈ [0,1]² (texel centres at (k+0.5)/N), clamped to
+/// the edge texels. Precondition: image non-empty.
+float sampleBilinear(const HeightImage& image, double su, double sv);
+
+/// Where a placement sits in UV space (SPEC "Conventions").
+struct Footprint {
+    glm::dvec2 center{0.5, 0.5};
+    glm::dvec2 scale{0.1, 0.1}; ///< > 0
+    double rotationDeg = 0.0;
+
+    /// s = R(−rotation)·(p − center)/scale + 0.5; inside the footprint iff s ∈ [0,1]².
+    glm::dvec2 toPattern(glm::dvec2 uv) const;
+    /// Inverse of toPattern.
+    glm::dvec2 toUV(glm::dvec2 s) const;
+    /// Axis-aligned UV bounds of the rotated rectangle: {min, max}.
+    std::pair<glm::dvec2, glm::dvec2> uvBounds() const;
+};
+
+/// Texel rectangle [x0, x1) × [y0, y1) of a W×H map whose texel centres may lie in the footprint
+/// (clipped to the map; empty when x0 ≥ x1 or y0 ≥ y1).
+struct TexelRect { int x0 = 0, y0 = 0, x1 = 0, y1 = 0; };
+TexelRect footprintTexels(const Footprint& f, int width, int height);
+
+/// A placement ready to bake: pattern image, footprint, model, and the current t and constant.
+struct BakePlacement {
+    const HeightImage* pattern = nullptr; ///< not owned; must outlive the bake
+    Footprint footprint;
+    DeformModel model = DeformModel::Scale;
+    Target target = Target::Bump;
+    Response response = Response::Log2;
+    double h = 1.0;
+    double t = 0.0; ///< normalised angle from normalizedT
+};
+
+/// The contribution of one placement at a UV point (0 outside its footprint).
+float placementHeight(const BakePlacement& p, glm::dvec2 uv);
+
+struct HeightMaps {
+    HeightImage bump, displacement;
+};
+
+struct BakeSettings {
+    int width = 1024, height = 1024;
+    const HeightImage* base = nullptr; ///< static bump map; sampled bilinearly if sizes differ
+    int threads = 0;                   ///< 0 = hardware concurrency
+};
+
+/// Bakes both maps: every texel centre sums its placements' L_out into the target map, plus the
+/// base map on bump. Fails on a non-positive or > kMaxHeightmapSize size or a null pattern.
+Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
+                                  const BakeSettings& settings);
+
+} // namespace dermis

@@ -1,0 +1,96 @@
+// Dermis core — a skinned character in memory: node hierarchy, joints, mesh parts, clips.
+//
+// Plain data, filled by a loader shell (server/io/gltf_loader) or built by hand in tests. The core
+// never reads files: a Model owns decoded data only. Conventions follow glTF 2.0: right-handed,
+// metres, quaternions [x, y, z, w] (glm::quat stores w, x, y, z — use glm::quat(w, x, y, z)),
+// column-major matrices, UV (0,0) at the first pixel of the first image row.
+#pragma once
+
+#include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+/// One node of the glTF scene hierarchy, in rest (non-animated) local TRS.
+struct Node {
+    std::string name;   ///< may be empty for unnamed nodes
+    int parent = -1;    ///< index into Model::nodes, −1 for a root
+    glm::vec3 translation{0.0f};
+    glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f}; ///< glm order (w, x, y, z)
+    glm::vec3 scale{1.0f};
+};
+
+/// One influence of a mesh part: the node whose world matrix moves the vertices, and the matrix
+/// taking the part's bind-space positions into that node's local space.
+struct Influence {
+    int node = -1;
+    glm::mat4 inverseBind{1.0f};
+};
+
+/// One triangle list (a glTF primitive). Skinned primitives keep glTF's bind space; a rigid mesh
+/// attached to node N is stored as a one-influence skin: positions in rest world space and
+/// inverseBind = inverse(restWorld(N)), so skinning with the posed world matrix moves it rigidly.
+struct MeshPart {
+    std::string name;
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals;       ///< unit; computed (area-weighted) when the file has none
+    std::vector<glm::vec2> uvs;           ///< TEXCOORD_0; empty when the file has none
+    std::vector<glm::u16vec4> joints;     ///< indices into `influences`, one per vertex
+    std::vector<glm::vec4> weights;       ///< normalised (sum 1), one per vertex
+    std::vector<std::uint32_t> indices;   ///< triangle list, 3 per triangle
+    std::vector<Influence> influences;
+    int material = -1;                    ///< index into Model::materials, −1 for none
+};
+
+/// An RGBA8 image, row 0 first.
+struct Image8 {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> rgba; ///< width·height·4 bytes
+};
+
+struct Material {
+    std::string name;
+    glm::vec4 baseColorFactor{1.0f};
+    int baseColorTexture = -1; ///< index into Model::images, −1 for none
+};
+
+enum class Interpolation { Linear, Step, CubicSpline };
+enum class ChannelPath { Translation, Rotation, Scale };
+
+/// One animation channel. `values` holds, per key, 3 (T, S) or 4 (R, x y z w) floats; for
+/// CubicSpline each key holds in-tangent, value, out-tangent (3 groups), as in glTF.
+struct Channel {
+    int node = -1;
+    ChannelPath path = ChannelPath::Rotation;
+    Interpolation interpolation = Interpolation::Linear;
+    std::vector<float> times; ///< strictly increasing seconds
+    std::vector<float> values;
+};
+
+struct Clip {
+    std::string name;
+    float duration = 0.0f; ///< last key time over all channels (start is 0)
+    std::vector<Channel> channels;
+};
+
+struct Model {
+    std::vector<Node> nodes;
+    std::vector<int> joints;  ///< node indices that are joints of a skin, in first-seen order
+    std::vector<MeshPart> parts;
+    std::vector<Material> materials;
+    std::vector<Image8> images;
+    std::vector<Clip> clips;
+
+    bool hasUVs() const;        ///< every part has TEXCOORD_0
+    std::size_t triangleCount() const;
+    /// Index into `nodes` of the joint named `name` (joints only), −1 if none.
+    int findJoint(const std::string& name) const;
+    /// Index into `clips` of the clip named `name`, −1 if none.
+    int findClip(const std::string& name) const;
+};
+
+} // namespace dermis

@@ -1,0 +1,57 @@
+// Dermis core — pose math: clip sampling, pose overrides, world matrices, joint angles, CPU
+// linear blend skinning (the paper's SSD).
+//
+// Pure functions over a Model; no I/O. Thread-safe for concurrent calls on a const Model.
+#pragma once
+
+#include "model.hpp"
+#include "result.hpp"
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+/// Local TRS of every node (same indexing as Model::nodes).
+struct LocalPose {
+    std::vector<glm::vec3> translation;
+    std::vector<glm::quat> rotation;
+    std::vector<glm::vec3> scale;
+};
+
+/// The model's rest pose (each node's own TRS).
+LocalPose restPose(const Model& model);
+
+/// Samples clip `clip` at `time` seconds (clamped to [0, duration]) over the rest pose: nodes
+/// without a channel keep their rest TRS. LINEAR (slerp for rotations), STEP and CUBICSPLINE
+/// (Hermite, rotations renormalised) as in glTF 2.0 Appendix C. Precondition: clip is a valid index.
+LocalPose sampleClip(const Model& model, int clip, float time);
+
+/// World matrix of every node for a local pose (parents before children not required).
+std::vector<glm::mat4> worldMatrices(const Model& model, const LocalPose& pose);
+
+/// Posed vertices of one part.
+struct SkinnedPart {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> normals; ///< unit length
+};
+
+/// CPU linear blend skinning of every part: p' = Σ w_k · world(node_k) · inverseBind_k · p;
+/// normals with the inverse-transpose of the blended matrix, renormalised.
+std::vector<SkinnedPart> skin(const Model& model, const std::vector<glm::mat4>& world);
+
+/// A joint's rotation axis in its rest frame; normalised by the caller (see jointAngle).
+/// Returns theta in degrees in (−180, 180]: the twist angle of q_rel = q_rest⁻¹ · q_pose about
+/// `axis` (SPEC §2): theta = 2·atan2(dot(q_rel.xyz, a), q_rel.w), wrapped. q and −q give the same
+/// angle. Precondition: |axis| = 1.
+double jointAngle(const glm::quat& restLocal, const glm::quat& poseLocal, const glm::vec3& axis);
+
+/// q_rest · R_x(x) · R_y(y) · R_z(z), angles in degrees (the scene document's `axis_angles`).
+glm::quat axisAnglesRotation(const glm::quat& restLocal, double xDeg, double yDeg, double zDeg);
+
+/// Wraps degrees into (−180, 180].
+double wrapDegrees(double deg);
+
+} // namespace dermis

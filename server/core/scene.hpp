@@ -1,0 +1,109 @@
+// Dermis core — the scene document `dermis.scene/1` (SPEC §2b) and the pattern manifest
+// `dermis.patterns/1` (SPEC §3).
+//
+// Parsing validates every field and applies defaults; errors name the offending field by JSON
+// pointer (RFC 6901, e.g. "/placements/3/theta_max") in Error::field and in the message.
+// Serialising a parsed Scene writes every field explicitly, so parse → serialise → parse →
+// serialise is byte-stable. Unknown fields are kept nowhere (they are ignored).
+// No file access: paths (model, patterns, base map) stay strings, resolved by a shell.
+#pragma once
+
+#include "deform.hpp"
+#include "heightmap.hpp"
+#include "result.hpp"
+
+#include <nlohmann/json_fwd.hpp>
+
+#include <array>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+/// One entry of the built-in pattern library.
+struct PatternInfo {
+    std::string id;          ///< [a-z0-9_]+
+    std::string file;        ///< image file name, relative to the manifest
+    PatternKind kind = PatternKind::Wrinkle;
+    DeformModel model = DeformModel::Scale;
+    Target target = Target::Bump;
+    std::string joint;       ///< suggested joint role ("elbow", "spine", …)
+    std::string axis = "x";  ///< suggested axis
+    double thetaMin = 0.0, thetaMax = 90.0;
+    std::string description;
+};
+
+struct PatternManifest {
+    std::vector<PatternInfo> patterns;
+    const PatternInfo* find(const std::string& id) const;
+};
+
+/// Parses a `dermis.patterns/1` manifest: {"format": "dermis.patterns/1", "patterns": [ … ]}.
+Result<PatternManifest> parsePatternManifest(const nlohmann::json& doc);
+nlohmann::json toJson(const PatternManifest& manifest);
+
+struct Placement {
+    std::string id;                      ///< unique within the scene
+    std::string pattern;                 ///< key of Scene::patterns, or a built-in pattern id
+    std::array<double, 2> center{0.5, 0.5}; ///< UV
+    std::array<double, 2> scale{0.1, 0.1};  ///< UV size of the footprint, > 0
+    double rotation = 0.0;               ///< degrees, counter-clockwise in (u, v) per SPEC
+    std::string joint;                   ///< joint name in the model
+    std::string axisName = "x";          ///< "x", "y", "z", or "" when `axis` was a vector
+    std::array<double, 3> axis{1, 0, 0}; ///< unit vector (normalised on parse)
+    double thetaMin = 0.0, thetaMax = 90.0, h = 1.0;
+    DeformModel model = DeformModel::Scale;
+    Target target = Target::Bump;
+    Response response = Response::Log2;
+};
+
+/// A joint override of the pose: exactly one of rotation / axisAngles is set.
+struct JointPose {
+    std::optional<std::array<double, 4>> rotation; ///< [x, y, z, w], normalised on parse
+    std::optional<std::array<double, 3>> axisAngles; ///< degrees about x, y, z (absent = 0)
+};
+
+struct Pose {
+    std::optional<std::string> animation; ///< clip name; absent = the model's first clip
+    double time = 0.0;                    ///< seconds, ≥ 0 (clamped to the clip when evaluated)
+    std::map<std::string, JointPose> joints;
+};
+
+struct Camera {
+    double yaw = 0.0, pitch = 10.0;
+    std::optional<double> distance; ///< absent = "auto"
+};
+
+struct RenderSettings {
+    std::array<int, 2> size{1024, 1024};
+    Camera camera;
+    std::optional<double> displacementScale; ///< absent = "auto"
+    double bumpStrength = 1.0;
+    int msaa = 4; ///< 1, 2 or 4
+};
+
+struct Scene {
+    std::string model = "builtin:default";
+    std::array<int, 2> heightmapSize{1024, 1024}; ///< each in [1, kMaxHeightmapSize]
+    std::optional<std::string> heightmapBase;      ///< static height map path
+    std::map<std::string, std::string> patterns;   ///< custom pattern id → path
+    std::vector<Placement> placements;
+    Pose pose;
+    RenderSettings render;
+};
+
+constexpr int kMaxRenderSize = 8192;
+
+/// Parses and validates a scene document. `manifest` supplies the built-in pattern ids (a
+/// placement's pattern must be a key of "patterns" or a built-in id) and the per-kind defaults of
+/// `model`/`target` when a placement omits them (custom patterns default to scale/bump).
+/// Fails with the JSON pointer of the first offending field.
+Result<Scene> parseScene(const nlohmann::json& doc, const PatternManifest& manifest);
+/// Parses text first (malformed JSON → ErrorCode::Parse, field "").
+Result<Scene> parseSceneText(const std::string& text, const PatternManifest& manifest);
+/// Serialises with every field explicit ("auto" where optional values are absent).
+nlohmann::json toJson(const Scene& scene);
+
+} // namespace dermis
