@@ -1,1 +1,129 @@
-// placeholder: implemented in this issue
+// Scene document + character → height maps (CPU reference path).
+#include "bake.hpp"
+
+#include <cmath>
+
+namespace dermis {
+namespace {
+
+/// Joint by name first, then any named node (so non-skin nodes can be posed and drive patterns).
+int findPosable(const Model& model, const std::string& name) {
+    if (int j = model.findJoint(name); j >= 0) return j;
+    for (std::size_t n = 0; n < model.nodes.size(); ++n)
+        if (model.nodes[n].name == name) return static_cast<int>(n);
+    return -1;
+}
+
+/// RFC 6901 escaping of one reference token.
+std::string pointerToken(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '~') out += "~0";
+        else if (c == '/') out += "~1";
+        else out += c;
+    }
+    return out;
+}
+
+} // namespace
+
+Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
+                               std::optional<double> timeOverride) {
+    const char* where = "dermis::evaluatePose";
+    LocalPose local;
+    const double time = timeOverride.value_or(pose.time);
+    if (!std::isfinite(time))
+        return makeError(ErrorCode::InvalidArgument, where, "/pose/time", "must be finite");
+    int clip = -1;
+    if (pose.animation) {
+        clip = model.findClip(*pose.animation);
+        if (clip < 0)
+            return makeError(ErrorCode::NotFound, where, "/pose/animation",
+                             "the model has no clip named '" + *pose.animation + "'");
+    } else if (!model.clips.empty()) {
+        clip = 0;
+    }
+    local = clip >= 0 ? sampleClip(model, clip, static_cast<float>(time)) : restPose(model);
+
+    for (const auto& [name, jp] : pose.joints) {
+        const int n = findPosable(model, name);
+        if (n < 0)
+            return makeError(ErrorCode::NotFound, where, "/pose/joints/" + pointerToken(name),
+                             "the model has no joint named '" + name + "'");
+        if (jp.rotation) {
+            const auto& q = *jp.rotation; // [x, y, z, w]
+            local.rotation[n] = glm::normalize(glm::quat(static_cast<float>(q[3]),
+                                                         static_cast<float>(q[0]),
+                                                         static_cast<float>(q[1]),
+                                                         static_cast<float>(q[2])));
+        } else if (jp.axisAngles) {
+            const auto& a = *jp.axisAngles;
+            local.rotation[n] = axisAnglesRotation(model.nodes[n].rotation, a[0], a[1], a[2]);
+        }
+    }
+    return local;
+}
+
+Result<double> placementAngle(const Model& model, const LocalPose& pose, const Placement& p,
+                              std::size_t index) {
+    const int n = findPosable(model, p.joint);
+    if (n < 0)
+        return makeError(ErrorCode::NotFound, "dermis::placementAngle",
+                         "/placements/" + std::to_string(index) + "/joint",
+                         "the model has no joint named '" + p.joint + "'");
+    const glm::vec3 axis = glm::normalize(glm::vec3(static_cast<float>(p.axis[0]),
+                                                    static_cast<float>(p.axis[1]),
+                                                    static_cast<float>(p.axis[2])));
+    return jointAngle(model.nodes[n].rotation, pose.rotation[n], axis);
+}
+
+Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const Model& model,
+                                                     const LocalPose& pose,
+                                                     const PatternImages& images) {
+    const char* where = "dermis::resolvePlacements";
+    std::vector<BakePlacement> out;
+    out.reserve(scene.placements.size());
+    const bool uvs = model.hasUVs();
+    for (std::size_t i = 0; i < scene.placements.size(); ++i) {
+        const Placement& p = scene.placements[i];
+        const std::string ptr = "/placements/" + std::to_string(i);
+        if (!uvs)
+            return makeError(ErrorCode::InvalidArgument, where, ptr,
+                             "the model has no TEXCOORD_0, so patterns cannot be placed in its "
+                             "texture space");
+        auto it = images.find(p.pattern);
+        if (it == images.end())
+            return makeError(ErrorCode::NotFound, where, ptr + "/pattern",
+                             "no image loaded for pattern '" + p.pattern + "'");
+        auto theta = placementAngle(model, pose, p, i);
+        if (!theta) return theta.error();
+        BakePlacement b;
+        b.pattern = &it->second;
+        b.footprint.center = {p.center[0], p.center[1]};
+        b.footprint.scale = {p.scale[0], p.scale[1]};
+        b.footprint.rotationDeg = p.rotation;
+        b.model = p.model;
+        b.target = p.target;
+        b.response = p.response;
+        b.h = p.h;
+        b.t = normalizedT(*theta, p.thetaMin, p.thetaMax);
+        out.push_back(b);
+    }
+    return out;
+}
+
+Result<HeightMaps> bakeScene(const Scene& scene, const Model& model, const PatternImages& images,
+                             const SceneBakeOptions& options) {
+    auto pose = evaluatePose(model, scene.pose, options.time);
+    if (!pose) return pose.error();
+    auto placements = resolvePlacements(scene, model, *pose, images);
+    if (!placements) return placements.error();
+    BakeSettings settings;
+    settings.width = scene.heightmapSize[0];
+    settings.height = scene.heightmapSize[1];
+    settings.base = options.base;
+    settings.threads = options.threads;
+    return bakeHeightMaps(*placements, settings);
+}
+
+} // namespace dermis

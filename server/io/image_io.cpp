@@ -1,1 +1,216 @@
-// placeholder: implemented in this issue
+// Pattern images and float height maps through OpenImageIO. See image_io.hpp for the value
+// mapping and failure modes.
+#include "image_io.hpp"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+namespace dermis {
+namespace {
+
+using OIIO::ImageInput;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+/// A file name whose extension selects the OpenImageIO plugin for encoded bytes (by magic).
+std::string sniffName(const std::vector<std::uint8_t>& b) {
+    auto starts = [&](std::initializer_list<std::uint8_t> m) {
+        if (b.size() < m.size()) return false;
+        return std::equal(m.begin(), m.end(), b.begin());
+    };
+    if (starts({0x89, 'P', 'N', 'G'})) return "mem.png";
+    if (starts({0xFF, 0xD8, 0xFF})) return "mem.jpg";
+    if (starts({'I', 'I', 42, 0}) || starts({'M', 'M', 0, 42})) return "mem.tif";
+    if (starts({0x76, 0x2F, 0x31, 0x01})) return "mem.exr";
+    if (starts({'8', 'B', 'P', 'S'})) return "mem.psd";
+    if (starts({'B', 'M'})) return "mem.bmp";
+    if (starts({'#', '?'})) return "mem.hdr";
+    if (starts({'R', 'I', 'F', 'F'})) return "mem.webp";
+    if (starts({'G', 'I', 'F'})) return "mem.gif";
+    return "mem.tga"; // TGA has no magic number
+}
+
+Error oiioError(const char* where, const std::string& field, const std::string& what) {
+    std::string detail = OIIO::geterror();
+    return makeError(ErrorCode::Parse, where, field, detail.empty() ? what : what + " (" + detail + ")");
+}
+
+Status checkSpec(const char* where, const std::string& name, const ImageSpec& spec, int maxSide) {
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+        return makeError(ErrorCode::Parse, where, name, "image has no pixels");
+    if (spec.depth > 1)
+        return makeError(ErrorCode::Unsupported, where, name, "volume images are not supported");
+    if (spec.width > maxSide || spec.height > maxSide)
+        return makeError(ErrorCode::InvalidArgument, where, name,
+                         "image is " + std::to_string(spec.width) + "x" +
+                             std::to_string(spec.height) + ", larger than the limit of " +
+                             std::to_string(maxSide) + " per side");
+    return Ok{};
+}
+
+/// Reads channel 0 of an open image with SPEC §2's value mapping.
+Result<HeightImage> readHeight(ImageInput& in, const char* where, const std::string& name) {
+    const ImageSpec& spec = in.spec();
+    if (auto s = checkSpec(where, name, spec, kMaxPatternSize); !s) return s.error();
+    HeightImage img(spec.width, spec.height);
+    const std::size_t n = img.data.size();
+    const auto base = TypeDesc::BASETYPE(spec.format.basetype);
+    auto clamp1 = [](double v) { return static_cast<float>(std::clamp(v, -1.0, 1.0)); };
+    bool ok = false;
+    if (base == TypeDesc::UINT8) {
+        std::vector<std::uint8_t> px(n);
+        ok = in.read_image(0, 0, 0, 1, TypeDesc::UINT8, px.data());
+        for (std::size_t k = 0; ok && k < n; ++k) img.data[k] = clamp1((px[k] - 128.0) / 127.0);
+    } else if (base == TypeDesc::UINT16) {
+        std::vector<std::uint16_t> px(n);
+        ok = in.read_image(0, 0, 0, 1, TypeDesc::UINT16, px.data());
+        for (std::size_t k = 0; ok && k < n; ++k)
+            img.data[k] = clamp1((px[k] - 32768.0) / 32767.0);
+    } else if (base == TypeDesc::HALF || base == TypeDesc::FLOAT || base == TypeDesc::DOUBLE) {
+        ok = in.read_image(0, 0, 0, 1, TypeDesc::FLOAT, img.data.data());
+        for (std::size_t k = 0; ok && k < n; ++k) {
+            float v = img.data[k];
+            img.data[k] = std::isfinite(v) ? clamp1(v) : 0.0f;
+        }
+    } else {
+        // Other integer types: OpenImageIO normalises to [0, 1]; map 0.5 to height 0.
+        ok = in.read_image(0, 0, 0, 1, TypeDesc::FLOAT, img.data.data());
+        for (std::size_t k = 0; ok && k < n; ++k) img.data[k] = clamp1(2.0 * img.data[k] - 1.0);
+    }
+    if (!ok) return oiioError(where, name, "cannot decode pixels: " + in.geterror());
+    return img;
+}
+
+/// RAII temporary file for formats whose OpenImageIO plugin cannot read from memory.
+struct TempFile {
+    std::string path;
+    ~TempFile() {
+        if (!path.empty()) std::remove(path.c_str());
+    }
+};
+
+Result<TempFile> writeTemp(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+    std::string tmpl = (std::filesystem::temp_directory_path() / "dermis-XXXXXX").string();
+    std::string ext = name.substr(name.find('.'));
+    tmpl += ext;
+    int fd = mkstemps(tmpl.data(), static_cast<int>(ext.size()));
+    if (fd < 0) return makeError(ErrorCode::Io, "dermis::readImage", "", "cannot create a temporary file");
+    ::close(fd);
+    TempFile t{tmpl};
+    std::ofstream out(t.path, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!out) return makeError(ErrorCode::Io, "dermis::readImage", "", "cannot write a temporary file");
+    return t;
+}
+
+/// Opens encoded bytes: through an in-memory proxy when the plugin supports it, else via a
+/// temporary file. `keep` holds whatever must outlive the returned ImageInput.
+template <class Fn>
+auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where, Fn&& fn)
+    -> decltype(fn(std::declval<ImageInput&>())) {
+    if (bytes.empty()) return makeError(ErrorCode::Parse, where, "", "empty image data");
+    const std::string name = sniffName(bytes);
+    {
+        OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
+        ImageSpec config;
+        auto in = ImageInput::open(name, &config, &proxy);
+        if (in) return fn(*in);
+        OIIO::geterror(); // clear
+    }
+    auto tmp = writeTemp(bytes, name);
+    if (!tmp) return tmp.error();
+    auto in = ImageInput::open(tmp->path);
+    if (!in) return oiioError(where, "", "unrecognised or corrupt image data");
+    return fn(*in);
+}
+
+} // namespace
+
+Result<HeightImage> readHeightImage(const std::string& path) {
+    const char* where = "dermis::readHeightImage";
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        return makeError(ErrorCode::NotFound, where, path, "no such file");
+    auto in = ImageInput::open(path);
+    if (!in) return oiioError(where, path, "cannot open image");
+    return readHeight(*in, where, path);
+}
+
+Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes) {
+    const char* where = "dermis::readHeightImageFromMemory";
+    return withOpenedMemory(bytes, where,
+                            [&](ImageInput& in) { return readHeight(in, where, ""); });
+}
+
+Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes) {
+    const char* where = "dermis::decodeImage8";
+    return withOpenedMemory(bytes, where, [&](ImageInput& in) -> Result<Image8> {
+        const ImageSpec& spec = in.spec();
+        if (auto s = checkSpec(where, "", spec, 16384); !s) return s.error();
+        const int nc = std::min(spec.nchannels, 4);
+        std::vector<std::uint8_t> px(static_cast<std::size_t>(spec.width) * spec.height * nc);
+        if (!in.read_image(0, 0, 0, nc, TypeDesc::UINT8, px.data()))
+            return oiioError(where, "", "cannot decode pixels: " + in.geterror());
+        Image8 out;
+        out.width = spec.width;
+        out.height = spec.height;
+        out.rgba.resize(static_cast<std::size_t>(spec.width) * spec.height * 4);
+        for (std::size_t k = 0, n = px.size() / nc; k < n; ++k) {
+            const std::uint8_t* s = &px[k * nc];
+            std::uint8_t* d = &out.rgba[k * 4];
+            if (nc >= 3) {
+                d[0] = s[0], d[1] = s[1], d[2] = s[2];
+                d[3] = nc == 4 ? s[3] : 255;
+            } else {
+                d[0] = d[1] = d[2] = s[0];
+                d[3] = nc == 2 ? s[1] : 255;
+            }
+        }
+        return out;
+    });
+}
+
+Status writeFloatImage(const std::string& path, const HeightImage& image) {
+    const char* where = "dermis::writeFloatImage";
+    if (image.width <= 0 || image.height <= 0 ||
+        image.data.size() != static_cast<std::size_t>(image.width) * image.height)
+        return makeError(ErrorCode::InvalidArgument, where, "image", "empty or inconsistent image");
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) return oiioError(where, path, "no image writer for this file name");
+    ImageSpec spec(image.width, image.height, 1, TypeDesc::FLOAT);
+    spec.channelnames = {"Y"};
+    if (!out->open(path, spec))
+        return makeError(ErrorCode::Io, where, path, "cannot open for writing: " + out->geterror());
+    if (!out->write_image(TypeDesc::FLOAT, image.data.data()) || !out->close())
+        return makeError(ErrorCode::Io, where, path, "cannot write: " + out->geterror());
+    return Ok{};
+}
+
+Status writeHeight16Png(const std::string& path, const HeightImage& image) {
+    const char* where = "dermis::writeHeight16Png";
+    if (image.width <= 0 || image.height <= 0 ||
+        image.data.size() != static_cast<std::size_t>(image.width) * image.height)
+        return makeError(ErrorCode::InvalidArgument, where, "image", "empty or inconsistent image");
+    std::vector<std::uint16_t> px(image.data.size());
+    for (std::size_t k = 0; k < px.size(); ++k) {
+        double v = std::clamp(static_cast<double>(image.data[k]), -1.0, 1.0);
+        px[k] = static_cast<std::uint16_t>(std::lround(32768.0 + 32767.0 * v));
+    }
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) return oiioError(where, path, "no image writer for this file name");
+    ImageSpec spec(image.width, image.height, 1, TypeDesc::UINT16);
+    if (!out->open(path, spec))
+        return makeError(ErrorCode::Io, where, path, "cannot open for writing: " + out->geterror());
+    if (!out->write_image(TypeDesc::UINT16, px.data()) || !out->close())
+        return makeError(ErrorCode::Io, where, path, "cannot write: " + out->geterror());
+    return Ok{};
+}
+
+} // namespace dermis

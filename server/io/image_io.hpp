@@ -8,6 +8,7 @@
 #pragma once
 
 #include "core/heightmap.hpp"
+#include "core/model.hpp"
 #include "core/result.hpp"
 
 #include <cstdint>

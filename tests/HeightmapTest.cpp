@@ -1,0 +1,184 @@
+// HeightmapTest — the CPU height-map reference (SPEC §2 "Height maps") on hand-computed scenes.
+// Pure.
+#include "core/heightmap.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+using namespace dermis;
+
+namespace {
+BakePlacement place(const HeightImage* img, glm::dvec2 c, glm::dvec2 s, double rot, double t,
+                    DeformModel m = DeformModel::Scale, Target tg = Target::Bump,
+                    Response r = Response::Log2, double h = 1.0) {
+    BakePlacement p;
+    p.pattern = img;
+    p.footprint.center = c;
+    p.footprint.scale = s;
+    p.footprint.rotationDeg = rot;
+    p.t = t;
+    p.model = m;
+    p.target = tg;
+    p.response = r;
+    p.h = h;
+    return p;
+}
+BakeSettings size(int w, int h, int threads = 1) {
+    BakeSettings s;
+    s.width = w;
+    s.height = h;
+    s.threads = threads;
+    return s;
+}
+} // namespace
+
+TEST(HeightmapTest, FullCoverPlacementCopiesThePatternTexelForTexel) {
+    HeightImage pat(8, 8);
+    for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) pat.at(i, j) = (i - 3.5f) / 4.0f * (j % 2 ? 1.0f : -0.5f);
+    auto maps = bakeHeightMaps({place(&pat, {0.5, 0.5}, {1, 1}, 0, 1.0, DeformModel::Scale,
+                                      Target::Bump, Response::Log2, 0.5)},
+                               size(8, 8));
+    ASSERT_TRUE(maps.ok());
+    for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) {
+            EXPECT_FLOAT_EQ(maps->bump.at(i, j), pat.at(i, j) * 0.5f);
+            EXPECT_EQ(maps->displacement.at(i, j), 0.0f);
+        }
+}
+
+TEST(HeightmapTest, BilinearUpsamplingByHand) {
+    // A 2×2 pattern over a 4×4 map: texel centres at s = 1/8, 3/8, 5/8, 7/8 → pattern x =
+    // s·2 − 0.5 = −0.25 (clamped 0), 0.25, 0.75, 1.25 (clamped 1).
+    HeightImage pat(2, 2);
+    pat.at(0, 0) = pat.at(0, 1) = 0.0f;
+    pat.at(1, 0) = pat.at(1, 1) = 1.0f;
+    auto maps = bakeHeightMaps({place(&pat, {0.5, 0.5}, {1, 1}, 0, 1.0)}, size(4, 4));
+    ASSERT_TRUE(maps.ok());
+    const float expected[4] = {0.0f, 0.25f, 0.75f, 1.0f};
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) EXPECT_FLOAT_EQ(maps->bump.at(i, j), expected[i]);
+}
+
+TEST(HeightmapTest, FootprintCoversOnlyItsTexels) {
+    HeightImage pat(4, 4, 1.0f);
+    // Footprint u ∈ [0.25, 0.5], v ∈ [0.5, 1.0] on an 8×4 map: columns 2,3 and rows 2,3.
+    auto maps = bakeHeightMaps({place(&pat, {0.375, 0.75}, {0.25, 0.5}, 0, 1.0)}, size(8, 4));
+    ASSERT_TRUE(maps.ok());
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 8; ++i) {
+            const bool in = (i == 2 || i == 3) && (j == 2 || j == 3);
+            EXPECT_EQ(maps->bump.at(i, j), in ? 1.0f : 0.0f) << i << "," << j;
+        }
+}
+
+TEST(HeightmapTest, TargetsModelsAndOverlapsAdd) {
+    HeightImage pat(2, 2, 0.9f);
+    const double t = 0.5;
+    std::vector<BakePlacement> ps = {
+        place(&pat, {0.5, 0.5}, {1, 1}, 0, t),                                     // bump, scale
+        place(&pat, {0.5, 0.5}, {1, 1}, 0, t, DeformModel::Bias),                  // bump, bias
+        place(&pat, {0.5, 0.5}, {1, 1}, 0, t, DeformModel::Scale, Target::Displacement),
+        place(&pat, {0.5, 0.5}, {1, 1}, 0, 0.0, DeformModel::Scale, Target::Displacement), // t=0
+    };
+    auto maps = bakeHeightMaps(ps, size(4, 4));
+    ASSERT_TRUE(maps.ok());
+    const double g = std::log2(1.5);
+    EXPECT_NEAR(maps->bump.at(1, 1), 0.9 * g + (0.9 - g), 1e-6);
+    EXPECT_NEAR(maps->displacement.at(2, 3), 0.9 * g, 1e-6);
+}
+
+TEST(HeightmapTest, ZeroAngleGivesEmptyMaps) {
+    HeightImage pat(3, 3, -0.7f);
+    auto maps = bakeHeightMaps({place(&pat, {0.5, 0.5}, {0.5, 0.5}, 10, 0.0)}, size(16, 16));
+    ASSERT_TRUE(maps.ok());
+    for (float v : maps->bump.data) EXPECT_EQ(v, 0.0f);
+}
+
+TEST(HeightmapTest, StaticBaseMapIsAddedToBump) {
+    HeightImage base(4, 4, 0.1f);
+    base.at(0, 0) = 0.3f;
+    HeightImage pat(2, 2, 0.5f);
+    BakeSettings s = size(4, 4);
+    s.base = &base;
+    auto maps = bakeHeightMaps({place(&pat, {0.5, 0.5}, {1, 1}, 0, 1.0)}, s);
+    ASSERT_TRUE(maps.ok());
+    EXPECT_FLOAT_EQ(maps->bump.at(0, 0), 0.8f);
+    EXPECT_FLOAT_EQ(maps->bump.at(3, 2), 0.6f);
+    EXPECT_EQ(maps->displacement.at(0, 0), 0.0f);
+    // A base of another size is sampled bilinearly at the texel centres.
+    HeightImage small(2, 2, 0.0f);
+    small.at(1, 0) = small.at(1, 1) = 1.0f;
+    s.base = &small;
+    auto m2 = bakeHeightMaps({}, s);
+    ASSERT_TRUE(m2.ok());
+    EXPECT_FLOAT_EQ(m2->bump.at(1, 0), 0.25f);
+    EXPECT_FLOAT_EQ(m2->bump.at(3, 3), 1.0f);
+}
+
+TEST(HeightmapTest, MatchesThePerPointReferenceAndIsThreadCountIndependent) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(0, 1), sc(0.05, 0.5), rot(-180, 180);
+    std::vector<HeightImage> pats;
+    for (int k = 0; k < 4; ++k) {
+        HeightImage p(5 + 7 * k, 9 + 3 * k);
+        for (float& v : p.data) v = static_cast<float>(u(rng) * 2 - 1);
+        pats.push_back(std::move(p));
+    }
+    std::vector<BakePlacement> ps;
+    const DeformModel models[] = {DeformModel::Scale, DeformModel::Bias};
+    const Response responses[] = {Response::Log2, Response::Ln, Response::Linear,
+                                  Response::Smoothstep};
+    for (int k = 0; k < 15; ++k)
+        ps.push_back(place(&pats[k % 4], {u(rng), u(rng)}, {sc(rng), sc(rng)}, rot(rng),
+                           k == 3 ? 1.0 : u(rng), models[k % 2],
+                           k % 3 ? Target::Bump : Target::Displacement, responses[k % 4],
+                           0.5 + u(rng)));
+    const int W = 257, H = 131;
+    auto one = bakeHeightMaps(ps, size(W, H, 1));
+    ASSERT_TRUE(one.ok());
+    // Reference: the per-point definition, summed in document order.
+    int nonzero = 0;
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            float b = 0, d = 0;
+            for (const BakePlacement& p : ps) {
+                const float v = placementHeight(p, {(i + 0.5) / W, (j + 0.5) / H});
+                (p.target == Target::Bump ? b : d) += v;
+            }
+            ASSERT_NEAR(one->bump.at(i, j), b, 1e-5) << i << "," << j;
+            ASSERT_NEAR(one->displacement.at(i, j), d, 1e-5) << i << "," << j;
+            nonzero += b != 0.0f;
+        }
+    EXPECT_GT(nonzero, W * H / 10);
+    for (int threads : {2, 3, 7, 64}) {
+        auto many = bakeHeightMaps(ps, size(W, H, threads));
+        ASSERT_TRUE(many.ok());
+        EXPECT_EQ(0, std::memcmp(one->bump.data.data(), many->bump.data.data(),
+                                 one->bump.data.size() * sizeof(float)))
+            << threads;
+        EXPECT_EQ(0, std::memcmp(one->displacement.data.data(), many->displacement.data.data(),
+                                 one->displacement.data.size() * sizeof(float)))
+            << threads;
+    }
+}
+
+TEST(HeightmapTest, RejectsBadSizesAndMissingPatterns) {
+    HeightImage pat(2, 2, 1.0f);
+    EXPECT_EQ(bakeHeightMaps({}, size(0, 16)).error().field, "/heightmap/size");
+    EXPECT_EQ(bakeHeightMaps({}, size(16, -1)).error().field, "/heightmap/size");
+    EXPECT_EQ(bakeHeightMaps({}, size(kMaxHeightmapSize + 1, 16)).error().field,
+              "/heightmap/size");
+    auto noPattern = bakeHeightMaps({place(nullptr, {0.5, 0.5}, {1, 1}, 0, 1)}, size(4, 4));
+    EXPECT_EQ(noPattern.error().field, "/placements/0/pattern");
+    HeightImage empty;
+    EXPECT_FALSE(bakeHeightMaps({place(&pat, {0.5, 0.5}, {1, 1}, 0, 1),
+                                 place(&empty, {0.5, 0.5}, {1, 1}, 0, 1)},
+                                size(4, 4))
+                     .ok());
+    EXPECT_EQ(bakeHeightMaps({place(&pat, {0.5, 0.5}, {0, 1}, 0, 1)}, size(4, 4)).error().field,
+              "/placements/0/scale");
+}
