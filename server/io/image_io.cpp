@@ -91,6 +91,11 @@ Result<HeightImage> readHeight(ImageInput& in, const char* where, const std::str
 /// RAII temporary file for formats whose OpenImageIO plugin cannot read from memory.
 struct TempFile {
     std::string path;
+    explicit TempFile(std::string p) : path(std::move(p)) {}
+    TempFile(TempFile&& o) noexcept : path(std::move(o.path)) { o.path.clear(); }
+    TempFile(const TempFile&) = delete;
+    TempFile& operator=(const TempFile&) = delete;
+    TempFile& operator=(TempFile&&) = delete;
     ~TempFile() {
         if (!path.empty()) std::remove(path.c_str());
     }
@@ -103,7 +108,7 @@ Result<TempFile> writeTemp(const std::vector<std::uint8_t>& bytes, const std::st
     int fd = mkstemps(tmpl.data(), static_cast<int>(ext.size()));
     if (fd < 0) return makeError(ErrorCode::Io, "dermis::readImage", "", "cannot create a temporary file");
     ::close(fd);
-    TempFile t{tmpl};
+    TempFile t(tmpl);
     std::ofstream out(t.path, std::ios::binary);
     out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     if (!out) return makeError(ErrorCode::Io, "dermis::readImage", "", "cannot write a temporary file");

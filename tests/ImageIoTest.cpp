@@ -1,0 +1,147 @@
+// ImageIoTest — pattern images in (SPEC §2 value mapping), float maps out, bad files rejected.
+// Writes and reads temporary files through OpenImageIO.
+#include "io/image_io.hpp"
+#include "TestFiles.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace dermis;
+using namespace dermis::test;
+using OIIO::TypeDesc;
+
+TEST(ImageIoTest, SixteenBitMapping) {
+    TempDir dir;
+    const std::vector<std::uint16_t> px = {0, 1, 32768, 65535, 49151, 16384};
+    writeImage(dir / "p16.png", 3, 2, 1, px, TypeDesc::UINT16);
+    auto img = readHeightImage(dir / "p16.png");
+    ASSERT_TRUE(img.ok()) << img.error().message;
+    ASSERT_EQ(img->width, 3);
+    ASSERT_EQ(img->height, 2);
+    EXPECT_FLOAT_EQ(img->at(0, 0), -1.0f); // (0 − 32768)/32767 clamped
+    EXPECT_FLOAT_EQ(img->at(1, 0), -1.0f); // (1 − 32768)/32767 = −1 exactly
+    EXPECT_FLOAT_EQ(img->at(2, 0), 0.0f);
+    EXPECT_FLOAT_EQ(img->at(0, 1), 1.0f);
+    EXPECT_FLOAT_EQ(img->at(1, 1), static_cast<float>((49151 - 32768) / 32767.0));
+    EXPECT_FLOAT_EQ(img->at(2, 1), static_cast<float>((16384 - 32768) / 32767.0));
+}
+
+TEST(ImageIoTest, EightBitMappingAndFirstChannel) {
+    TempDir dir;
+    // RGB: only the first (red) channel counts.
+    const std::vector<std::uint8_t> px = {0, 200, 200, 128, 0, 0, 255, 9, 9, 191, 255, 255};
+    writeImage(dir / "p8.png", 2, 2, 3, px, TypeDesc::UINT8);
+    auto img = readHeightImage(dir / "p8.png");
+    ASSERT_TRUE(img.ok()) << img.error().message;
+    EXPECT_FLOAT_EQ(img->at(0, 0), -1.0f);
+    EXPECT_FLOAT_EQ(img->at(1, 0), 0.0f);
+    EXPECT_FLOAT_EQ(img->at(0, 1), 1.0f);
+    EXPECT_FLOAT_EQ(img->at(1, 1), static_cast<float>((191 - 128) / 127.0));
+}
+
+TEST(ImageIoTest, FloatImagesAsTheyAreClamped) {
+    TempDir dir;
+    const std::vector<float> px = {-0.5f, 0.25f, 2.0f, -3.0f};
+    writeImage(dir / "pf.exr", 2, 2, 1, px, TypeDesc::FLOAT);
+    writeImage(dir / "pf.tif", 2, 2, 1, px, TypeDesc::FLOAT);
+    for (const char* name : {"pf.exr", "pf.tif"}) {
+        auto img = readHeightImage(dir / name);
+        ASSERT_TRUE(img.ok()) << img.error().message;
+        EXPECT_FLOAT_EQ(img->at(0, 0), -0.5f) << name;
+        EXPECT_FLOAT_EQ(img->at(1, 0), 0.25f) << name;
+        EXPECT_FLOAT_EQ(img->at(0, 1), 1.0f) << name;
+        EXPECT_FLOAT_EQ(img->at(1, 1), -1.0f) << name;
+    }
+}
+
+TEST(ImageIoTest, TiffSixteenBitAndFromMemory) {
+    TempDir dir;
+    const std::vector<std::uint16_t> px = {32768, 65535};
+    writeImage(dir / "p.tif", 2, 1, 1, px, TypeDesc::UINT16);
+    writeImage(dir / "p.png", 2, 1, 1, px, TypeDesc::UINT16);
+    for (const char* name : {"p.tif", "p.png"}) {
+        auto img = readHeightImageFromMemory(readBytes(dir / name));
+        ASSERT_TRUE(img.ok()) << name << ": " << img.error().message;
+        EXPECT_FLOAT_EQ(img->at(0, 0), 0.0f);
+        EXPECT_FLOAT_EQ(img->at(1, 0), 1.0f);
+    }
+}
+
+TEST(ImageIoTest, WritesSingleChannelFloatExrRowZeroFirst) {
+    TempDir dir;
+    HeightImage img(3, 2);
+    img.at(0, 0) = 0.125f;
+    img.at(2, 1) = -0.75f;
+    ASSERT_TRUE(writeFloatImage(dir / "m.exr", img).ok());
+    auto in = OIIO::ImageInput::open(dir / "m.exr");
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    EXPECT_EQ(spec.nchannels, 1);
+    EXPECT_EQ(spec.format, TypeDesc::FLOAT);
+    std::vector<float> px(6);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 1, TypeDesc::FLOAT, px.data()));
+    EXPECT_EQ(px[0], 0.125f);
+    EXPECT_EQ(px[5], -0.75f);
+    // And back through the pattern reader.
+    auto back = readHeightImage(dir / "m.exr");
+    ASSERT_TRUE(back.ok());
+    EXPECT_EQ(back->data, img.data);
+}
+
+TEST(ImageIoTest, Height16PngRoundTrip) {
+    TempDir dir;
+    HeightImage img(2, 1);
+    img.at(0, 0) = 0.0f;
+    img.at(1, 0) = -0.5f;
+    ASSERT_TRUE(writeHeight16Png(dir / "h.png", img).ok());
+    auto back = readHeightImage(dir / "h.png");
+    ASSERT_TRUE(back.ok());
+    EXPECT_FLOAT_EQ(back->at(0, 0), 0.0f);
+    EXPECT_NEAR(back->at(1, 0), -0.5f, 1.0 / 32767);
+}
+
+TEST(ImageIoTest, DecodeImage8ExpandsGrey) {
+    TempDir dir;
+    const std::vector<std::uint8_t> px = {10, 250};
+    writeImage(dir / "g.png", 2, 1, 1, px, TypeDesc::UINT8);
+    auto img = decodeImage8(readBytes(dir / "g.png"));
+    ASSERT_TRUE(img.ok()) << img.error().message;
+    ASSERT_EQ(img->rgba.size(), 8u);
+    EXPECT_EQ(img->rgba[0], 10);
+    EXPECT_EQ(img->rgba[2], 10);
+    EXPECT_EQ(img->rgba[3], 255);
+    EXPECT_EQ(img->rgba[5], 250);
+}
+
+TEST(ImageIoTest, BadFilesGiveErrorsNotCrashes) {
+    TempDir dir;
+    EXPECT_EQ(readHeightImage(dir / "missing.png").error().code, ErrorCode::NotFound);
+    EXPECT_FALSE(readHeightImageFromMemory({}).ok());
+    EXPECT_FALSE(decodeImage8({}).ok());
+    std::vector<std::uint8_t> garbage(300);
+    std::mt19937 rng(5);
+    for (auto& b : garbage) b = static_cast<std::uint8_t>(rng());
+    EXPECT_FALSE(readHeightImageFromMemory(garbage).ok());
+    writeBytes(dir / "garbage.png", garbage);
+    EXPECT_FALSE(readHeightImage(dir / "garbage.png").ok());
+
+    std::vector<std::uint16_t> px(64 * 64);
+    for (auto& v : px) v = static_cast<std::uint16_t>(rng());
+    writeImage(dir / "ok.png", 64, 64, 1, px, TypeDesc::UINT16);
+    const auto bytes = readBytes(dir / "ok.png");
+    for (std::size_t cut : {std::size_t(8), std::size_t(30), bytes.size() / 2, bytes.size() - 40}) {
+        std::vector<std::uint8_t> truncated(bytes.begin(), bytes.begin() + cut);
+        EXPECT_FALSE(readHeightImageFromMemory(truncated).ok()) << cut;
+        writeBytes(dir / "t.png", truncated);
+        EXPECT_FALSE(readHeightImage(dir / "t.png").ok()) << cut;
+    }
+}
+
+TEST(ImageIoTest, OversizedPatternsAreRejected) {
+    TempDir dir;
+    std::vector<std::uint8_t> px(kMaxPatternSize + 1, 128);
+    writeImage(dir / "wide.png", kMaxPatternSize + 1, 1, 1, px, TypeDesc::UINT8);
+    auto img = readHeightImage(dir / "wide.png");
+    ASSERT_FALSE(img.ok());
+    EXPECT_EQ(img.error().code, ErrorCode::InvalidArgument);
+    EXPECT_NE(img.error().message.find("larger than the limit"), std::string::npos);
+}
