@@ -4,7 +4,7 @@ ASAN_BUILD ?= build-asan
 JOBS ?= 2
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-asan run bench clean format
+.PHONY: all deps build test test-asan run bench patterns clean format
 
 all: build
 
@@ -34,6 +34,10 @@ run: build
 
 bench: build
 	$(BUILD)/bench/dermis-bench
+
+# Regenerates the built-in pattern library (patterns/*.png, manifest.json, contact sheet).
+patterns: build
+	cmake --build $(BUILD) --target patterns
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
