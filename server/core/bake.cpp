@@ -14,17 +14,6 @@ int findPosable(const Model& model, const std::string& name) {
     return -1;
 }
 
-/// RFC 6901 escaping of one reference token.
-std::string pointerToken(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        if (c == '~') out += "~0";
-        else if (c == '/') out += "~1";
-        else out += c;
-    }
-    return out;
-}
-
 } // namespace
 
 Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
@@ -48,7 +37,7 @@ Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
     for (const auto& [name, jp] : pose.joints) {
         const int n = findPosable(model, name);
         if (n < 0)
-            return makeError(ErrorCode::NotFound, where, "/pose/joints/" + pointerToken(name),
+            return makeError(ErrorCode::NotFound, where, "/pose/joints/" + jsonPointerEscape(name),
                              "the model has no joint named '" + name + "'");
         if (jp.rotation) {
             const auto& q = *jp.rotation; // [x, y, z, w]

@@ -1,1 +1,991 @@
-// placeholder: implemented in this issue
+// Dermis core — the scene document `dermis.scene/1` (SPEC §2b) and the pattern manifest
+// `dermis.patterns/1` (SPEC §3): validation with JSON-pointer errors, defaults, serialisation.
+//
+// Every reader below takes the value and the RFC 6901 pointer of where it sits in the document,
+// so that whatever fails can name the field ("/placements/3/theta_max") in Error::field.
+// Unknown fields are ignored (SPEC §2b: "more fields may be added").
+#include "scene.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <set>
+#include <string_view>
+#include <utility>
+
+namespace dermis {
+
+using json = nlohmann::json;
+
+namespace {
+
+constexpr const char* kSceneWhere = "dermis::parseScene";
+constexpr const char* kSceneTextWhere = "dermis::parseSceneText";
+constexpr const char* kManifestWhere = "dermis::parsePatternManifest";
+constexpr const char* kSceneFormat = "dermis.scene/1";
+constexpr const char* kManifestFormat = "dermis.patterns/1";
+constexpr const char* kBuiltinPrefix = "builtin:";
+
+/// A placement's footprint may cover the UV square many times over, but not absurdly: a scale of
+/// 1e300 would make every texel of the map sample one pattern texel and is surely a typo.
+constexpr double kMaxPlacementScale = 16.0;
+/// Ids end up in URLs (/scenes/{id}/placements/{pid}) and file names; keep them short.
+constexpr std::size_t kMaxIdLength = 128;
+constexpr std::size_t kMaxPathLength = 4096;
+
+// --- small predicates -------------------------------------------------------------------------
+
+/// Strict UTF-8 (no overlongs, no surrogates, ≤ U+10FFFF). Text parsed by nlohmann is already
+/// valid; this guards documents built in code from raw bytes, which dump() would throw on.
+bool validUtf8(std::string_view s) {
+    std::size_t i = 0;
+    while (i < s.size()) {
+        const auto c = static_cast<unsigned char>(s[i]);
+        std::size_t n = 0;
+        std::uint32_t cp = 0;
+        if (c < 0x80) {
+            ++i;
+            continue;
+        } else if ((c & 0xE0) == 0xC0) {
+            n = 1;
+            cp = c & 0x1Fu;
+        } else if ((c & 0xF0) == 0xE0) {
+            n = 2;
+            cp = c & 0x0Fu;
+        } else if ((c & 0xF8) == 0xF0) {
+            n = 3;
+            cp = c & 0x07u;
+        } else {
+            return false;
+        }
+        if (i + n >= s.size()) return false; // truncated sequence
+        for (std::size_t k = 1; k <= n; ++k) {
+            const auto cc = static_cast<unsigned char>(s[i + k]);
+            if ((cc & 0xC0) != 0x80) return false;
+            cp = (cp << 6) | (cc & 0x3Fu);
+        }
+        static constexpr std::uint32_t kMin[4] = {0, 0x80, 0x800, 0x10000};
+        if (cp < kMin[n] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+        i += n + 1;
+    }
+    return true;
+}
+
+bool isAlnum(char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+}
+
+/// Built-in pattern ids: [a-z0-9_]+.
+bool isManifestId(std::string_view s) {
+    if (s.empty() || s.size() > kMaxIdLength) return false;
+    return std::all_of(s.begin(), s.end(), [](char c) {
+        return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+    });
+}
+
+/// Scene-level ids (custom patterns, placements): [A-Za-z0-9_.-]+ starting with a letter, digit
+/// or underscore, so that "." and ".." can never be an id (they are URL path segments).
+bool isSceneId(std::string_view s) {
+    if (s.empty() || s.size() > kMaxIdLength) return false;
+    if (!isAlnum(s.front()) && s.front() != '_') return false;
+    return std::all_of(s.begin(), s.end(),
+                       [](char c) { return isAlnum(c) || c == '_' || c == '.' || c == '-'; });
+}
+
+/// Names after "builtin:" select a file in the data folder: [A-Za-z0-9_-]+ only, no path tricks.
+bool isBuiltinName(std::string_view s) {
+    if (s.empty() || s.size() > kMaxIdLength) return false;
+    return std::all_of(s.begin(), s.end(),
+                       [](char c) { return isAlnum(c) || c == '_' || c == '-'; });
+}
+
+/// A manifest's file name: relative, '/'-separated, no empty, "." or ".." segments, no backslash,
+/// colon (drive letters, URLs) or control characters — it must stay inside the manifest's folder.
+bool isPlainRelativePath(std::string_view f) {
+    if (f.empty() || f.size() > kMaxPathLength) return false;
+    for (char c : f)
+        if (c == '\\' || c == ':' || static_cast<unsigned char>(c) < 0x20) return false;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t slash = f.find('/', start);
+        const std::string_view seg = f.substr(
+            start, slash == std::string_view::npos ? std::string_view::npos : slash - start);
+        if (seg.empty() || seg == "." || seg == "..") return false;
+        if (slash == std::string_view::npos) return true;
+        start = slash + 1;
+    }
+}
+
+std::string describeType(const json& v) {
+    return v.type_name();
+}
+
+/// Another version of our own format is valid input this build does not handle (Unsupported);
+/// anything else in "format" is simply wrong (InvalidArgument).
+ErrorCode formatErrorCode(const std::string& got, std::string_view family) {
+    return got.rfind(family, 0) == 0 ? ErrorCode::Unsupported : ErrorCode::InvalidArgument;
+}
+
+/// Makes `v` unit length. Returns false for a zero vector. A vector that is already unit (to
+/// within 1e-12 in squared length) is kept bit for bit, so that parse → serialise → parse does not
+/// drift by an ulp.
+template <std::size_t N> bool normalizeInPlace(std::array<double, N>& v) {
+    double m = 0.0;
+    for (double c : v)
+        m = std::max(m, std::abs(c));
+    if (!(m > 0.0)) return false;
+    double sq = 0.0;
+    for (double c : v)
+        sq += c * c;
+    // The tolerance is far above the rounding error of one normalisation (a few ulps) and far
+    // below anything that matters to an axis or a rotation.
+    if (std::abs(sq - 1.0) <= 1e-12) return true;
+    // Scale by the largest component first so that tiny or huge inputs neither underflow nor
+    // overflow.
+    double sqScaled = 0.0;
+    for (double c : v)
+        sqScaled += (c / m) * (c / m);
+    const double len = std::sqrt(sqScaled);
+    for (double& c : v)
+        c = (c / m) / len;
+    return true;
+}
+
+// --- the reader: typed access with pointer-named errors ----------------------------------------
+
+class Reader {
+  public:
+    explicit Reader(const char* where) : where_(where) {}
+
+    Error bad(const std::string& ptr, const std::string& what,
+              ErrorCode code = ErrorCode::InvalidArgument) const {
+        return makeError(code, where_, ptr, what);
+    }
+
+    /// The member `key` of object `obj`, or nullptr when absent.
+    static const json* find(const json& obj, const char* key) {
+        auto it = obj.find(key);
+        return it == obj.end() ? nullptr : &*it;
+    }
+
+    Status object(const json& v, const std::string& ptr) const {
+        if (!v.is_object()) return bad(ptr, "expected an object, got " + describeType(v));
+        return Ok{};
+    }
+
+    Status array(const json& v, const std::string& ptr) const {
+        if (!v.is_array()) return bad(ptr, "expected an array, got " + describeType(v));
+        return Ok{};
+    }
+
+    /// A finite number (booleans and null are not numbers).
+    Result<double> number(const json& v, const std::string& ptr) const {
+        if (!v.is_number()) return bad(ptr, "expected a number, got " + describeType(v));
+        const double d = v.get<double>();
+        if (!std::isfinite(d)) return bad(ptr, "must be a finite number");
+        return d;
+    }
+
+    /// A finite number ≥ lo (and ≤ hi).
+    Result<double> numberIn(const json& v, const std::string& ptr, double lo,
+                            double hi = std::numeric_limits<double>::infinity()) const {
+        auto d = number(v, ptr);
+        if (!d) return d;
+        if (*d < lo || *d > hi) {
+            std::string range = std::isinf(hi) ? "must be >= " + fmt(lo)
+                                               : "must be in [" + fmt(lo) + ", " + fmt(hi) + "]";
+            return bad(ptr, range + ", got " + fmt(*d));
+        }
+        return d;
+    }
+
+    /// An integral number in [lo, hi]. 512.0 is accepted (it is an integer), 10.5 is not.
+    Result<int> integer(const json& v, const std::string& ptr, int lo, int hi) const {
+        if (!v.is_number()) return bad(ptr, "expected an integer, got " + describeType(v));
+        const double d = v.get<double>();
+        if (!std::isfinite(d) || d != std::floor(d)) return bad(ptr, "must be an integer");
+        if (d < lo || d > hi)
+            return bad(ptr, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                                "], got " + fmt(d));
+        return static_cast<int>(d);
+    }
+
+    Result<std::string> string(const json& v, const std::string& ptr, bool nonEmpty = true) const {
+        if (!v.is_string()) return bad(ptr, "expected a string, got " + describeType(v));
+        const auto& s = v.get_ref<const std::string&>();
+        if (nonEmpty && s.empty()) return bad(ptr, "must not be empty");
+        if (!validUtf8(s)) return bad(ptr, "must be valid UTF-8");
+        return s;
+    }
+
+    /// A file path or reference: a non-empty string without NUL bytes, of sane length.
+    Result<std::string> path(const json& v, const std::string& ptr) const {
+        auto s = string(v, ptr);
+        if (!s) return s;
+        if (s->size() > kMaxPathLength) return bad(ptr, "is too long");
+        if (s->find('\0') != std::string::npos) return bad(ptr, "must not contain NUL characters");
+        return s;
+    }
+
+    /// An array of exactly N finite numbers; an element's error names the element.
+    template <std::size_t N>
+    Result<std::array<double, N>> numbers(const json& v, const std::string& ptr) const {
+        if (!v.is_array())
+            return bad(ptr, "expected an array of " + std::to_string(N) + " numbers, got " +
+                                describeType(v));
+        if (v.size() != N)
+            return bad(ptr, "must have exactly " + std::to_string(N) + " elements, got " +
+                                std::to_string(v.size()));
+        std::array<double, N> out{};
+        for (std::size_t i = 0; i < N; ++i) {
+            auto d = number(v[i], ptr + "/" + std::to_string(i));
+            if (!d) return d.error();
+            out[i] = *d;
+        }
+        return out;
+    }
+
+    /// [w, h], each an integer in [lo, hi].
+    Result<std::array<int, 2>> size(const json& v, const std::string& ptr, int lo, int hi) const {
+        if (!v.is_array())
+            return bad(ptr, "expected an array [width, height], got " + describeType(v));
+        if (v.size() != 2)
+            return bad(ptr, "must have exactly 2 elements, got " + std::to_string(v.size()));
+        std::array<int, 2> out{};
+        for (std::size_t i = 0; i < 2; ++i) {
+            auto n = integer(v[i], ptr + "/" + std::to_string(i), lo, hi);
+            if (!n) return n.error();
+            out[i] = *n;
+        }
+        return out;
+    }
+
+    /// Shortest text that reads back as `d`; integral values without a trailing ".0".
+    static std::string fmt(double d) {
+        if (std::isfinite(d) && d == std::floor(d) && std::abs(d) < 1e15)
+            return std::to_string(static_cast<long long>(d));
+        return json(d).dump();
+    }
+
+  private:
+    const char* where_;
+};
+
+/// Joins a pointer and a member name (escaped).
+std::string member(const std::string& ptr, const std::string& key) {
+    return ptr + "/" + jsonPointerEscape(key);
+}
+std::string member(const std::string& ptr, std::size_t index) {
+    return ptr + "/" + std::to_string(index);
+}
+
+// --- axis ---------------------------------------------------------------------------------------
+
+/// "x" | "y" | "z" → unit vector; nullopt otherwise.
+std::optional<std::array<double, 3>> namedAxis(std::string_view name) {
+    if (name == "x") return std::array<double, 3>{1, 0, 0};
+    if (name == "y") return std::array<double, 3>{0, 1, 0};
+    if (name == "z") return std::array<double, 3>{0, 0, 1};
+    return std::nullopt;
+}
+
+// --- scene sections -----------------------------------------------------------------------------
+
+Status parseHeightmap(const Reader& rd, const json& v, Scene& scene) {
+    const std::string ptr = "/heightmap";
+    if (auto s = rd.object(v, ptr); !s) return s;
+    if (const json* size = Reader::find(v, "size")) {
+        auto wh = rd.size(*size, ptr + "/size", 1, kMaxHeightmapSize);
+        if (!wh) return wh.error();
+        scene.heightmapSize = *wh;
+    }
+    if (const json* base = Reader::find(v, "base")) {
+        auto p = rd.path(*base, ptr + "/base");
+        if (!p) return p.error();
+        scene.heightmapBase = *p;
+    }
+    return Ok{};
+}
+
+Status parsePatterns(const Reader& rd, const json& v, const PatternManifest& manifest,
+                     Scene& scene) {
+    const std::string ptr = "/patterns";
+    if (auto s = rd.object(v, ptr); !s) return s;
+    for (const auto& [id, value] : v.items()) {
+        const std::string p = member(ptr, id);
+        if (!isSceneId(id))
+            return rd.bad(p, "pattern id '" + id +
+                                 "' must match [A-Za-z0-9_][A-Za-z0-9_.-]* (at "
+                                 "most " +
+                                 std::to_string(kMaxIdLength) + " characters)");
+        if (manifest.find(id))
+            return rd.bad(p, "pattern id '" + id + "' collides with a built-in pattern");
+        auto path = rd.path(value, p);
+        if (!path) return path.error();
+        scene.patterns.emplace(id, *path);
+    }
+    return Ok{};
+}
+
+/// One placement. `reservedIds` holds every explicit id of the document (so generated ids avoid
+/// them); `seenIds` the ids of the placements before this one.
+Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const Scene& scene,
+                      const PatternManifest& manifest, const std::set<std::string>& reservedIds,
+                      std::set<std::string>& seenIds, Placement& out) {
+    const std::string ptr = member("/placements", index);
+    if (auto s = rd.object(v, ptr); !s) return s;
+
+    // id: explicit (validated, unique) or generated "p<index>" (suffixed if that is taken).
+    if (const json* id = Reader::find(v, "id")) {
+        auto s = rd.string(*id, ptr + "/id");
+        if (!s) return s.error();
+        if (!isSceneId(*s))
+            return rd.bad(ptr + "/id", "placement id '" + *s +
+                                           "' must match [A-Za-z0-9_][A-Za-z0-9_.-]* (at most " +
+                                           std::to_string(kMaxIdLength) + " characters)");
+        if (seenIds.count(*s)) return rd.bad(ptr + "/id", "duplicate placement id '" + *s + "'");
+        out.id = *s;
+    } else {
+        std::string generated = "p" + std::to_string(index);
+        for (int k = 1; reservedIds.count(generated) || seenIds.count(generated); ++k)
+            generated = "p" + std::to_string(index) + "_" + std::to_string(k);
+        out.id = generated;
+    }
+    seenIds.insert(out.id);
+
+    // pattern (required): a custom pattern of this scene or a built-in one. Its defaults follow.
+    const json* pattern = Reader::find(v, "pattern");
+    if (!pattern) return rd.bad(ptr + "/pattern", "is required");
+    auto patternId = rd.string(*pattern, ptr + "/pattern");
+    if (!patternId) return patternId.error();
+    out.pattern = *patternId;
+    if (scene.patterns.count(out.pattern)) {
+        // Custom patterns carry no kind: scale model on the bump map, the most common case.
+        out.model = DeformModel::Scale;
+        out.target = Target::Bump;
+    } else if (const PatternInfo* info = manifest.find(out.pattern)) {
+        // Built-in ones suggest model, target, axis and theta range through the manifest.
+        out.model = info->model;
+        out.target = info->target;
+        out.thetaMin = info->thetaMin;
+        out.thetaMax = info->thetaMax;
+        if (auto a = namedAxis(info->axis)) {
+            out.axisName = info->axis;
+            out.axis = *a;
+        }
+    } else {
+        return rd.bad(ptr + "/pattern",
+                      "unknown pattern '" + out.pattern +
+                          "': neither a key of \"patterns\" nor a built-in pattern id",
+                      ErrorCode::NotFound);
+    }
+
+    if (const json* c = Reader::find(v, "center")) {
+        auto uv = rd.numbers<2>(*c, ptr + "/center");
+        if (!uv) return uv.error();
+        out.center = *uv;
+    }
+    if (const json* s = Reader::find(v, "scale")) {
+        auto su = rd.numbers<2>(*s, ptr + "/scale");
+        if (!su) return su.error();
+        for (std::size_t i = 0; i < 2; ++i)
+            if ((*su)[i] <= 0.0 || (*su)[i] > kMaxPlacementScale)
+                return rd.bad(member(ptr + "/scale", i), "must be in (0, " +
+                                                             Reader::fmt(kMaxPlacementScale) +
+                                                             "], got " + Reader::fmt((*su)[i]));
+        out.scale = *su;
+    }
+    if (const json* r = Reader::find(v, "rotation")) {
+        auto d = rd.number(*r, ptr + "/rotation");
+        if (!d) return d.error();
+        out.rotation = *d;
+    }
+
+    const json* joint = Reader::find(v, "joint");
+    if (!joint) return rd.bad(ptr + "/joint", "is required");
+    auto jointName = rd.string(*joint, ptr + "/joint");
+    if (!jointName) return jointName.error();
+    out.joint = *jointName;
+
+    if (const json* a = Reader::find(v, "axis")) {
+        const std::string p = ptr + "/axis";
+        if (a->is_string()) {
+            auto named = namedAxis(a->get_ref<const std::string&>());
+            if (!named) return rd.bad(p, "must be \"x\", \"y\", \"z\" or a 3-vector");
+            out.axisName = a->get<std::string>();
+            out.axis = *named;
+        } else if (a->is_array()) {
+            auto vec = rd.numbers<3>(*a, p);
+            if (!vec) return vec.error();
+            if (!normalizeInPlace(*vec)) return rd.bad(p, "must have a non-zero length");
+            out.axisName.clear();
+            out.axis = *vec;
+        } else {
+            return rd.bad(p, "expected \"x\", \"y\", \"z\" or a 3-vector, got " + describeType(*a));
+        }
+    }
+
+    if (const json* t = Reader::find(v, "theta_min")) {
+        auto d = rd.number(*t, ptr + "/theta_min");
+        if (!d) return d.error();
+        out.thetaMin = *d;
+    }
+    if (const json* t = Reader::find(v, "theta_max")) {
+        auto d = rd.number(*t, ptr + "/theta_max");
+        if (!d) return d.error();
+        out.thetaMax = *d;
+    }
+    if (out.thetaMin == out.thetaMax)
+        return rd.bad(ptr + "/theta_max",
+                      "must differ from theta_min (" + Reader::fmt(out.thetaMin) + ")");
+    if (const json* h = Reader::find(v, "h")) {
+        auto d = rd.numberIn(*h, ptr + "/h", 0.0);
+        if (!d) return d.error();
+        out.h = *d;
+    }
+
+    if (const json* m = Reader::find(v, "model")) {
+        auto s = rd.string(*m, ptr + "/model");
+        if (!s) return s.error();
+        auto model = deformModelFromString(*s);
+        if (!model)
+            return rd.bad(ptr + "/model", "must be \"scale\" or \"bias\", got '" + *s + "'");
+        out.model = *model;
+    }
+    if (const json* t = Reader::find(v, "target")) {
+        auto s = rd.string(*t, ptr + "/target");
+        if (!s) return s.error();
+        auto target = targetFromString(*s);
+        if (!target)
+            return rd.bad(ptr + "/target",
+                          "must be \"bump\" or \"displacement\", got '" + *s + "'");
+        out.target = *target;
+    }
+    if (const json* r = Reader::find(v, "response")) {
+        auto s = rd.string(*r, ptr + "/response");
+        if (!s) return s.error();
+        auto response = responseFromString(*s);
+        if (!response)
+            return rd.bad(ptr + "/response",
+                          "must be \"log2\", \"ln\", \"linear\" or \"smoothstep\", got '" + *s +
+                              "'");
+        out.response = *response;
+    }
+    return Ok{};
+}
+
+Status parsePlacements(const Reader& rd, const json& v, const PatternManifest& manifest,
+                       Scene& scene) {
+    if (auto s = rd.array(v, "/placements"); !s) return s;
+    // Explicit ids first, so that a generated "p0" never takes an id that a later placement
+    // names explicitly.
+    std::set<std::string> reserved;
+    for (const json& p : v)
+        if (p.is_object())
+            if (auto it = p.find("id"); it != p.end() && it->is_string())
+                reserved.insert(it->get<std::string>());
+    std::set<std::string> seen;
+    scene.placements.reserve(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        Placement p;
+        if (auto s = parsePlacement(rd, v[i], i, scene, manifest, reserved, seen, p); !s) return s;
+        scene.placements.push_back(std::move(p));
+    }
+    return Ok{};
+}
+
+Status parseJointPose(const Reader& rd, const json& v, const std::string& ptr, JointPose& out) {
+    if (auto s = rd.object(v, ptr); !s) return s;
+    const json* rotation = Reader::find(v, "rotation");
+    const json* axisAngles = Reader::find(v, "axis_angles");
+    if ((rotation == nullptr) == (axisAngles == nullptr))
+        return rd.bad(ptr, "must have exactly one of \"rotation\" and \"axis_angles\"");
+    if (rotation) {
+        auto q = rd.numbers<4>(*rotation, ptr + "/rotation");
+        if (!q) return q.error();
+        if (!normalizeInPlace(*q))
+            return rd.bad(ptr + "/rotation", "quaternion [x, y, z, w] must have a non-zero length");
+        out.rotation = *q;
+    } else {
+        const std::string p = ptr + "/axis_angles";
+        if (auto s = rd.object(*axisAngles, p); !s) return s;
+        std::array<double, 3> angles{0, 0, 0};
+        static constexpr const char* kNames[3] = {"x", "y", "z"};
+        for (std::size_t i = 0; i < 3; ++i) {
+            if (const json* a = Reader::find(*axisAngles, kNames[i])) {
+                auto d = rd.number(*a, p + "/" + kNames[i]);
+                if (!d) return d.error();
+                angles[i] = *d;
+            }
+        }
+        out.axisAngles = angles;
+    }
+    return Ok{};
+}
+
+Status parsePose(const Reader& rd, const json& v, Pose& pose) {
+    const std::string ptr = "/pose";
+    if (auto s = rd.object(v, ptr); !s) return s;
+    if (const json* a = Reader::find(v, "animation")) {
+        auto s = rd.string(*a, ptr + "/animation");
+        if (!s) return s.error();
+        pose.animation = *s;
+    }
+    if (const json* t = Reader::find(v, "time")) {
+        auto d = rd.numberIn(*t, ptr + "/time", 0.0);
+        if (!d) return d.error();
+        pose.time = *d;
+    }
+    if (const json* joints = Reader::find(v, "joints")) {
+        if (auto s = rd.object(*joints, ptr + "/joints"); !s) return s;
+        for (const auto& [name, jv] : joints->items()) {
+            const std::string p = member(ptr + "/joints", name);
+            if (name.empty()) return rd.bad(p, "joint name must not be empty");
+            if (!validUtf8(name)) return rd.bad(p, "joint name must be valid UTF-8");
+            JointPose jp;
+            if (auto s = parseJointPose(rd, jv, p, jp); !s) return s;
+            pose.joints.emplace(name, jp);
+        }
+    }
+    return Ok{};
+}
+
+/// "auto" (→ nullopt) or a finite number ≥ lo (> lo when `exclusive`).
+Result<std::optional<double>> autoOrNumber(const Reader& rd, const json& v, const std::string& ptr,
+                                           double lo, bool exclusive) {
+    if (v.is_string()) {
+        if (v.get_ref<const std::string&>() == "auto") return std::optional<double>{};
+        return rd.bad(ptr, "must be \"auto\" or a number");
+    }
+    if (!v.is_number()) return rd.bad(ptr, "expected \"auto\" or a number, got " + describeType(v));
+    auto d = rd.number(v, ptr);
+    if (!d) return d.error();
+    if (exclusive ? *d <= lo : *d < lo)
+        return rd.bad(ptr, std::string(exclusive ? "must be > " : "must be >= ") + Reader::fmt(lo) +
+                               " (or \"auto\"), got " + Reader::fmt(*d));
+    return std::optional<double>{*d};
+}
+
+Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
+    const std::string ptr = "/render";
+    if (auto s = rd.object(v, ptr); !s) return s;
+    if (const json* size = Reader::find(v, "size")) {
+        auto wh = rd.size(*size, ptr + "/size", 1, kMaxRenderSize);
+        if (!wh) return wh.error();
+        render.size = *wh;
+    }
+    if (const json* cam = Reader::find(v, "camera")) {
+        const std::string p = ptr + "/camera";
+        if (auto s = rd.object(*cam, p); !s) return s;
+        if (const json* yaw = Reader::find(*cam, "yaw")) {
+            auto d = rd.number(*yaw, p + "/yaw");
+            if (!d) return d.error();
+            render.camera.yaw = *d;
+        }
+        if (const json* pitch = Reader::find(*cam, "pitch")) {
+            auto d = rd.numberIn(*pitch, p + "/pitch", -90.0, 90.0);
+            if (!d) return d.error();
+            render.camera.pitch = *d;
+        }
+        if (const json* dist = Reader::find(*cam, "distance")) {
+            auto d = autoOrNumber(rd, *dist, p + "/distance", 0.0, true);
+            if (!d) return d.error();
+            render.camera.distance = *d;
+        }
+    }
+    if (const json* ds = Reader::find(v, "displacement_scale")) {
+        auto d = autoOrNumber(rd, *ds, ptr + "/displacement_scale", 0.0, false);
+        if (!d) return d.error();
+        render.displacementScale = *d;
+    }
+    if (const json* bs = Reader::find(v, "bump_strength")) {
+        auto d = rd.numberIn(*bs, ptr + "/bump_strength", 0.0);
+        if (!d) return d.error();
+        render.bumpStrength = *d;
+    }
+    if (const json* msaa = Reader::find(v, "msaa")) {
+        auto n = rd.integer(*msaa, ptr + "/msaa", 1, 4);
+        if (!n) return n.error();
+        if (*n == 3) return rd.bad(ptr + "/msaa", "must be 1, 2 or 4, got 3");
+        render.msaa = *n;
+    }
+    return Ok{};
+}
+
+// --- text → json with the pointer of an out-of-range number -------------------------------------
+
+/// Builds the DOM like nlohmann's own SAX DOM parser, but keeps track of where it is, so that a
+/// number that overflows a double (1e999 — nlohmann refuses it rather than yield inf) is reported
+/// at its JSON pointer like any other non-finite value, not as a bare syntax error.
+class TrackingSax final : public json::json_sax_t {
+  public:
+    explicit TrackingSax(json& root) : root_(root) {}
+
+    bool null() override { return put(json(nullptr)) != nullptr; }
+    bool boolean(bool b) override { return put(json(b)) != nullptr; }
+    bool number_integer(json::number_integer_t n) override { return put(json(n)) != nullptr; }
+    bool number_unsigned(json::number_unsigned_t n) override { return put(json(n)) != nullptr; }
+    bool number_float(json::number_float_t d, const json::string_t&) override {
+        return put(json(d)) != nullptr;
+    }
+    bool string(json::string_t& s) override { return put(json(std::move(s))) != nullptr; }
+    bool binary(json::binary_t& b) override { return put(json::binary(std::move(b))) != nullptr; }
+    bool start_object(std::size_t) override { return open(json::object()); }
+    bool key(json::string_t& k) override {
+        keys_.back() = k;
+        return true;
+    }
+    bool end_object() override { return close(); }
+    bool start_array(std::size_t) override { return open(json::array()); }
+    bool end_array() override { return close(); }
+    bool parse_error(std::size_t position, const std::string&, const json::exception& ex) override {
+        errorId = ex.id;
+        errorPosition = position;
+        errorWhat = ex.what();
+        errorPointer = currentPointer();
+        return false;
+    }
+
+    int errorId = 0;
+    std::size_t errorPosition = 0;
+    std::string errorWhat, errorPointer;
+
+  private:
+    /// Stores `v` where the parser is (root, next array element or current member).
+    json* put(json v) {
+        if (stack_.empty()) {
+            root_ = std::move(v);
+            return &root_;
+        }
+        json& top = *stack_.back();
+        if (top.is_array()) {
+            top.push_back(std::move(v));
+            return &top.back();
+        }
+        json& slot = top[keys_.back()];
+        slot = std::move(v);
+        return &slot;
+    }
+    bool open(json container) {
+        // Only the innermost open container is ever modified, so pointers to the outer ones
+        // stay valid while they are on the stack.
+        stack_.push_back(put(std::move(container)));
+        keys_.emplace_back();
+        return true;
+    }
+    bool close() {
+        stack_.pop_back();
+        keys_.pop_back();
+        return true;
+    }
+    /// Pointer of the value being read: for arrays the element about to be appended (or, below
+    /// the innermost level, the one being filled), for objects the current key.
+    std::string currentPointer() const {
+        std::string p;
+        for (std::size_t i = 0; i < stack_.size(); ++i) {
+            const json& c = *stack_[i];
+            if (c.is_array())
+                p += "/" + std::to_string(i + 1 < stack_.size() ? c.size() - 1 : c.size());
+            else
+                p += "/" + jsonPointerEscape(keys_[i]);
+        }
+        return p;
+    }
+
+    json& root_;
+    std::vector<json*> stack_;
+    std::vector<std::string> keys_;
+};
+
+/// "[json.exception.parse_error.101] parse error at …" → "parse error at …".
+std::string stripExceptionPrefix(const std::string& what) {
+    if (!what.empty() && what.front() == '[')
+        if (auto close = what.find("] "); close != std::string::npos) return what.substr(close + 2);
+    return what;
+}
+
+} // namespace
+
+// --- public API ---------------------------------------------------------------------------------
+
+std::string jsonPointerEscape(const std::string& token) {
+    std::string out;
+    out.reserve(token.size());
+    for (char c : token) {
+        if (c == '~')
+            out += "~0";
+        else if (c == '/')
+            out += "~1";
+        else
+            out += c;
+    }
+    return out;
+}
+
+const PatternInfo* PatternManifest::find(const std::string& id) const {
+    for (const PatternInfo& p : patterns)
+        if (p.id == id) return &p;
+    return nullptr;
+}
+
+Result<PatternManifest> parsePatternManifest(const json& doc) {
+    const Reader rd(kManifestWhere);
+    if (auto s = rd.object(doc, ""); !s) return s.error();
+    const json* format = Reader::find(doc, "format");
+    if (!format) return rd.bad("/format", std::string("is required (\"") + kManifestFormat + "\")");
+    auto f = rd.string(*format, "/format");
+    if (!f) return f.error();
+    if (*f != kManifestFormat)
+        return rd.bad("/format",
+                      "must be \"" + std::string(kManifestFormat) + "\", got '" + *f + "'",
+                      formatErrorCode(*f, "dermis.patterns/"));
+
+    const json* list = Reader::find(doc, "patterns");
+    if (!list) return rd.bad("/patterns", "is required");
+    if (auto s = rd.array(*list, "/patterns"); !s) return s.error();
+
+    PatternManifest out;
+    std::set<std::string> ids;
+    for (std::size_t i = 0; i < list->size(); ++i) {
+        const json& e = (*list)[i];
+        const std::string ptr = member("/patterns", i);
+        if (auto s = rd.object(e, ptr); !s) return s.error();
+        PatternInfo info;
+
+        const json* id = Reader::find(e, "id");
+        if (!id) return rd.bad(ptr + "/id", "is required");
+        auto idStr = rd.string(*id, ptr + "/id");
+        if (!idStr) return idStr.error();
+        if (!isManifestId(*idStr))
+            return rd.bad(ptr + "/id", "pattern id '" + *idStr + "' must match [a-z0-9_]+");
+        if (!ids.insert(*idStr).second)
+            return rd.bad(ptr + "/id", "duplicate pattern id '" + *idStr + "'");
+        info.id = *idStr;
+
+        const json* file = Reader::find(e, "file");
+        if (!file) return rd.bad(ptr + "/file", "is required");
+        auto fileStr = rd.string(*file, ptr + "/file");
+        if (!fileStr) return fileStr.error();
+        if (!isPlainRelativePath(*fileStr))
+            return rd.bad(ptr + "/file", "'" + *fileStr +
+                                             "' must be a relative path inside the manifest's "
+                                             "folder (no '..', '\\', ':' or leading '/')");
+        info.file = *fileStr;
+
+        const json* kind = Reader::find(e, "kind");
+        if (!kind) return rd.bad(ptr + "/kind", "is required");
+        auto kindStr = rd.string(*kind, ptr + "/kind");
+        if (!kindStr) return kindStr.error();
+        auto k = patternKindFromString(*kindStr);
+        if (!k)
+            return rd.bad(ptr + "/kind",
+                          "must be \"wrinkle\", \"bulge\" or \"bone\", got '" + *kindStr + "'");
+        info.kind = *k;
+        info.model = defaultModel(*k);
+        info.target = defaultTarget(*k);
+
+        if (const json* m = Reader::find(e, "model")) {
+            auto s = rd.string(*m, ptr + "/model");
+            if (!s) return s.error();
+            auto model = deformModelFromString(*s);
+            if (!model)
+                return rd.bad(ptr + "/model", "must be \"scale\" or \"bias\", got '" + *s + "'");
+            info.model = *model;
+        }
+        if (const json* t = Reader::find(e, "target")) {
+            auto s = rd.string(*t, ptr + "/target");
+            if (!s) return s.error();
+            auto target = targetFromString(*s);
+            if (!target)
+                return rd.bad(ptr + "/target",
+                              "must be \"bump\" or \"displacement\", got '" + *s + "'");
+            info.target = *target;
+        }
+        if (const json* j = Reader::find(e, "joint")) {
+            auto s = rd.string(*j, ptr + "/joint", false);
+            if (!s) return s.error();
+            info.joint = *s;
+        }
+        if (const json* a = Reader::find(e, "axis")) {
+            auto s = rd.string(*a, ptr + "/axis");
+            if (!s) return s.error();
+            if (!namedAxis(*s)) return rd.bad(ptr + "/axis", "must be \"x\", \"y\" or \"z\"");
+            info.axis = *s;
+        }
+        if (const json* t = Reader::find(e, "theta_min")) {
+            auto d = rd.number(*t, ptr + "/theta_min");
+            if (!d) return d.error();
+            info.thetaMin = *d;
+        }
+        if (const json* t = Reader::find(e, "theta_max")) {
+            auto d = rd.number(*t, ptr + "/theta_max");
+            if (!d) return d.error();
+            info.thetaMax = *d;
+        }
+        if (info.thetaMin == info.thetaMax)
+            return rd.bad(ptr + "/theta_max", "must differ from theta_min");
+        if (const json* d = Reader::find(e, "description")) {
+            auto s = rd.string(*d, ptr + "/description", false);
+            if (!s) return s.error();
+            info.description = *s;
+        }
+        out.patterns.push_back(std::move(info));
+    }
+    return out;
+}
+
+json toJson(const PatternManifest& manifest) {
+    json list = json::array();
+    for (const PatternInfo& p : manifest.patterns) {
+        json e = json::object();
+        e["id"] = p.id;
+        e["file"] = p.file;
+        e["kind"] = std::string(toString(p.kind));
+        e["model"] = std::string(toString(p.model));
+        e["target"] = std::string(toString(p.target));
+        e["joint"] = p.joint;
+        e["axis"] = p.axis;
+        e["theta_min"] = p.thetaMin;
+        e["theta_max"] = p.thetaMax;
+        e["description"] = p.description;
+        list.push_back(std::move(e));
+    }
+    json doc = json::object();
+    doc["format"] = kManifestFormat;
+    doc["patterns"] = std::move(list);
+    return doc;
+}
+
+Result<Scene> parseScene(const json& doc, const PatternManifest& manifest) {
+    const Reader rd(kSceneWhere);
+    if (auto s = rd.object(doc, ""); !s)
+        return rd.bad("", "the scene document must be a JSON object, got " + describeType(doc));
+
+    const json* format = Reader::find(doc, "format");
+    if (!format) return rd.bad("/format", std::string("is required (\"") + kSceneFormat + "\")");
+    auto f = rd.string(*format, "/format");
+    if (!f) return f.error();
+    if (*f != kSceneFormat)
+        return rd.bad("/format", "must be \"" + std::string(kSceneFormat) + "\", got '" + *f + "'",
+                      formatErrorCode(*f, "dermis.scene/"));
+
+    Scene scene;
+    if (const json* m = Reader::find(doc, "model")) {
+        auto s = rd.path(*m, "/model");
+        if (!s) return s.error();
+        const std::string_view prefix = kBuiltinPrefix;
+        if (s->rfind(prefix, 0) == 0 && !isBuiltinName(std::string_view(*s).substr(prefix.size())))
+            return rd.bad("/model", "built-in model name '" + *s +
+                                        "' must be \"builtin:\" followed by [A-Za-z0-9_-]+");
+        scene.model = *s;
+    }
+    if (const json* h = Reader::find(doc, "heightmap"))
+        if (auto s = parseHeightmap(rd, *h, scene); !s) return s.error();
+    if (const json* p = Reader::find(doc, "patterns"))
+        if (auto s = parsePatterns(rd, *p, manifest, scene); !s) return s.error();
+    if (const json* p = Reader::find(doc, "placements"))
+        if (auto s = parsePlacements(rd, *p, manifest, scene); !s) return s.error();
+    if (const json* p = Reader::find(doc, "pose"))
+        if (auto s = parsePose(rd, *p, scene.pose); !s) return s.error();
+    if (const json* r = Reader::find(doc, "render"))
+        if (auto s = parseRender(rd, *r, scene.render); !s) return s.error();
+    return scene;
+}
+
+Result<Scene> parseSceneText(const std::string& text, const PatternManifest& manifest) {
+    json doc;
+    TrackingSax sax(doc);
+    bool ok = false;
+    try {
+        ok = json::sax_parse(text, &sax);
+    } catch (const json::exception& e) {
+        // The SAX interface reports errors through parse_error(); this is a safety net only.
+        return makeError(ErrorCode::Parse, kSceneTextWhere, "",
+                         "malformed JSON: " + stripExceptionPrefix(e.what()));
+    }
+    if (!ok) {
+        if (sax.errorId == 406) // out_of_range.406: a number too large for a double
+            return makeError(ErrorCode::InvalidArgument, kSceneWhere, sax.errorPointer,
+                             "must be a finite number (" + stripExceptionPrefix(sax.errorWhat) +
+                                 ")");
+        return makeError(ErrorCode::Parse, kSceneTextWhere, "",
+                         "malformed JSON: " + stripExceptionPrefix(sax.errorWhat));
+    }
+    return parseScene(doc, manifest);
+}
+
+json toJson(const Scene& scene) {
+    json doc = json::object();
+    doc["format"] = kSceneFormat;
+    doc["model"] = scene.model;
+
+    json heightmap = json::object();
+    heightmap["size"] = json::array({scene.heightmapSize[0], scene.heightmapSize[1]});
+    if (scene.heightmapBase) heightmap["base"] = *scene.heightmapBase;
+    doc["heightmap"] = std::move(heightmap);
+
+    json patterns = json::object();
+    for (const auto& [id, path] : scene.patterns)
+        patterns[id] = path;
+    doc["patterns"] = std::move(patterns);
+
+    json placements = json::array();
+    for (const Placement& p : scene.placements) {
+        json e = json::object();
+        e["id"] = p.id;
+        e["pattern"] = p.pattern;
+        e["center"] = json::array({p.center[0], p.center[1]});
+        e["scale"] = json::array({p.scale[0], p.scale[1]});
+        e["rotation"] = p.rotation;
+        e["joint"] = p.joint;
+        if (p.axisName.empty())
+            e["axis"] = json::array({p.axis[0], p.axis[1], p.axis[2]});
+        else
+            e["axis"] = p.axisName;
+        e["theta_min"] = p.thetaMin;
+        e["theta_max"] = p.thetaMax;
+        e["h"] = p.h;
+        e["model"] = std::string(toString(p.model));
+        e["target"] = std::string(toString(p.target));
+        e["response"] = std::string(toString(p.response));
+        placements.push_back(std::move(e));
+    }
+    doc["placements"] = std::move(placements);
+
+    json pose = json::object();
+    if (scene.pose.animation) pose["animation"] = *scene.pose.animation;
+    pose["time"] = scene.pose.time;
+    json joints = json::object();
+    for (const auto& [name, jp] : scene.pose.joints) {
+        json j = json::object();
+        if (jp.rotation) {
+            const auto& q = *jp.rotation;
+            j["rotation"] = json::array({q[0], q[1], q[2], q[3]});
+        } else {
+            const auto a = jp.axisAngles.value_or(std::array<double, 3>{0, 0, 0});
+            j["axis_angles"] = json{{"x", a[0]}, {"y", a[1]}, {"z", a[2]}};
+        }
+        joints[name] = std::move(j);
+    }
+    pose["joints"] = std::move(joints);
+    doc["pose"] = std::move(pose);
+
+    const RenderSettings& r = scene.render;
+    json render = json::object();
+    render["size"] = json::array({r.size[0], r.size[1]});
+    json camera = json::object();
+    camera["yaw"] = r.camera.yaw;
+    camera["pitch"] = r.camera.pitch;
+    camera["distance"] = r.camera.distance ? json(*r.camera.distance) : json("auto");
+    render["camera"] = std::move(camera);
+    render["displacement_scale"] = r.displacementScale ? json(*r.displacementScale) : json("auto");
+    render["bump_strength"] = r.bumpStrength;
+    render["msaa"] = r.msaa;
+    doc["render"] = std::move(render);
+    return doc;
+}
+
+} // namespace dermis

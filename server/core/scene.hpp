@@ -106,4 +106,8 @@ Result<Scene> parseSceneText(const std::string& text, const PatternManifest& man
 /// Serialises with every field explicit ("auto" where optional values are absent).
 nlohmann::json toJson(const Scene& scene);
 
+/// RFC 6901 escaping of one JSON-pointer reference token ("~" → "~0", "/" → "~1"), for building
+/// Error::field values such as "/pose/joints/" + jsonPointerEscape(jointName).
+std::string jsonPointerEscape(const std::string& token);
+
 } // namespace dermis

@@ -1,0 +1,778 @@
+// Scene documents (`dermis.scene/1`, SPEC §2b) and the pattern manifest (`dermis.patterns/1`):
+// parsing, defaults, serialisation round trips, and one test per kind of bad input, each checking
+// the exact JSON pointer that the error names. Pure: no files, no GL.
+#include "core/scene.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+
+using dermis::ErrorCode;
+using dermis::PatternManifest;
+using dermis::Scene;
+using nlohmann::json;
+
+namespace {
+
+/// A small hand-built library: one pattern of each kind, with suggested axis and theta range.
+PatternManifest testManifest() {
+    PatternManifest m;
+    dermis::PatternInfo crease;
+    crease.id = "crease";
+    crease.file = "crease.png";
+    crease.kind = dermis::PatternKind::Wrinkle;
+    crease.model = dermis::DeformModel::Scale;
+    crease.target = dermis::Target::Bump;
+    crease.joint = "elbow";
+    crease.axis = "x";
+    crease.thetaMin = 0;
+    crease.thetaMax = 120;
+    m.patterns.push_back(crease);
+
+    dermis::PatternInfo biceps;
+    biceps.id = "biceps";
+    biceps.file = "biceps.png";
+    biceps.kind = dermis::PatternKind::Bulge;
+    biceps.model = dermis::DeformModel::Scale;
+    biceps.target = dermis::Target::Displacement;
+    biceps.joint = "elbow";
+    biceps.axis = "z";
+    biceps.thetaMin = 10;
+    biceps.thetaMax = 100;
+    m.patterns.push_back(biceps);
+
+    dermis::PatternInfo clavicle;
+    clavicle.id = "clavicle";
+    clavicle.file = "clavicle.png";
+    clavicle.kind = dermis::PatternKind::Bone;
+    clavicle.model = dermis::DeformModel::Bias;
+    clavicle.target = dermis::Target::Bump;
+    clavicle.joint = "shoulder";
+    clavicle.axis = "y";
+    clavicle.thetaMin = -30;
+    clavicle.thetaMax = 60;
+    m.patterns.push_back(clavicle);
+    return m;
+}
+
+/// The example of SPEC §2b, verbatim.
+const char* kSpecExample = R"({
+  "format": "dermis.scene/1",
+  "model": "builtin:default" ,
+  "heightmap": { "size": [1024, 1024], "base": "optional/static_height.exr" },
+  "patterns": { "my_ridge": "custom/ridge.png" },
+  "placements": [
+    { "id": "elbow_l", "pattern": "crease", "center": [0.31, 0.42], "scale": [0.08, 0.05],
+      "rotation": 30, "joint": "forearm.l", "axis": "x", "theta_min": 0, "theta_max": 120,
+      "h": 1.0, "model": "scale", "target": "bump", "response": "log2" }
+  ],
+  "pose": { "animation": "Walk", "time": 0.5,
+            "joints": { "forearm.l": { "rotation": [0, 0, 0.383, 0.924] },
+                        "spine":     { "axis_angles": { "x": 20, "y": -10 } } } },
+  "render": { "size": [1024, 1024], "camera": { "yaw": 0, "pitch": 10, "distance": "auto" },
+              "displacement_scale": "auto", "bump_strength": 1.0 }
+})";
+
+dermis::Result<Scene> parse(const std::string& text) {
+    return dermis::parseSceneText(text, testManifest());
+}
+
+Scene parseOk(const std::string& text) {
+    auto r = parse(text);
+    EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message) << "\n" << text;
+    return r.ok() ? *r : Scene{};
+}
+
+/// parse → serialise → parse → serialise must be byte-identical; returns the first dump.
+std::string expectStableRoundTrip(const std::string& text) {
+    const PatternManifest m = testManifest();
+    auto a = dermis::parseSceneText(text, m);
+    EXPECT_TRUE(a.ok()) << (a.ok() ? "" : a.error().message);
+    if (!a) return {};
+    const std::string first = dermis::toJson(*a).dump();
+    auto b = dermis::parseSceneText(first, m);
+    EXPECT_TRUE(b.ok()) << (b.ok() ? "" : b.error().message) << "\n" << first;
+    if (!b) return first;
+    EXPECT_EQ(first, dermis::toJson(*b).dump());
+    // Pretty-printed text reads back the same too.
+    auto c = dermis::parseSceneText(dermis::toJson(*b).dump(2), m);
+    EXPECT_TRUE(c.ok());
+    if (c) EXPECT_EQ(first, dermis::toJson(*c).dump());
+    return first;
+}
+
+/// `{"format":"dermis.scene/1", <body>}`.
+std::string doc(const std::string& body) {
+    return std::string(R"({"format":"dermis.scene/1")") + (body.empty() ? "" : ",") + body + "}";
+}
+
+/// One placement with the required fields plus `extra`.
+std::string placement(const std::string& extra) {
+    return doc(R"("placements":[{"pattern":"crease","joint":"elbow")" +
+               (extra.empty() ? std::string() : "," + extra) + "}]");
+}
+
+/// A pose with one joint "spine" whose value is `value`.
+std::string spine(const std::string& value) {
+    return doc(R"("pose":{"joints":{"spine":)" + value + "}}");
+}
+
+} // namespace
+
+// --- valid documents ---------------------------------------------------------------------------
+
+TEST(SceneTest, SpecExampleParses) {
+    Scene s = parseOk(kSpecExample);
+    EXPECT_EQ(s.model, "builtin:default");
+    EXPECT_EQ(s.heightmapSize, (std::array<int, 2>{1024, 1024}));
+    ASSERT_TRUE(s.heightmapBase.has_value());
+    EXPECT_EQ(*s.heightmapBase, "optional/static_height.exr");
+    ASSERT_EQ(s.patterns.size(), 1u);
+    EXPECT_EQ(s.patterns.at("my_ridge"), "custom/ridge.png");
+
+    ASSERT_EQ(s.placements.size(), 1u);
+    const dermis::Placement& p = s.placements[0];
+    EXPECT_EQ(p.id, "elbow_l");
+    EXPECT_EQ(p.pattern, "crease");
+    EXPECT_DOUBLE_EQ(p.center[0], 0.31);
+    EXPECT_DOUBLE_EQ(p.center[1], 0.42);
+    EXPECT_DOUBLE_EQ(p.scale[0], 0.08);
+    EXPECT_DOUBLE_EQ(p.scale[1], 0.05);
+    EXPECT_DOUBLE_EQ(p.rotation, 30.0);
+    EXPECT_EQ(p.joint, "forearm.l");
+    EXPECT_EQ(p.axisName, "x");
+    EXPECT_EQ(p.axis, (std::array<double, 3>{1, 0, 0}));
+    EXPECT_DOUBLE_EQ(p.thetaMin, 0.0);
+    EXPECT_DOUBLE_EQ(p.thetaMax, 120.0);
+    EXPECT_DOUBLE_EQ(p.h, 1.0);
+    EXPECT_EQ(p.model, dermis::DeformModel::Scale);
+    EXPECT_EQ(p.target, dermis::Target::Bump);
+    EXPECT_EQ(p.response, dermis::Response::Log2);
+
+    ASSERT_TRUE(s.pose.animation.has_value());
+    EXPECT_EQ(*s.pose.animation, "Walk");
+    EXPECT_DOUBLE_EQ(s.pose.time, 0.5);
+    ASSERT_EQ(s.pose.joints.size(), 2u);
+    const dermis::JointPose& fore = s.pose.joints.at("forearm.l");
+    ASSERT_TRUE(fore.rotation.has_value());
+    EXPECT_FALSE(fore.axisAngles.has_value());
+    const auto& q = *fore.rotation;
+    EXPECT_NEAR(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3], 1.0, 1e-12);
+    EXPECT_NEAR(q[2] / q[3], 0.383 / 0.924, 1e-12); // direction kept, length normalised
+    const dermis::JointPose& sp = s.pose.joints.at("spine");
+    ASSERT_TRUE(sp.axisAngles.has_value());
+    EXPECT_FALSE(sp.rotation.has_value());
+    EXPECT_EQ(*sp.axisAngles, (std::array<double, 3>{20, -10, 0}));
+
+    EXPECT_EQ(s.render.size, (std::array<int, 2>{1024, 1024}));
+    EXPECT_DOUBLE_EQ(s.render.camera.yaw, 0.0);
+    EXPECT_DOUBLE_EQ(s.render.camera.pitch, 10.0);
+    EXPECT_FALSE(s.render.camera.distance.has_value());
+    EXPECT_FALSE(s.render.displacementScale.has_value());
+    EXPECT_DOUBLE_EQ(s.render.bumpStrength, 1.0);
+    EXPECT_EQ(s.render.msaa, 4);
+}
+
+TEST(SceneTest, MinimalDocumentGetsDefaults) {
+    Scene s = parseOk(doc(""));
+    EXPECT_EQ(s.model, "builtin:default");
+    EXPECT_EQ(s.heightmapSize, (std::array<int, 2>{1024, 1024}));
+    EXPECT_FALSE(s.heightmapBase.has_value());
+    EXPECT_TRUE(s.patterns.empty());
+    EXPECT_TRUE(s.placements.empty());
+    EXPECT_FALSE(s.pose.animation.has_value());
+    EXPECT_EQ(s.pose.time, 0.0);
+    EXPECT_TRUE(s.pose.joints.empty());
+    EXPECT_EQ(s.render.size, (std::array<int, 2>{1024, 1024}));
+    EXPECT_EQ(s.render.camera.yaw, 0.0);
+    EXPECT_EQ(s.render.camera.pitch, 10.0);
+    EXPECT_FALSE(s.render.camera.distance.has_value());
+    EXPECT_FALSE(s.render.displacementScale.has_value());
+    EXPECT_EQ(s.render.bumpStrength, 1.0);
+    EXPECT_EQ(s.render.msaa, 4);
+}
+
+TEST(SceneTest, PlacementDefaultsFollowThePatternKind) {
+    Scene s = parseOk(doc(R"("patterns":{"mine":"mine.png"},"placements":[
+        {"pattern":"crease","joint":"a"},
+        {"pattern":"biceps","joint":"b"},
+        {"pattern":"clavicle","joint":"c"},
+        {"pattern":"mine","joint":"d"}])"));
+    ASSERT_EQ(s.placements.size(), 4u);
+    const auto& wrinkle = s.placements[0];
+    EXPECT_EQ(wrinkle.model, dermis::DeformModel::Scale);
+    EXPECT_EQ(wrinkle.target, dermis::Target::Bump);
+    const auto& bulge = s.placements[1];
+    EXPECT_EQ(bulge.model, dermis::DeformModel::Scale);
+    EXPECT_EQ(bulge.target, dermis::Target::Displacement);
+    const auto& bone = s.placements[2];
+    EXPECT_EQ(bone.model, dermis::DeformModel::Bias);
+    EXPECT_EQ(bone.target, dermis::Target::Bump);
+    const auto& custom = s.placements[3];
+    EXPECT_EQ(custom.model, dermis::DeformModel::Scale);
+    EXPECT_EQ(custom.target, dermis::Target::Bump);
+
+    // The manifest's suggested axis and theta range apply to built-in patterns ...
+    EXPECT_EQ(bulge.axisName, "z");
+    EXPECT_EQ(bulge.axis, (std::array<double, 3>{0, 0, 1}));
+    EXPECT_EQ(bulge.thetaMin, 10.0);
+    EXPECT_EQ(bulge.thetaMax, 100.0);
+    EXPECT_EQ(bone.axisName, "y");
+    EXPECT_EQ(bone.thetaMin, -30.0);
+    EXPECT_EQ(bone.thetaMax, 60.0);
+    // ... custom patterns get the struct defaults.
+    EXPECT_EQ(custom.axisName, "x");
+    EXPECT_EQ(custom.thetaMin, 0.0);
+    EXPECT_EQ(custom.thetaMax, 90.0);
+
+    // Everything else per placement.
+    for (const auto& p : s.placements) {
+        EXPECT_EQ(p.center, (std::array<double, 2>{0.5, 0.5}));
+        EXPECT_EQ(p.scale, (std::array<double, 2>{0.1, 0.1}));
+        EXPECT_EQ(p.rotation, 0.0);
+        EXPECT_EQ(p.h, 1.0);
+        EXPECT_EQ(p.response, dermis::Response::Log2);
+    }
+    EXPECT_EQ(s.placements[0].id, "p0");
+    EXPECT_EQ(s.placements[3].id, "p3");
+}
+
+TEST(SceneTest, ExplicitModelAndTargetOverrideTheKind) {
+    Scene s = parseOk(doc(R"("placements":[
+        {"pattern":"clavicle","joint":"a","model":"scale","target":"displacement",
+         "response":"smoothstep"},
+        {"pattern":"biceps","joint":"b","model":"bias","target":"bump","response":"ln"},
+        {"pattern":"crease","joint":"c","response":"linear"}])"));
+    ASSERT_EQ(s.placements.size(), 3u);
+    EXPECT_EQ(s.placements[0].model, dermis::DeformModel::Scale);
+    EXPECT_EQ(s.placements[0].target, dermis::Target::Displacement);
+    EXPECT_EQ(s.placements[0].response, dermis::Response::Smoothstep);
+    EXPECT_EQ(s.placements[1].model, dermis::DeformModel::Bias);
+    EXPECT_EQ(s.placements[1].target, dermis::Target::Bump);
+    EXPECT_EQ(s.placements[1].response, dermis::Response::Ln);
+    EXPECT_EQ(s.placements[2].response, dermis::Response::Linear);
+}
+
+TEST(SceneTest, GeneratedIdsAvoidExplicitOnes) {
+    Scene s = parseOk(doc(R"("placements":[
+        {"pattern":"crease","joint":"a"},
+        {"id":"p0","pattern":"crease","joint":"a"},
+        {"pattern":"crease","joint":"a"}])"));
+    ASSERT_EQ(s.placements.size(), 3u);
+    EXPECT_EQ(s.placements[1].id, "p0");
+    EXPECT_NE(s.placements[0].id, "p0");
+    EXPECT_EQ(s.placements[0].id.rfind("p0", 0), 0u);
+    EXPECT_EQ(s.placements[2].id, "p2");
+    expectStableRoundTrip(doc(R"("placements":[{"pattern":"crease","joint":"a"},
+                                 {"id":"p0","pattern":"crease","joint":"a"}])"));
+}
+
+TEST(SceneTest, AxisVectorIsNormalised) {
+    Scene s = parseOk(placement(R"("axis":[0, 3, -4])"));
+    ASSERT_EQ(s.placements.size(), 1u);
+    const auto& p = s.placements[0];
+    EXPECT_EQ(p.axisName, "");
+    EXPECT_NEAR(p.axis[0], 0.0, 1e-15);
+    EXPECT_NEAR(p.axis[1], 0.6, 1e-15);
+    EXPECT_NEAR(p.axis[2], -0.8, 1e-15);
+
+    // Tiny and huge vectors neither underflow nor overflow.
+    Scene tiny = parseOk(placement(R"("axis":[1e-300, 0, 1e-300])"));
+    EXPECT_NEAR(tiny.placements[0].axis[0], std::sqrt(0.5), 1e-15);
+    Scene huge = parseOk(placement(R"("axis":[1e300, 1e300, 0])"));
+    EXPECT_NEAR(huge.placements[0].axis[1], std::sqrt(0.5), 1e-15);
+
+    // Named axes.
+    EXPECT_EQ(parseOk(placement(R"("axis":"y")")).placements[0].axis,
+              (std::array<double, 3>{0, 1, 0}));
+    EXPECT_EQ(parseOk(placement(R"("axis":"z")")).placements[0].axisName, "z");
+}
+
+TEST(SceneTest, QuaternionIsNormalised) {
+    Scene s = parseOk(spine(R"({"rotation":[0, 0, 2, 0]})"));
+    EXPECT_EQ(*s.pose.joints.at("spine").rotation, (std::array<double, 4>{0, 0, 1, 0}));
+}
+
+TEST(SceneTest, RoundTripIsStable) {
+    expectStableRoundTrip(kSpecExample);
+    expectStableRoundTrip(doc(""));
+    expectStableRoundTrip(doc(R"("patterns":{"mine":"a/b.png","z.1-x":"c.exr"},"placements":[
+        {"pattern":"crease","joint":"a","axis":[0.1, 0.2, 0.3],"rotation":-12.345},
+        {"pattern":"mine","joint":"b","axis":[1, 1, 1],"h":0.3333333333333333,
+         "theta_min":90,"theta_max":-45.5},
+        {"pattern":"biceps","joint":"c","center":[1e-7, 0.9999999],"scale":[16, 1e-9]}],
+        "pose":{"time":3.25,"joints":{"a/b~c":{"rotation":[0.1, 0.2, 0.3, 0.4]},
+                                      "q":{"rotation":[0.5, 0.5, 0.5, 0.5]},
+                                      "e":{"axis_angles":{}}}},
+        "render":{"size":[640, 480],"camera":{"yaw":-725.5,"pitch":-90,"distance":3.5},
+                  "displacement_scale":0,"bump_strength":0,"msaa":1})"));
+}
+
+TEST(SceneTest, RoundTripOfNormalisedVectorsIsStable) {
+    // Normalisation must be idempotent bit for bit, or re-saving a scene would drift.
+    std::mt19937_64 rng(12345);
+    std::uniform_real_distribution<double> uni(-1.0, 1.0);
+    std::uniform_int_distribution<int> exponent(-200, 200);
+    for (int i = 0; i < 300; ++i) {
+        auto component = [&] { return uni(rng) * std::pow(10.0, exponent(rng) % 8); };
+        json axis = json::array({component(), component(), component()});
+        json quat = json::array({component(), component(), component(), component()});
+        expectStableRoundTrip(placement(R"("axis":)" + axis.dump()) + "");
+        expectStableRoundTrip(spine(R"({"rotation":)" + quat.dump() + "}"));
+    }
+}
+
+TEST(SceneTest, SerialisationWritesEveryField) {
+    json j = dermis::toJson(parseOk(placement("")));
+    EXPECT_EQ(j["format"], "dermis.scene/1");
+    EXPECT_EQ(j["model"], "builtin:default");
+    EXPECT_EQ(j["heightmap"]["size"], json::array({1024, 1024}));
+    EXPECT_FALSE(j["heightmap"].contains("base"));
+    EXPECT_TRUE(j["patterns"].is_object());
+    const json& p = j["placements"][0];
+    for (const char* key : {"id", "pattern", "center", "scale", "rotation", "joint", "axis",
+                            "theta_min", "theta_max", "h", "model", "target", "response"})
+        EXPECT_TRUE(p.contains(key)) << key;
+    EXPECT_EQ(p["axis"], "x");
+    EXPECT_EQ(p["response"], "log2");
+    EXPECT_FALSE(j["pose"].contains("animation")); // absent = the model's first clip
+    EXPECT_EQ(j["pose"]["time"], 0.0);
+    EXPECT_TRUE(j["pose"]["joints"].is_object());
+    EXPECT_EQ(j["render"]["camera"]["distance"], "auto");
+    EXPECT_EQ(j["render"]["displacement_scale"], "auto");
+    EXPECT_EQ(j["render"]["msaa"], 4);
+
+    json v = dermis::toJson(parseOk(placement(R"("axis":[0, 0, 5])")));
+    EXPECT_EQ(v["placements"][0]["axis"], json::array({0.0, 0.0, 1.0}));
+    json a = dermis::toJson(parseOk(spine(R"({"axis_angles":{"y":15}})")));
+    EXPECT_EQ(a["pose"]["joints"]["spine"]["axis_angles"],
+              json({{"x", 0.0}, {"y", 15.0}, {"z", 0.0}}));
+}
+
+TEST(SceneTest, AcceptsEdgeValues) {
+    // Integral floats are integers; sizes at both limits; reversed theta range; h = 0.
+    Scene s = parseOk(doc(R"("heightmap":{"size":[4096.0, 1]},"render":{"size":[8192, 1],
+        "camera":{"pitch":90},"msaa":2},"placements":[{"pattern":"crease","joint":"j",
+        "theta_min":120,"theta_max":0,"h":0}])"));
+    EXPECT_EQ(s.heightmapSize, (std::array<int, 2>{4096, 1}));
+    EXPECT_EQ(s.render.size, (std::array<int, 2>{8192, 1}));
+    EXPECT_EQ(s.render.msaa, 2);
+    EXPECT_EQ(s.placements[0].thetaMin, 120.0);
+    EXPECT_EQ(s.placements[0].h, 0.0);
+    // Unknown fields are ignored at every level.
+    parseOk(doc(R"("future":1,"render":{"hdr":true},"placements":[{"pattern":"crease",
+        "joint":"j","note":"x"}],"pose":{"joints":{"j":{"rotation":[0,0,0,1],"w":1}}})"));
+    // A UTF-8 BOM and surrounding whitespace are fine.
+    parseOk("\xEF\xBB\xBF  " + doc("") + "\n");
+}
+
+TEST(SceneTest, ParseSceneFromJsonValue) {
+    json j = json::parse(kSpecExample);
+    auto a = dermis::parseScene(j, testManifest());
+    ASSERT_TRUE(a.ok()) << a.error().message;
+    EXPECT_EQ(dermis::toJson(*a).dump(), dermis::toJson(parseOk(kSpecExample)).dump());
+}
+
+// --- invalid documents: each names its offending field ---------------------------------------
+
+struct BadCase {
+    const char* name;
+    std::string text;
+    std::string pointer;
+    ErrorCode code = ErrorCode::InvalidArgument;
+};
+
+class SceneBadInput : public testing::TestWithParam<BadCase> {};
+
+TEST_P(SceneBadInput, NamesTheField) {
+    const BadCase& c = GetParam();
+    auto r = parse(c.text);
+    ASSERT_FALSE(r.ok()) << c.text;
+    EXPECT_EQ(r.error().field, c.pointer) << r.error().message;
+    EXPECT_EQ(r.error().code, c.code) << r.error().message;
+    EXPECT_FALSE(r.error().message.empty());
+    if (!c.pointer.empty())
+        EXPECT_NE(r.error().message.find(c.pointer), std::string::npos) << r.error().message;
+}
+
+const BadCase kBadCases[] = {
+    // Malformed JSON and the root.
+    {"Empty", "", "", ErrorCode::Parse},
+    {"Truncated", R"({"format": "dermis.scene/1",)", "", ErrorCode::Parse},
+    {"TrailingComma", R"({"format": "dermis.scene/1",})", "", ErrorCode::Parse},
+    {"TrailingGarbage", doc("") + "x", "", ErrorCode::Parse},
+    {"NaNLiteral", doc(R"("render":{"bump_strength":NaN})"), "", ErrorCode::Parse},
+    {"Comment", "// c\n" + doc(""), "", ErrorCode::Parse},
+    {"RootArray", "[1, 2]", ""},
+    {"RootNull", "null", ""},
+    {"RootString", R"("dermis.scene/1")", ""},
+    // format.
+    {"FormatMissing", "{}", "/format"},
+    {"FormatOtherVersion", R"({"format":"dermis.scene/2"})", "/format", ErrorCode::Unsupported},
+    {"FormatWrong", R"({"format":"scene"})", "/format"},
+    {"FormatNumber", R"({"format":1})", "/format"},
+    // model.
+    {"ModelEmpty", doc(R"("model":"")"), "/model"},
+    {"ModelNumber", doc(R"("model":5)"), "/model"},
+    {"ModelBuiltinTraversal", doc(R"("model":"builtin:../../etc/passwd")"), "/model"},
+    {"ModelBuiltinEmpty", doc(R"("model":"builtin:")"), "/model"},
+    // heightmap.
+    {"HeightmapArray", doc(R"("heightmap":[])"), "/heightmap"},
+    {"HeightmapZeroSize", doc(R"("heightmap":{"size":[0, 1024]})"), "/heightmap/size/0"},
+    {"HeightmapNegativeSize", doc(R"("heightmap":{"size":[1024, -1]})"), "/heightmap/size/1"},
+    {"HeightmapHugeSize", doc(R"("heightmap":{"size":[8192, 8192]})"), "/heightmap/size/0"},
+    {"HeightmapVeryHugeSize", doc(R"("heightmap":{"size":[16, 1e300]})"), "/heightmap/size/1"},
+    {"HeightmapFractionalSize", doc(R"("heightmap":{"size":[10.5, 10]})"), "/heightmap/size/0"},
+    {"HeightmapOneElement", doc(R"("heightmap":{"size":[1024]})"), "/heightmap/size"},
+    {"HeightmapSizeString", doc(R"("heightmap":{"size":"1024"})"), "/heightmap/size"},
+    {"HeightmapSizeBool", doc(R"("heightmap":{"size":[true, 1]})"), "/heightmap/size/0"},
+    {"HeightmapBaseEmpty", doc(R"("heightmap":{"base":""})"), "/heightmap/base"},
+    {"HeightmapBaseNull", doc(R"("heightmap":{"base":null})"), "/heightmap/base"},
+    // patterns.
+    {"PatternsArray", doc(R"("patterns":["a.png"])"), "/patterns"},
+    {"PatternIdWithSlash", doc(R"("patterns":{"a/b":"x.png"})"), "/patterns/a~1b"},
+    {"PatternIdDotDot", doc(R"("patterns":{"..":"x.png"})"), "/patterns/.."},
+    {"PatternIdBuiltin", doc(R"("patterns":{"crease":"x.png"})"), "/patterns/crease"},
+    {"PatternPathNumber", doc(R"("patterns":{"mine":3})"), "/patterns/mine"},
+    {"PatternPathEmpty", doc(R"("patterns":{"mine":""})"), "/patterns/mine"},
+    // placements.
+    {"PlacementsObject", doc(R"("placements":{})"), "/placements"},
+    {"PlacementNotObject", doc(R"("placements":[1])"), "/placements/0"},
+    {"PatternMissing", doc(R"("placements":[{"joint":"a"}])"), "/placements/0/pattern"},
+    {"PatternUnknown", doc(R"("placements":[{"pattern":"nope","joint":"a"}])"),
+     "/placements/0/pattern", ErrorCode::NotFound},
+    {"PatternNull", doc(R"("placements":[{"pattern":null,"joint":"a"}])"), "/placements/0/pattern"},
+    {"JointMissing", doc(R"("placements":[{"pattern":"crease"}])"), "/placements/0/joint"},
+    {"JointEmpty", doc(R"("placements":[{"pattern":"crease","joint":""}])"), "/placements/0/joint"},
+    {"CenterOneElement", placement(R"("center":[0.5])"), "/placements/0/center"},
+    {"CenterString", placement(R"("center":["a", 0.5])"), "/placements/0/center/0"},
+    {"CenterOverflow", placement(R"("center":[0.5, 1e999])"), "/placements/0/center/1"},
+    {"ScaleZero", placement(R"("scale":[0, 0.1])"), "/placements/0/scale/0"},
+    {"ScaleNegative", placement(R"("scale":[0.1, -1])"), "/placements/0/scale/1"},
+    {"ScaleHuge", placement(R"("scale":[100, 0.1])"), "/placements/0/scale/0"},
+    {"RotationString", placement(R"("rotation":"30")"), "/placements/0/rotation"},
+    {"RotationNull", placement(R"("rotation":null)"), "/placements/0/rotation"},
+    {"ThetaEqual", placement(R"("theta_min":45,"theta_max":45)"), "/placements/0/theta_max"},
+    {"ThetaEqualToDefault", placement(R"("theta_max":0)"), "/placements/0/theta_max"},
+    {"ThetaMinString", placement(R"("theta_min":"0")"), "/placements/0/theta_min"},
+    {"ThetaMaxOverflow", placement(R"("theta_max":-1e400)"), "/placements/0/theta_max"},
+    {"HNegative", placement(R"("h":-1)"), "/placements/0/h"},
+    {"HOverflow", placement(R"("h":1e400)"), "/placements/0/h"},
+    {"HBool", placement(R"("h":true)"), "/placements/0/h"},
+    {"ModelUnknown", placement(R"("model":"linear")"), "/placements/0/model"},
+    {"TargetUnknown", placement(R"("target":"normal")"), "/placements/0/target"},
+    {"ResponseUnknown", placement(R"("response":"log10")"), "/placements/0/response"},
+    {"ResponseNumber", placement(R"("response":2)"), "/placements/0/response"},
+    {"AxisName", placement(R"("axis":"w")"), "/placements/0/axis"},
+    {"AxisUpperCase", placement(R"("axis":"X")"), "/placements/0/axis"},
+    {"AxisZero", placement(R"("axis":[0, 0, 0])"), "/placements/0/axis"},
+    {"AxisTwoElements", placement(R"("axis":[1, 0])"), "/placements/0/axis"},
+    {"AxisStringElement", placement(R"("axis":[1, "0", 0])"), "/placements/0/axis/1"},
+    {"AxisBool", placement(R"("axis":true)"), "/placements/0/axis"},
+    {"IdDuplicate", doc(R"("placements":[{"id":"a","pattern":"crease","joint":"j"},
+        {"id":"a","pattern":"crease","joint":"j"}])"),
+     "/placements/1/id"},
+    {"IdNumber", placement(R"("id":7)"), "/placements/0/id"},
+    {"IdSlash", placement(R"("id":"a/b")"), "/placements/0/id"},
+    {"IdEmpty", placement(R"("id":"")"), "/placements/0/id"},
+    {"SecondPlacement", doc(R"("placements":[{"pattern":"crease","joint":"j"},
+        {"pattern":"crease","joint":"j","h":-2}])"),
+     "/placements/1/h"},
+    {"SecondPlacementOverflow", doc(R"("placements":[{"pattern":"crease","joint":"j"},
+        {"pattern":"crease","joint":"j","scale":[0.1, 2e308]}])"),
+     "/placements/1/scale/1"},
+    // pose.
+    {"PoseArray", doc(R"("pose":[])"), "/pose"},
+    {"PoseTimeNegative", doc(R"("pose":{"time":-1})"), "/pose/time"},
+    {"PoseTimeString", doc(R"("pose":{"time":"0"})"), "/pose/time"},
+    {"PoseAnimationEmpty", doc(R"("pose":{"animation":""})"), "/pose/animation"},
+    {"PoseAnimationNumber", doc(R"("pose":{"animation":3})"), "/pose/animation"},
+    {"PoseJointsArray", doc(R"("pose":{"joints":[]})"), "/pose/joints"},
+    {"JointBoth", spine(R"({"rotation":[0,0,0,1],"axis_angles":{"x":1}})"), "/pose/joints/spine"},
+    {"JointNeither", spine("{}"), "/pose/joints/spine"},
+    {"JointNumber", spine("5"), "/pose/joints/spine"},
+    {"JointZeroQuaternion", spine(R"({"rotation":[0,0,0,0]})"), "/pose/joints/spine/rotation"},
+    {"JointThreeElementQuaternion", spine(R"({"rotation":[0,0,1]})"),
+     "/pose/joints/spine/rotation"},
+    {"JointQuaternionString", spine(R"({"rotation":[0,0,"1",0]})"),
+     "/pose/joints/spine/rotation/2"},
+    {"JointQuaternionOverflow", spine(R"({"rotation":[0,0,1e309,1]})"),
+     "/pose/joints/spine/rotation/2"},
+    {"JointAxisAnglesString", spine(R"({"axis_angles":{"x":"20"}})"),
+     "/pose/joints/spine/axis_angles/x"},
+    {"JointAxisAnglesArray", spine(R"({"axis_angles":[20]})"), "/pose/joints/spine/axis_angles"},
+    {"JointNameEscaped", doc(R"("pose":{"joints":{"a/b~c":{"rotation":[0,0,0,0]}}})"),
+     "/pose/joints/a~1b~0c/rotation"},
+    {"JointNameEmpty", doc(R"("pose":{"joints":{"":{"rotation":[0,0,0,1]}}})"), "/pose/joints/"},
+    // render.
+    {"RenderNumber", doc(R"("render":1)"), "/render"},
+    {"RenderSizeZero", doc(R"("render":{"size":[0, 1]})"), "/render/size/0"},
+    {"RenderSizeHuge", doc(R"("render":{"size":[9000, 10]})"), "/render/size/0"},
+    {"RenderSizeNull", doc(R"("render":{"size":null})"), "/render/size"},
+    {"CameraString", doc(R"("render":{"camera":"front"})"), "/render/camera"},
+    {"CameraYawNull", doc(R"("render":{"camera":{"yaw":null}})"), "/render/camera/yaw"},
+    {"CameraPitchOutOfRange", doc(R"("render":{"camera":{"pitch":95}})"), "/render/camera/pitch"},
+    {"CameraDistanceZero", doc(R"("render":{"camera":{"distance":0}})"), "/render/camera/distance"},
+    {"CameraDistanceWord", doc(R"("render":{"camera":{"distance":"far"}})"),
+     "/render/camera/distance"},
+    {"CameraDistanceOverflow", doc(R"("render":{"camera":{"distance":1e999}})"),
+     "/render/camera/distance"},
+    {"DisplacementScaleNegative", doc(R"("render":{"displacement_scale":-1})"),
+     "/render/displacement_scale"},
+    {"DisplacementScaleWord", doc(R"("render":{"displacement_scale":"big"})"),
+     "/render/displacement_scale"},
+    {"DisplacementScaleBool", doc(R"("render":{"displacement_scale":false})"),
+     "/render/displacement_scale"},
+    {"BumpStrengthNegative", doc(R"("render":{"bump_strength":-0.5})"), "/render/bump_strength"},
+    {"BumpStrengthOverflow", doc(R"("render":{"bump_strength":1e999})"), "/render/bump_strength"},
+    {"MsaaThree", doc(R"("render":{"msaa":3})"), "/render/msaa"},
+    {"MsaaEight", doc(R"("render":{"msaa":8})"), "/render/msaa"},
+    {"MsaaZero", doc(R"("render":{"msaa":0})"), "/render/msaa"},
+    {"MsaaString", doc(R"("render":{"msaa":"4"})"), "/render/msaa"},
+    {"MsaaFraction", doc(R"("render":{"msaa":2.5})"), "/render/msaa"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Table, SceneBadInput, testing::ValuesIn(kBadCases),
+                         [](const testing::TestParamInfo<BadCase>& info) {
+                             return std::string(info.param.name);
+                         });
+
+TEST(SceneTest, AtLeastFortyBadDocuments) {
+    EXPECT_GE(std::size(kBadCases), 40u);
+}
+
+TEST(SceneTest, FirstErrorInDocumentOrderWins) {
+    // Both the heightmap and the render settings are wrong: the earlier section is reported.
+    auto r = parse(doc(R"("heightmap":{"size":[0,0]},"render":{"msaa":3})"));
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().field, "/heightmap/size/0");
+}
+
+TEST(SceneTest, NonFiniteValuesBuiltInCodeAreRejected) {
+    // Documents built in code (not parsed from text) can hold NaN and inf.
+    const PatternManifest m = testManifest();
+    json j = json::parse(kSpecExample);
+    j["render"]["bump_strength"] = std::numeric_limits<double>::quiet_NaN();
+    auto a = dermis::parseScene(j, m);
+    ASSERT_FALSE(a.ok());
+    EXPECT_EQ(a.error().field, "/render/bump_strength");
+
+    j = json::parse(kSpecExample);
+    j["placements"][0]["center"][1] = std::numeric_limits<double>::infinity();
+    auto b = dermis::parseScene(j, m);
+    ASSERT_FALSE(b.ok());
+    EXPECT_EQ(b.error().field, "/placements/0/center/1");
+
+    j = json::parse(kSpecExample);
+    j["heightmap"]["size"][0] = -std::numeric_limits<double>::infinity();
+    auto c = dermis::parseScene(j, m);
+    ASSERT_FALSE(c.ok());
+    EXPECT_EQ(c.error().field, "/heightmap/size/0");
+
+    // Invalid UTF-8 in a string would make serialisation throw: refuse it at the field.
+    j = json::parse(kSpecExample);
+    j["placements"][0]["joint"] = std::string("arm\xff");
+    auto d = dermis::parseScene(j, m);
+    ASSERT_FALSE(d.ok());
+    EXPECT_EQ(d.error().field, "/placements/0/joint");
+}
+
+TEST(SceneTest, DeeplyNestedInputDoesNotCrash) {
+    std::string deep(100000, '[');
+    auto r = parse(doc(R"("future":)" + deep));
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, ErrorCode::Parse);
+    std::string closed = deep + std::string(100000, ']');
+    auto s = parse(doc(R"("future":)" + closed)); // unknown field: ignored
+    EXPECT_TRUE(s.ok());
+}
+
+TEST(SceneTest, JsonPointerEscape) {
+    EXPECT_EQ(dermis::jsonPointerEscape("a/b~c"), "a~1b~0c");
+    EXPECT_EQ(dermis::jsonPointerEscape("~/"), "~0~1");
+    EXPECT_EQ(dermis::jsonPointerEscape("plain.name"), "plain.name");
+}
+
+// --- the pattern manifest -----------------------------------------------------------------------
+
+namespace {
+
+const char* kManifestText = R"({
+  "format": "dermis.patterns/1",
+  "patterns": [
+    {"id": "crease", "file": "crease.png", "kind": "wrinkle", "joint": "elbow", "axis": "x",
+     "theta_min": 0, "theta_max": 120, "description": "inner-elbow crease"},
+    {"id": "biceps", "file": "bulges/biceps.png", "kind": "bulge", "joint": "elbow",
+     "axis": "z", "theta_min": 10, "theta_max": 100, "description": "round bulge"},
+    {"id": "clavicle", "file": "clavicle.png", "kind": "bone", "joint": "shoulder",
+     "axis": "y", "theta_min": -30, "theta_max": 60, "description": "clavicle ridge"},
+    {"id": "waist_twist", "file": "waist.png", "kind": "wrinkle", "model": "bias",
+     "target": "displacement", "joint": "spine", "axis": "y", "theta_min": 45, "theta_max": -45,
+     "description": ""}
+  ]
+})";
+
+dermis::Result<PatternManifest> parseManifest(const std::string& text) {
+    return dermis::parsePatternManifest(json::parse(text));
+}
+
+/// The manifest with the first entry's member `key` replaced by `value` (JSON text).
+std::string manifestWith(const std::string& key, const std::string& value) {
+    json j = json::parse(kManifestText);
+    j["patterns"][0][key] = json::parse(value);
+    return j.dump();
+}
+
+} // namespace
+
+TEST(PatternManifestTest, ParsesWithKindDefaults) {
+    auto m = parseManifest(kManifestText);
+    ASSERT_TRUE(m.ok()) << m.error().message;
+    ASSERT_EQ(m->patterns.size(), 4u);
+    const dermis::PatternInfo* crease = m->find("crease");
+    ASSERT_NE(crease, nullptr);
+    EXPECT_EQ(crease->file, "crease.png");
+    EXPECT_EQ(crease->kind, dermis::PatternKind::Wrinkle);
+    EXPECT_EQ(crease->model, dermis::DeformModel::Scale);
+    EXPECT_EQ(crease->target, dermis::Target::Bump);
+    EXPECT_EQ(crease->joint, "elbow");
+    EXPECT_EQ(crease->thetaMax, 120.0);
+    EXPECT_EQ(crease->description, "inner-elbow crease");
+
+    const dermis::PatternInfo* biceps = m->find("biceps");
+    ASSERT_NE(biceps, nullptr);
+    EXPECT_EQ(biceps->model, dermis::DeformModel::Scale);
+    EXPECT_EQ(biceps->target, dermis::Target::Displacement);
+    EXPECT_EQ(biceps->file, "bulges/biceps.png");
+
+    const dermis::PatternInfo* bone = m->find("clavicle");
+    ASSERT_NE(bone, nullptr);
+    EXPECT_EQ(bone->model, dermis::DeformModel::Bias);
+    EXPECT_EQ(bone->target, dermis::Target::Bump);
+    EXPECT_EQ(bone->axis, "y");
+
+    const dermis::PatternInfo* twist = m->find("waist_twist");
+    ASSERT_NE(twist, nullptr);
+    EXPECT_EQ(twist->model, dermis::DeformModel::Bias); // explicit beats the kind
+    EXPECT_EQ(twist->target, dermis::Target::Displacement);
+
+    EXPECT_EQ(m->find("nope"), nullptr);
+}
+
+TEST(PatternManifestTest, MinimalEntryGetsDefaults) {
+    auto m = parseManifest(
+        R"({"format":"dermis.patterns/1","patterns":[{"id":"a","file":"a.png","kind":"bone"}]})");
+    ASSERT_TRUE(m.ok()) << m.error().message;
+    const auto& p = m->patterns[0];
+    EXPECT_EQ(p.model, dermis::DeformModel::Bias);
+    EXPECT_EQ(p.target, dermis::Target::Bump);
+    EXPECT_EQ(p.axis, "x");
+    EXPECT_EQ(p.thetaMin, 0.0);
+    EXPECT_EQ(p.thetaMax, 90.0);
+    EXPECT_EQ(p.joint, "");
+}
+
+TEST(PatternManifestTest, RoundTripIsStable) {
+    auto m = parseManifest(kManifestText);
+    ASSERT_TRUE(m.ok());
+    const std::string first = dermis::toJson(*m).dump();
+    auto again = dermis::parsePatternManifest(json::parse(first));
+    ASSERT_TRUE(again.ok()) << again.error().message;
+    EXPECT_EQ(first, dermis::toJson(*again).dump());
+}
+
+TEST(PatternManifestTest, ScenesUseTheParsedManifest) {
+    auto m = parseManifest(kManifestText);
+    ASSERT_TRUE(m.ok());
+    auto s =
+        dermis::parseSceneText(doc(R"("placements":[{"pattern":"waist_twist","joint":"j"}])"), *m);
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    EXPECT_EQ(s->placements[0].model, dermis::DeformModel::Bias);
+    EXPECT_EQ(s->placements[0].target, dermis::Target::Displacement);
+    EXPECT_EQ(s->placements[0].thetaMin, 45.0);
+    EXPECT_EQ(s->placements[0].thetaMax, -45.0);
+    // With an empty manifest there are no built-in ids.
+    auto none = dermis::parseSceneText(doc(R"("placements":[{"pattern":"crease","joint":"j"}])"),
+                                       PatternManifest{});
+    ASSERT_FALSE(none.ok());
+    EXPECT_EQ(none.error().field, "/placements/0/pattern");
+}
+
+struct BadManifest {
+    const char* name;
+    std::string text;
+    std::string pointer;
+};
+
+class PatternManifestBadInput : public testing::TestWithParam<BadManifest> {};
+
+TEST_P(PatternManifestBadInput, NamesTheField) {
+    const BadManifest& c = GetParam();
+    auto r = parseManifest(c.text);
+    ASSERT_FALSE(r.ok()) << c.text;
+    EXPECT_EQ(r.error().field, c.pointer) << r.error().message;
+}
+
+const BadManifest kBadManifests[] = {
+    {"RootArray", "[]", ""},
+    {"FormatMissing", R"({"patterns":[]})", "/format"},
+    {"FormatWrong", R"({"format":"dermis.scene/1","patterns":[]})", "/format"},
+    {"PatternsMissing", R"({"format":"dermis.patterns/1"})", "/patterns"},
+    {"PatternsObject", R"({"format":"dermis.patterns/1","patterns":{}})", "/patterns"},
+    {"EntryNotObject", R"({"format":"dermis.patterns/1","patterns":["crease"]})", "/patterns/0"},
+    {"DuplicateId",
+     [] {
+         json j = json::parse(kManifestText);
+         j["patterns"][2]["id"] = "crease";
+         return j.dump();
+     }(),
+     "/patterns/2/id"},
+    {"IdUpperCase", manifestWith("id", R"("Crease")"), "/patterns/0/id"},
+    {"IdDash", manifestWith("id", R"("in-elbow")"), "/patterns/0/id"},
+    {"IdMissing",
+     [] {
+         json j = json::parse(kManifestText);
+         j["patterns"][0].erase("id");
+         return j.dump();
+     }(),
+     "/patterns/0/id"},
+    {"KindUnknown", manifestWith("kind", R"("scar")"), "/patterns/0/kind"},
+    {"KindMissing",
+     [] {
+         json j = json::parse(kManifestText);
+         j["patterns"][1].erase("kind");
+         return j.dump();
+     }(),
+     "/patterns/1/kind"},
+    {"ModelUnknown", manifestWith("model", R"("offset")"), "/patterns/0/model"},
+    {"TargetUnknown", manifestWith("target", R"("normal")"), "/patterns/0/target"},
+    {"AxisVector", manifestWith("axis", "[1,0,0]"), "/patterns/0/axis"},
+    {"ThetaEqual", manifestWith("theta_max", "0"), "/patterns/0/theta_max"},
+    {"ThetaString", manifestWith("theta_min", R"("0")"), "/patterns/0/theta_min"},
+    {"FileMissing",
+     [] {
+         json j = json::parse(kManifestText);
+         j["patterns"][0].erase("file");
+         return j.dump();
+     }(),
+     "/patterns/0/file"},
+    {"FileEmpty", manifestWith("file", R"("")"), "/patterns/0/file"},
+    {"FileParent", manifestWith("file", R"("../secret.png")"), "/patterns/0/file"},
+    {"FileInnerParent", manifestWith("file", R"("a/../../b.png")"), "/patterns/0/file"},
+    {"FileAbsolute", manifestWith("file", R"("/etc/passwd")"), "/patterns/0/file"},
+    {"FileBackslash", manifestWith("file", R"("..\\x.png")"), "/patterns/0/file"},
+    {"FileDrive", manifestWith("file", R"("C:x.png")"), "/patterns/0/file"},
+    {"FileDoubleSlash", manifestWith("file", R"("a//b.png")"), "/patterns/0/file"},
+    {"FileDot", manifestWith("file", R"("./a.png")"), "/patterns/0/file"},
+    {"FileNumber", manifestWith("file", "3"), "/patterns/0/file"},
+    {"DescriptionNumber", manifestWith("description", "3"), "/patterns/0/description"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Table, PatternManifestBadInput, testing::ValuesIn(kBadManifests),
+                         [](const testing::TestParamInfo<BadManifest>& info) {
+                             return std::string(info.param.name);
+                         });
