@@ -23,16 +23,16 @@ const std::string kRigged =
     std::string(DERMIS_SHARED_DIR) + "/models/RiggedFigure/RiggedFigure.glb";
 const char* kJoint = "Skeleton_torso_joint_2";
 
-struct Run {
+struct CliRun {
     int code = -1;
     std::string err, out;
 };
 
-Run runServer(const TempDir& dir, const std::string& args) {
+CliRun runServer(const TempDir& dir, const std::string& args) {
     const std::string cmd = std::string(DERMIS_SERVER_EXE) + " " + args + " >" + (dir / "out.txt") +
                             " 2>" + (dir / "err.txt");
     const int status = std::system(cmd.c_str());
-    Run r;
+    CliRun r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     auto out = readBytes(dir / "out.txt"), err = readBytes(dir / "err.txt");
     r.out.assign(out.begin(), out.end());
@@ -83,7 +83,7 @@ protected:
 
 TEST_F(BakeCliTest, WritesTheCpuReferenceMapsAsExr) {
     writeScene(baseScene(kCesium));
-    const Run r = runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "maps"));
+    const CliRun r = runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "maps"));
     ASSERT_EQ(r.code, 0) << r.err;
     auto bump = readHeightImage(dir / "maps/bump.exr");
     auto disp = readHeightImage(dir / "maps/displacement.exr");
@@ -125,7 +125,7 @@ TEST_F(BakeCliTest, TimeOptionAndRestPose) {
     json doc = baseScene(kCesium);
     doc["pose"] = json::object(); // animated pose, joint not overridden
     writeScene(doc);
-    const Run r =
+    const CliRun r =
         runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "t") + " --time 0.5");
     ASSERT_EQ(r.code, 0) << r.err;
     auto loaded = loadSceneFile(dir / "scene.json");
@@ -164,13 +164,13 @@ TEST_F(BakeCliTest, BadScenesExitNonZeroNamingTheField) {
     cases.push_back({"model", d, "/model"});
     for (const Case& c : cases) {
         writeScene(c.doc);
-        const Run r = runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "x"));
+        const CliRun r = runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "x"));
         EXPECT_EQ(r.code, 1) << c.name;
         EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.name << ": " << r.err;
         EXPECT_NE(r.err.find("error"), std::string::npos) << c.name;
     }
     writeText(dir / "scene.json", "{ \"format\": \"dermis.scene/1\", ");
-    Run r = runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "x"));
+    CliRun r = runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "x"));
     EXPECT_EQ(r.code, 1);
     r = runServer(dir, "bake --out " + (dir / "x"));
     EXPECT_EQ(r.code, 2);
