@@ -29,8 +29,8 @@ test-asan: deps
 
 # Installs, builds and runs the product's main job (for now: bake the example scene).
 run: build
-	$(BUILD)/dermis-server bake --scene examples/cesiumman.scene.json --out out/example
-	@echo "wrote out/example/bump.exr and out/example/displacement.exr"
+	$(BUILD)/dermis-server bake --scene examples/cesiumman.scene.json --out out/example --png
+	@echo "wrote out/example/{bump,displacement}.{exr,png}"
 
 bench: build
 	$(BUILD)/bench/dermis-bench
