@@ -85,12 +85,19 @@ struct Model {
     std::vector<Image8> images;
     std::vector<Clip> clips;
 
-    bool hasUVs() const;        ///< every part has TEXCOORD_0
+    bool hasUVs() const;        ///< every part has TEXCOORD_0 (false for a model without parts)
     std::size_t triangleCount() const;
     /// Index into `nodes` of the joint named `name` (joints only), −1 if none.
     int findJoint(const std::string& name) const;
     /// Index into `clips` of the clip named `name`, −1 if none.
     int findClip(const std::string& name) const;
 };
+
+/// Area-weighted vertex normals of a triangle list: each triangle adds its unnormalised face
+/// normal (counter-clockwise winding, glTF's front face) to its corners, then each sum is
+/// normalised. Vertices on no (or only degenerate) triangles get (0, 0, 1). Triangles with an index
+/// out of range are ignored. Returns one unit normal per position.
+std::vector<glm::vec3> computeNormals(const std::vector<glm::vec3>& positions,
+                                      const std::vector<std::uint32_t>& indices);
 
 } // namespace dermis

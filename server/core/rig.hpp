@@ -29,7 +29,8 @@ LocalPose restPose(const Model& model);
 /// (Hermite, rotations renormalised) as in glTF 2.0 Appendix C. Precondition: clip is a valid index.
 LocalPose sampleClip(const Model& model, int clip, float time);
 
-/// World matrix of every node for a local pose (parents before children not required).
+/// World matrix of every node for a local pose: world(n) = world(parent) · T · R · S (parents
+/// before children not required). Precondition: `pose` has one entry per node (else identity).
 std::vector<glm::mat4> worldMatrices(const Model& model, const LocalPose& pose);
 
 /// Posed vertices of one part.
@@ -39,7 +40,10 @@ struct SkinnedPart {
 };
 
 /// CPU linear blend skinning of every part: p' = Σ w_k · world(node_k) · inverseBind_k · p;
-/// normals with the inverse-transpose of the blended matrix, renormalised.
+/// normals with the inverse-transpose of the blended matrix, renormalised. `world` comes from
+/// worldMatrices (one per node). Weights are used as stored (the loader normalises them). A part
+/// whose joints/weights arrays do not match its vertex count follows influence 0; a part without
+/// normals gets computeNormals of the posed positions. Never reads out of bounds.
 std::vector<SkinnedPart> skin(const Model& model, const std::vector<glm::mat4>& world);
 
 /// A joint's rotation axis in its rest frame; normalised by the caller (see jointAngle).

@@ -6,16 +6,32 @@
 //   2. loadGltfResources: decodes the captured images with OpenImageIO into Model::images.
 // loadGltfFile does both for a file on disk (external .bin/.png resolved beside the .gltf).
 //
-// What is loaded: every primitive (TRIANGLES mode) of every mesh reachable from the default
-// scene — skinned meshes in bind space, meshes on plain nodes as one-influence rigid skins (see
-// MeshPart) — with POSITION, NORMAL (computed when missing), TEXCOORD_0, JOINTS_0, WEIGHTS_0
-// (renormalised); nodes with names and rest TRS (a node `matrix` is decomposed); skin joints with
-// inverse bind matrices; base-colour factor and texture; animations (translation, rotation,
-// scale; LINEAR, STEP, CUBICSPLINE). Not loaded: morph targets, cameras, lights, other texture
-// slots, non-triangle primitives (skipped with no error).
+// What is loaded: every triangle primitive (TRIANGLES; TRIANGLE_STRIP and TRIANGLE_FAN are
+// converted to lists) of every mesh reachable from the default scene (scene 0 when `scene` is
+// absent, every root node when there are no scenes):
+//   * skinned meshes in glTF's bind space (rest-pose skinning maps it to world space by the
+//     transform above the skeleton, e.g. CesiumMan's "Z_UP" root rotation);
+//   * meshes on plain nodes as one-influence rigid skins in rest world space (see MeshPart);
+// with POSITION, NORMAL (computed, area-weighted, when missing), TEXCOORD_0, JOINTS_n/WEIGHTS_n
+// (the 4 largest weights per vertex, renormalised; a vertex with no weight follows influence 0).
+// Also: all nodes with names and rest TRS (a node `matrix` is decomposed), so Model::nodes has the
+// file's node indices; skin joints with inverse bind matrices (identity when absent);
+// Model::joints = the joints of all skins, in file order, each once; base-colour factor and
+// texture (Model::images holds only the images used as base-colour textures); animations
+// (translation, rotation, scale; LINEAR, STEP, CUBICSPLINE; unnamed clips are named
+// "animation<i>"). Accessors may be strided, normalised integers (KHR_mesh_quantization) or
+// sparse. Not loaded: morph targets and "weights" channels, cameras, lights, other texture slots,
+// points and lines (skipped with no error).
 //
-// Failure: truncated, garbage or inconsistent files (bad accessor bounds, out-of-range indices,
-// NaN positions, non-increasing key times) give an Error with the field at fault; never a crash.
+// External files of a .gltf (buffers, images) are read only from inside `baseDir`: absolute URIs,
+// ".." and links leading out of it are refused; with an empty `baseDir` no file is read.
+//
+// Failure: empty, truncated, garbage or inconsistent files (bad GLB chunks, accessor or buffer
+// view out of bounds, out-of-range indices or joints, NaN positions, non-increasing key times,
+// node cycles, JSON nested deeper than 64 levels) give an Error (ErrorCode::Parse) whose `field`
+// is the JSON pointer at fault, e.g. "/meshes/0/primitives/1/attributes/POSITION"; glTF 1.0, GLB
+// version 1 and unsupported required extensions give ErrorCode::Unsupported. Never a crash or an
+// out-of-bounds read.
 #pragma once
 
 #include "core/model.hpp"
@@ -27,10 +43,14 @@
 
 namespace dermis {
 
+/// Largest glTF/GLB file (and external resource) accepted, in bytes.
+constexpr std::size_t kMaxGltfBytes = std::size_t(1) << 30;
+
 /// Encoded images captured by parseGltf, consumed by loadGltfResources.
 struct PendingImages {
     struct Entry {
-        int imageIndex = -1;            ///< index in Model::images
+        int imageIndex = -1;             ///< index in Model::images
+        int gltfImage = -1;              ///< index in the file's `images` (for messages)
         std::vector<std::uint8_t> bytes; ///< PNG / JPEG / … as stored in the file
         std::string mimeType;
     };
@@ -45,7 +65,9 @@ struct ParsedGltf {
 /// Step 1. `baseDir` resolves external URIs of a .gltf ("" for a self-contained .glb).
 Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir);
 
-/// Step 2. Decodes every pending image to RGBA8 (OpenImageIO). A corrupt image is an error.
+/// Step 2. Decodes every pending image to RGBA8 (OpenImageIO, through decodeImage8) into
+/// parsed.model.images and clears parsed.images. A corrupt image is an error (field
+/// "/images/<i>"), leaving the model's images partly filled.
 Status loadGltfResources(ParsedGltf& parsed);
 
 /// Both steps for a file on disk.
