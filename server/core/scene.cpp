@@ -221,6 +221,18 @@ class Reader {
         return s;
     }
 
+    /// A string naming an enumerator: `parse` maps it (std::optional), `choices` lists the
+    /// accepted spellings for the message.
+    template <class Parse>
+    auto enumeration(const json& v, const std::string& ptr, Parse parse, const char* choices) const
+        -> Result<typename decltype(parse(std::string_view{}))::value_type> {
+        auto s = string(v, ptr);
+        if (!s) return s.error();
+        auto e = parse(*s);
+        if (!e) return bad(ptr, std::string("must be ") + choices + ", got '" + *s + "'");
+        return *e;
+    }
+
     /// A file path or reference: a non-empty string without NUL bytes, of sane length.
     Result<std::string> path(const json& v, const std::string& ptr) const {
         auto s = string(v, ptr);
@@ -448,31 +460,21 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
     }
 
     if (const json* m = Reader::find(v, "model")) {
-        auto s = rd.string(*m, ptr + "/model");
-        if (!s) return s.error();
-        auto model = deformModelFromString(*s);
-        if (!model)
-            return rd.bad(ptr + "/model", "must be \"scale\" or \"bias\", got '" + *s + "'");
-        out.model = *model;
+        auto e = rd.enumeration(*m, ptr + "/model", deformModelFromString, "\"scale\" or \"bias\"");
+        if (!e) return e.error();
+        out.model = *e;
     }
     if (const json* t = Reader::find(v, "target")) {
-        auto s = rd.string(*t, ptr + "/target");
-        if (!s) return s.error();
-        auto target = targetFromString(*s);
-        if (!target)
-            return rd.bad(ptr + "/target",
-                          "must be \"bump\" or \"displacement\", got '" + *s + "'");
-        out.target = *target;
+        auto e =
+            rd.enumeration(*t, ptr + "/target", targetFromString, "\"bump\" or \"displacement\"");
+        if (!e) return e.error();
+        out.target = *e;
     }
     if (const json* r = Reader::find(v, "response")) {
-        auto s = rd.string(*r, ptr + "/response");
-        if (!s) return s.error();
-        auto response = responseFromString(*s);
-        if (!response)
-            return rd.bad(ptr + "/response",
-                          "must be \"log2\", \"ln\", \"linear\" or \"smoothstep\", got '" + *s +
-                              "'");
-        out.response = *response;
+        auto e = rd.enumeration(*r, ptr + "/response", responseFromString,
+                                "\"log2\", \"ln\", \"linear\" or \"smoothstep\"");
+        if (!e) return e.error();
+        out.response = *e;
     }
     return Ok{};
 }
@@ -777,32 +779,24 @@ Result<PatternManifest> parsePatternManifest(const json& doc) {
 
         const json* kind = Reader::find(e, "kind");
         if (!kind) return rd.bad(ptr + "/kind", "is required");
-        auto kindStr = rd.string(*kind, ptr + "/kind");
-        if (!kindStr) return kindStr.error();
-        auto k = patternKindFromString(*kindStr);
-        if (!k)
-            return rd.bad(ptr + "/kind",
-                          "must be \"wrinkle\", \"bulge\" or \"bone\", got '" + *kindStr + "'");
+        auto k = rd.enumeration(*kind, ptr + "/kind", patternKindFromString,
+                                "\"wrinkle\", \"bulge\" or \"bone\"");
+        if (!k) return k.error();
         info.kind = *k;
         info.model = defaultModel(*k);
         info.target = defaultTarget(*k);
 
         if (const json* m = Reader::find(e, "model")) {
-            auto s = rd.string(*m, ptr + "/model");
-            if (!s) return s.error();
-            auto model = deformModelFromString(*s);
-            if (!model)
-                return rd.bad(ptr + "/model", "must be \"scale\" or \"bias\", got '" + *s + "'");
-            info.model = *model;
+            auto parsed =
+                rd.enumeration(*m, ptr + "/model", deformModelFromString, "\"scale\" or \"bias\"");
+            if (!parsed) return parsed.error();
+            info.model = *parsed;
         }
         if (const json* t = Reader::find(e, "target")) {
-            auto s = rd.string(*t, ptr + "/target");
-            if (!s) return s.error();
-            auto target = targetFromString(*s);
-            if (!target)
-                return rd.bad(ptr + "/target",
-                              "must be \"bump\" or \"displacement\", got '" + *s + "'");
-            info.target = *target;
+            auto parsed = rd.enumeration(*t, ptr + "/target", targetFromString,
+                                         "\"bump\" or \"displacement\"");
+            if (!parsed) return parsed.error();
+            info.target = *parsed;
         }
         if (const json* j = Reader::find(e, "joint")) {
             auto s = rd.string(*j, ptr + "/joint", false);
