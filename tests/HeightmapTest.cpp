@@ -182,3 +182,22 @@ TEST(HeightmapTest, RejectsBadSizesAndMissingPatterns) {
     EXPECT_EQ(bakeHeightMaps({place(&pat, {0.5, 0.5}, {0, 1}, 0, 1)}, size(4, 4)).error().field,
               "/placements/0/scale");
 }
+
+TEST(HeightmapTest, BakeIntoReusesStorageAndOverwritesStaleData) {
+    HeightImage pat(3, 3, 0.4f);
+    const std::vector<BakePlacement> ps = {place(&pat, {0.3, 0.3}, {0.3, 0.2}, 20, 0.7)};
+    auto fresh = bakeHeightMaps(ps, size(32, 16, 2));
+    ASSERT_TRUE(fresh.ok());
+    HeightMaps reused{HeightImage(32, 16, 9.0f), HeightImage(32, 16, -9.0f)};
+    const float* storage = reused.bump.data.data();
+    ASSERT_TRUE(bakeHeightMapsInto(ps, size(32, 16, 3), reused).ok());
+    EXPECT_EQ(reused.bump.data.data(), storage);
+    EXPECT_EQ(reused.bump.data, fresh->bump.data);
+    EXPECT_EQ(reused.displacement.data, fresh->displacement.data);
+    // A size change resizes; a failure leaves the maps as they were.
+    ASSERT_TRUE(bakeHeightMapsInto(ps, size(8, 8), reused).ok());
+    EXPECT_EQ(reused.bump.width, 8);
+    EXPECT_EQ(reused.bump.data.size(), 64u);
+    EXPECT_FALSE(bakeHeightMapsInto(ps, size(0, 8), reused).ok());
+    EXPECT_EQ(reused.bump.width, 8);
+}

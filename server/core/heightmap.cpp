@@ -66,7 +66,9 @@ TexelRect footprintTexels(const Footprint& f, int width, int height) {
 
 namespace {
 
-bool insideUnit(glm::dvec2 s) { return s.x >= 0.0 && s.x <= 1.0 && s.y >= 0.0 && s.y <= 1.0; }
+bool insideUnit(glm::dvec2 s) {
+    return s.x >= 0.0 && s.x <= 1.0 && s.y >= 0.0 && s.y <= 1.0;
+}
 
 } // namespace
 
@@ -78,8 +80,8 @@ float placementHeight(const BakePlacement& p, glm::dvec2 uv) {
                        deformConstant(p.model, p.response, p.t));
 }
 
-Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
-                                  const BakeSettings& settings) {
+Status bakeHeightMapsInto(const std::vector<BakePlacement>& placements,
+                          const BakeSettings& settings, HeightMaps& maps) {
     const char* where = "dermis::bakeHeightMaps";
     const int W = settings.width, H = settings.height;
     if (W <= 0 || H <= 0 || W > kMaxHeightmapSize || H > kMaxHeightmapSize)
@@ -101,7 +103,13 @@ Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
                  base->data.size() != static_cast<std::size_t>(base->width) * base->height))
         return makeError(ErrorCode::InvalidArgument, where, "/heightmap/base", "empty base map");
 
-    HeightMaps maps{HeightImage(W, H), HeightImage(W, H)};
+    // Reuse the caller's storage when it has the right size (a per-frame loop then never
+    // allocates); rows are cleared by the worker that bakes them.
+    for (HeightImage* m : {&maps.bump, &maps.displacement}) {
+        m->width = W;
+        m->height = H;
+        m->data.resize(static_cast<std::size_t>(W) * H);
+    }
 
     // Per-placement constants; placements at t = 0 contribute nothing and are dropped.
     struct Active {
@@ -123,13 +131,17 @@ Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
     // Rows [y0, y1): base first, then each placement in document order, so every texel's sum
     // has the same order whatever the split.
     auto bakeRows = [&](int y0, int y1) {
+        const std::size_t first = static_cast<std::size_t>(y0) * W,
+                          last = static_cast<std::size_t>(y1) * W;
+        std::fill(maps.bump.data.begin() + first, maps.bump.data.begin() + last, 0.0f);
+        std::fill(maps.displacement.data.begin() + first, maps.displacement.data.begin() + last,
+                  0.0f);
         if (base) {
             const bool same = base->width == W && base->height == H;
             for (int j = y0; j < y1; ++j)
                 for (int i = 0; i < W; ++i)
                     maps.bump.at(i, j) =
-                        same ? base->at(i, j)
-                             : sampleBilinear(*base, (i + 0.5) / W, (j + 0.5) / H);
+                        same ? base->at(i, j) : sampleBilinear(*base, (i + 0.5) / W, (j + 0.5) / H);
         }
         for (const Active& a : active) {
             const BakePlacement& p = *a.p;
@@ -164,8 +176,16 @@ Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
             const int y1 = static_cast<int>(static_cast<long long>(H) * (t + 1) / threads);
             pool.emplace_back(bakeRows, y0, y1);
         }
-        for (auto& th : pool) th.join();
+        for (auto& th : pool)
+            th.join();
     }
+    return Ok{};
+}
+
+Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
+                                  const BakeSettings& settings) {
+    HeightMaps maps;
+    if (auto s = bakeHeightMapsInto(placements, settings, maps); !s) return s.error();
     return maps;
 }
 

@@ -81,4 +81,9 @@ struct BakeSettings {
 Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
                                   const BakeSettings& settings);
 
+/// Same, into caller-owned maps: their storage is reused when the size matches (no allocation
+/// in a per-frame loop) and fully overwritten. On failure `maps` is left unchanged.
+Status bakeHeightMapsInto(const std::vector<BakePlacement>& placements,
+                          const BakeSettings& settings, HeightMaps& maps);
+
 } // namespace dermis
