@@ -150,7 +150,25 @@ Status bakeHeightMapsInto(const std::vector<BakePlacement>& placements,
             for (int j = r0; j < r1; ++j) {
                 const double dv = (j + 0.5) / H - c.y;
                 float* row = &a.out->data[static_cast<std::size_t>(j) * W];
-                for (int i = a.rect.x0; i < a.rect.x1; ++i) {
+                // Along the row s is linear in i: visit only the span where both coordinates
+                // can be in [0, 1] (widened by a texel; the inside test below stays exact).
+                const double du0 = 0.5 / W - c.x;
+                const double ax = (a.cosA * du0 + a.sinA * dv) / sc.x + 0.5,
+                             bx = a.cosA / (W * sc.x);
+                const double ay = (-a.sinA * du0 + a.cosA * dv) / sc.y + 0.5,
+                             by = -a.sinA / (W * sc.y);
+                double lo = a.rect.x0, hi = a.rect.x1;
+                for (auto [a0, b] : {std::pair{ax, bx}, std::pair{ay, by}}) {
+                    if (std::abs(b) < 1e-300) {
+                        if (a0 < -1e-9 || a0 > 1.0 + 1e-9) hi = lo; // the whole row is outside
+                        continue;
+                    }
+                    const double e0 = (0.0 - a0) / b, e1 = (1.0 - a0) / b;
+                    lo = std::max(lo, std::floor(std::min(e0, e1)) - 1.0);
+                    hi = std::min(hi, std::ceil(std::max(e0, e1)) + 2.0);
+                }
+                const int i0 = static_cast<int>(lo), i1 = static_cast<int>(std::max(lo, hi));
+                for (int i = i0; i < i1; ++i) {
                     const double du = (i + 0.5) / W - c.x;
                     // s = R(−rotation)·(p − c)/scale + 0.5 (same arithmetic as toPattern).
                     const glm::dvec2 s((a.cosA * du + a.sinA * dv) / sc.x + 0.5,
