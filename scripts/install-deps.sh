@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian packages Dermis needs to build and test. Used by the Makefile,
+# Installs the Debian and npm packages Dermis needs to build and test. Used by the Makefile,
 # .ci/run and docker/Dockerfile. Quick on a ready machine: it only calls apt-get when a
-# package is missing.
+# package is missing, and npm when the lock file changed.
 set -euo pipefail
 PKGS=(
   cmake g++ make ninja-build pkg-config
@@ -13,12 +13,23 @@ missing=()
 for p in "${PKGS[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+# Node.js + npm run the Khronos glTF validator in the tests (any Node >= 18 will do).
+command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "install-deps: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+
+# npm packages of the tests (pinned by package-lock.json), installed once per lock change.
+here="$(cd "$(dirname "$0")/.." && pwd)"
+validator="$here/tests/gltf-validator"
+if [ -f "$validator/package-lock.json" ] &&
+   { [ ! -d "$validator/node_modules" ] ||
+     [ "$validator/package-lock.json" -nt "$validator/node_modules/.package-lock.json" ]; }; then
+  echo "install-deps: npm ci in tests/gltf-validator"
+  (cd "$validator" && npm ci --no-audit --no-fund --loglevel=error)
+fi
