@@ -4,7 +4,7 @@ ASAN_BUILD ?= build-asan
 JOBS ?= 2
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-asan run bench patterns clean format
+.PHONY: all deps build test test-asan run bench patterns character clean format
 
 all: build
 
@@ -27,10 +27,11 @@ test-asan: deps
 	cmake --build $(ASAN_BUILD) -j $(JOBS)
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
 
-# Installs, builds and runs the product's main job (for now: bake the example scene).
+# Installs, builds and runs the product's main job (for now: bake the default character's
+# pattern set at the deepest point of its squat; the HTTP server replaces this).
 run: build
-	$(BUILD)/dermis-server bake --scene examples/cesiumman.scene.json --out out/example --png
-	@echo "wrote out/example/{bump,displacement}.{exr,png}"
+	$(BUILD)/dermis-server bake --scene models/default.scene.json --out out/default --png
+	@echo "wrote out/default/{bump,displacement}.{exr,png}"
 
 bench: build
 	$(BUILD)/bench/dermis-bench
@@ -38,6 +39,10 @@ bench: build
 # Regenerates the built-in pattern library (patterns/*.png, manifest.json, contact sheet).
 patterns: build
 	cmake --build $(BUILD) --target patterns
+
+# Regenerates the built-in default character (models/default.glb, default.charts.json).
+character: build
+	cmake --build $(BUILD) --target character
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
