@@ -500,5 +500,43 @@ TEST_F(DefaultCharacterTest, KhronosValidatorReportsNoErrors) {
     EXPECT_NE(text.find("errors 0,"), std::string::npos) << text;
 }
 
+TEST_F(DefaultCharacterTest, ClipsStayWithinPlausibleJointRanges) {
+    // Anatomical limits (degrees) about each joint's local axes (x bend, y twist, z side), in the
+    // joint frames of the generator: flexion is +x on both sides. Joints not listed: ±90°.
+    struct Limit {
+        const char* prefix;
+        double x0, x1, y, z;
+    };
+    const Limit limits[] = {
+        {"forearm.", -5, 150, 90, 10},     {"shin.", -5, 150, 10, 10},
+        {"thigh.", -40, 130, 45, 60},      {"spine_", -35, 45, 45, 35},
+        {"chest", -35, 45, 45, 35},        {"neck_", -60, 60, 80, 45},
+        {"upper_arm.", -90, 180, 90, 180}, {"clavicle.", -30, 30, 30, 45},
+    };
+    for (const Clip& clip : model().clips) {
+        const int c = model().findClip(clip.name);
+        std::set<float> keyTimes;
+        for (const Channel& ch : clip.channels)
+            keyTimes.insert(ch.times.begin(), ch.times.end());
+        for (float t : keyTimes) {
+            const LocalPose pose = sampleClip(model(), c, t);
+            for (int j : model().joints) {
+                const Node& n = model().nodes[static_cast<std::size_t>(j)];
+                double x0 = -90, x1 = 90, y = 90, z = 90;
+                for (const Limit& l : limits)
+                    if (n.name.rfind(l.prefix, 0) == 0) x0 = l.x0, x1 = l.x1, y = l.y, z = l.z;
+                const glm::quat q = pose.rotation[static_cast<std::size_t>(j)];
+                const double ax = jointAngle(n.rotation, q, {1, 0, 0});
+                const double ay = jointAngle(n.rotation, q, {0, 1, 0});
+                const double az = jointAngle(n.rotation, q, {0, 0, 1});
+                EXPECT_TRUE(ax >= x0 && ax <= x1)
+                    << clip.name << " t=" << t << " " << n.name << " x=" << ax;
+                EXPECT_LE(std::abs(ay), y) << clip.name << " t=" << t << " " << n.name;
+                EXPECT_LE(std::abs(az), z) << clip.name << " t=" << t << " " << n.name;
+            }
+        }
+    }
+}
+
 } // namespace
 } // namespace dermis
