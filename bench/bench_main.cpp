@@ -1,10 +1,21 @@
-// dermis-bench — prints JSON figures (median milliseconds) for the paper's headline scenario:
-// 15 placements in texture space, CPU height maps at 1024² and 2048², one thread and all threads.
-// Usage: dermis-bench [--repeat N]   (default 15 repetitions after one warm-up run)
+// dermis-bench — prints JSON figures (median milliseconds) for the paper's headline scenario.
+// Usage: dermis-bench [--repeat N] [--gl auto|egl-device|egl-surfaceless|osmesa] [--no-gpu]
+//                     [--no-cpu]   (--no-gpu: only the CPU cases; --no-cpu: only the frames)
+//   (default 15 repetitions after one warm-up run)
 //
-// Patterns are synthetic 512² smooth height fields (the built-in library's size); footprints
-// cover 0.08–0.3 of the UV square each, rotated, as in a dressed character.
+// 1. cpu_heightmaps: 15 placements in texture space, CPU height maps at 1024² and 2048², one
+//    thread and all threads. Patterns are synthetic 512² smooth height fields (the built-in
+//    library's size); footprints cover 0.08–0.3 of the UV square each, rotated.
+// 2. frame: the paper's per-frame loop on the default character (~4.3k triangles, ~50 joints)
+//    with the first 15 placements of models/default.scene.json and 1024² maps, the pose moving
+//    along the squat clip: height pass, skin pass, readback, PNG encode and total, at 512² and
+//    1024², MSAA off and 4x, with GPU height maps and with CPU height maps (the paper's "CPU"
+//    configuration). Stages are separated by glFinish.
 #include "core/heightmap.hpp"
+#include "gl/renderer.hpp"
+#include "gl/scene_frame.hpp"
+#include "io/frame_io.hpp"
+#include "io/scene_files.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -41,12 +52,112 @@ double medianMs(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+double round2(double v) { return std::round(v * 100) / 100; }
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The per-frame loop on the default character; appends one result per configuration.
+int benchFrames(GlBackend backend, int repeat, nlohmann::json& cases, nlohmann::json& gpuInfo) {
+    auto renderer = Renderer::create(backend);
+    if (!renderer) {
+        std::cerr << renderer.error().message << "\n";
+        return 1;
+    }
+    const RendererInfo& info = (*renderer)->info();
+    gpuInfo = {{"backend", info.backend}, {"gl_renderer", info.renderer}, {"gl_version", info.version}};
+    auto loaded = loadSceneFile(dermisDataDir() + "/models/default.scene.json");
+    if (!loaded) {
+        std::cerr << loaded.error().message << "\n";
+        return 1;
+    }
+    Scene scene = loaded->scene;
+    if (scene.placements.size() > 15) scene.placements.resize(15);
+    scene.heightmapSize = {1024, 1024};
+    scene.pose.animation = "squat";
+    auto model = std::make_shared<const Model>(std::move(loaded->model));
+    const int clip = model->findClip("squat");
+    const double duration = clip >= 0 ? model->clips[static_cast<std::size_t>(clip)].duration : 1.0;
+    for (bool cpuMaps : {false, true})
+        for (int size : {512, 1024})
+            for (int msaa : {1, 4}) {
+                scene.render.size = {size, size};
+                scene.render.msaa = msaa;
+                std::vector<double> height, skinMs, readback, encode, total;
+                for (int r = 0; r <= repeat; ++r) {
+                    const auto t0 = std::chrono::steady_clock::now();
+                    SceneFrameOptions opt;
+                    opt.time = duration * (r % 8) / 8.0; // the pose moves every frame
+                    opt.cpuHeightMaps = cpuMaps;
+                    opt.profile = true;
+                    auto frame = makeSceneFrame(scene, model, loaded->images, nullptr, opt);
+                    if (!frame) {
+                        std::cerr << frame.error().message << "\n";
+                        return 1;
+                    }
+                    auto result = (*renderer)->renderFrame(frame->request);
+                    if (!result) {
+                        std::cerr << result.error().message << "\n";
+                        return 1;
+                    }
+                    const auto te = std::chrono::steady_clock::now();
+                    auto png = encodePng(result->image, false);
+                    if (!png) {
+                        std::cerr << png.error().message << "\n";
+                        return 1;
+                    }
+                    if (r == 0) continue; // warm-up: uploads, shader variants, allocation
+                    height.push_back(cpuMaps ? frame->cpuBakeMs + result->timings.heightMs
+                                             : result->timings.heightMs);
+                    skinMs.push_back(result->timings.skinMs);
+                    readback.push_back(result->timings.readbackMs);
+                    encode.push_back(msSince(te));
+                    total.push_back(msSince(t0));
+                }
+                cases.push_back({{"name", "frame"},
+                                 {"heightmaps", cpuMaps ? "cpu" : "gpu"},
+                                 {"frame_size", size},
+                                 {"map_size", 1024},
+                                 {"msaa", msaa},
+                                 {"placements", scene.placements.size()},
+                                 {"triangles", model->triangleCount()},
+                                 {"joints", model->joints.size()},
+                                 {"height_ms", round2(medianMs(height))},
+                                 {"skin_ms", round2(medianMs(skinMs))},
+                                 {"readback_ms", round2(medianMs(readback))},
+                                 {"png_encode_ms", round2(medianMs(encode))},
+                                 {"total_ms", round2(medianMs(total))},
+                                 {"repetitions", total.size()}});
+            }
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
     int repeat = 15;
-    for (int i = 1; i + 1 < argc; ++i)
-        if (std::strcmp(argv[i], "--repeat") == 0) repeat = std::max(1, std::atoi(argv[i + 1]));
+    bool gpu = true, cpu = true;
+    GlBackend backend = GlBackend::Auto;
+    for (int i = 1; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
+            repeat = std::max(1, std::atoi(argv[++i]));
+        } else if (std::strcmp(argv[i], "--gl") == 0 && i + 1 < argc) {
+            auto b = glBackendFromString(argv[++i]);
+            if (!b) {
+                std::cerr << "dermis-bench: unknown --gl backend " << argv[i] << "\n";
+                return 2;
+            }
+            backend = *b;
+        } else if (std::strcmp(argv[i], "--no-gpu") == 0) {
+            gpu = false;
+        } else if (std::strcmp(argv[i], "--no-cpu") == 0) {
+            cpu = false;
+        } else {
+            std::cerr << "usage: dermis-bench [--repeat N] [--gl BACKEND] [--no-gpu]\n";
+            return 2;
+        }
+    }
 
     std::vector<HeightImage> patterns;
     for (unsigned k = 0; k < 8; ++k) patterns.push_back(makePattern(512, k + 1));
@@ -69,6 +180,7 @@ int main(int argc, char** argv) {
     nlohmann::json cases = nlohmann::json::array();
     for (int size : {1024, 2048})
         for (int threads : {1, hw}) {
+            if (!cpu) break;
             BakeSettings s;
             s.width = s.height = size;
             s.threads = threads;
@@ -94,8 +206,12 @@ int main(int argc, char** argv) {
                              {"min_ms", std::round(*std::min_element(ms.begin(), ms.end()) * 100) / 100},
                              {"repetitions", ms.size()}});
         }
+    nlohmann::json gpuInfo = nullptr;
+    if (gpu)
+        if (int rc = benchFrames(backend, repeat, cases, gpuInfo); rc != 0) return rc;
     nlohmann::json out = {{"benchmark", "dermis"},
                           {"hardware_threads", hw},
+                          {"gl", gpuInfo},
                           {"results", cases}};
     std::cout << out.dump(2) << "\n";
     return 0;

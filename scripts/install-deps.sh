@@ -7,6 +7,8 @@ PKGS=(
   cmake g++ make ninja-build pkg-config
   libglm-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
   libopenimageio-dev
+  libpng-dev zlib1g-dev libturbojpeg0-dev
+  python3-glad libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 missing=()

@@ -1,5 +1,6 @@
 // ImageIoTest — pattern images in (SPEC §2 value mapping), float maps out, bad files rejected.
 // Writes and reads temporary files through OpenImageIO.
+#include "io/frame_io.hpp"
 #include "io/image_io.hpp"
 #include "TestFiles.hpp"
 
@@ -110,6 +111,23 @@ TEST(ImageIoTest, DecodeImage8ExpandsGrey) {
     EXPECT_EQ(img->rgba[2], 10);
     EXPECT_EQ(img->rgba[3], 255);
     EXPECT_EQ(img->rgba[5], 250);
+}
+
+TEST(ImageIoTest, DecodeImage8KeepsUnassociatedAlpha) {
+    // glTF base-colour textures store colour and alpha independently: a half-transparent pixel
+    // must come back as stored, not premultiplied (OpenImageIO's default for PNG).
+    TempDir dir;
+    const std::vector<std::uint8_t> px = {200, 100, 50, 128, 10, 20, 30, 255};
+    Image8 src;
+    src.width = 2;
+    src.height = 1;
+    src.rgba = px;
+    auto png = encodePng(src); // libpng directly: stores the values as given
+    ASSERT_TRUE(png.ok()) << png.error().message;
+    writeBytes(dir / "a.png", *png);
+    auto img = decodeImage8(readBytes(dir / "a.png"));
+    ASSERT_TRUE(img.ok()) << img.error().message;
+    EXPECT_EQ(img->rgba, px);
 }
 
 TEST(ImageIoTest, BadFilesGiveErrorsNotCrashes) {

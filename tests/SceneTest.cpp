@@ -175,6 +175,7 @@ TEST(SceneTest, SpecExampleParses) {
     EXPECT_FALSE(s.render.displacementScale.has_value());
     EXPECT_DOUBLE_EQ(s.render.bumpStrength, 1.0);
     EXPECT_EQ(s.render.msaa, 4);
+    EXPECT_EQ(s.render.displacement, dermis::DisplacementMode::Vertex);
 }
 
 TEST(SceneTest, MinimalDocumentGetsDefaults) {
@@ -345,6 +346,7 @@ TEST(SceneTest, SerialisationWritesEveryField) {
     EXPECT_EQ(j["render"]["camera"]["distance"], "auto");
     EXPECT_EQ(j["render"]["displacement_scale"], "auto");
     EXPECT_EQ(j["render"]["msaa"], 4);
+    EXPECT_EQ(j["render"]["displacement"], "vertex");
 
     json v = dermis::toJson(parseOk(placement(R"("axis":[0, 0, 5])")));
     EXPECT_EQ(v["placements"][0]["axis"], json::array({0.0, 0.0, 1.0}));
@@ -356,11 +358,12 @@ TEST(SceneTest, SerialisationWritesEveryField) {
 TEST(SceneTest, AcceptsEdgeValues) {
     // Integral floats are integers; sizes at both limits; reversed theta range; h = 0.
     Scene s = parseOk(doc(R"("heightmap":{"size":[4096.0, 1]},"render":{"size":[8192, 1],
-        "camera":{"pitch":90},"msaa":2},"placements":[{"pattern":"crease","joint":"j",
+        "camera":{"pitch":90},"msaa":2,"displacement":"tessellated"},"placements":[{"pattern":"crease","joint":"j",
         "theta_min":120,"theta_max":0,"h":0}])"));
     EXPECT_EQ(s.heightmapSize, (std::array<int, 2>{4096, 1}));
     EXPECT_EQ(s.render.size, (std::array<int, 2>{8192, 1}));
     EXPECT_EQ(s.render.msaa, 2);
+    EXPECT_EQ(s.render.displacement, dermis::DisplacementMode::Tessellated);
     EXPECT_EQ(s.placements[0].thetaMin, 120.0);
     EXPECT_EQ(s.placements[0].h, 0.0);
     // Unknown fields are ignored at every level.
@@ -533,6 +536,8 @@ const BadCase kBadCases[] = {
     {"MsaaEight", doc(R"("render":{"msaa":8})"), "/render/msaa"},
     {"MsaaZero", doc(R"("render":{"msaa":0})"), "/render/msaa"},
     {"MsaaString", doc(R"("render":{"msaa":"4"})"), "/render/msaa"},
+    {"DisplacementUnknown", doc(R"("render":{"displacement":"geometry"})"), "/render/displacement"},
+    {"DisplacementNumber", doc(R"("render":{"displacement":1})"), "/render/displacement"},
     {"MsaaFraction", doc(R"("render":{"msaa":2.5})"), "/render/msaa"},
 };
 

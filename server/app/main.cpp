@@ -1,15 +1,25 @@
-// dermis-server — command line entry point. For now the offline commands:
-//   dermis-server bake --scene S.json --out DIR [--time T] [--threads N] [--png]
+// dermis-server — command line entry point. The offline commands:
+//   dermis-server bake   --scene S.json --out DIR [--time T] [--threads N] [--png] [--gpu] [--normals] [--gl B]
+//   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH]
+//                        [--heightmaps] [--gl B]
+//   dermis-server info   [--gl B]
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
+#include "core/normalmap.hpp"
+#include "gl/renderer.hpp"
+#include "gl/scene_frame.hpp"
+#include "io/frame_io.hpp"
 #include "io/image_io.hpp"
 #include "io/scene_files.hpp"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <regex>
 
 namespace {
 
@@ -18,12 +28,35 @@ int fail(const dermis::Error& e) {
     return 1;
 }
 
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+dermis::GlBackend backendOf(const std::string& name) {
+    return dermis::glBackendFromString(name).value_or(dermis::GlBackend::Auto);
+}
+
+const std::vector<std::string> kBackendNames = {"auto", "egl-device", "egl-surfaceless", "osmesa"};
+
+dermis::Status createFolderOf(const std::string& file) {
+    const std::filesystem::path parent = std::filesystem::path(file).parent_path();
+    if (parent.empty()) return dermis::Ok{};
+    std::error_code ec;
+    std::filesystem::create_directories(parent, ec);
+    if (ec)
+        return dermis::makeError(dermis::ErrorCode::Io, "dermis-server", parent.string(),
+                                 "cannot create the output folder: " + ec.message());
+    return dermis::Ok{};
+}
+
+// --- bake ------------------------------------------------------------------------------------
+
 struct BakeArgs {
-    std::string scene, out;
+    std::string scene, out, gl = "auto";
     double time = -1.0;
     bool hasTime = false;
     int threads = 0;
-    bool png = false;
+    bool png = false, gpu = false, normals = false;
 };
 
 int runBake(const BakeArgs& a) {
@@ -31,30 +64,188 @@ int runBake(const BakeArgs& a) {
     auto t0 = std::chrono::steady_clock::now();
     auto loaded = loadSceneFile(a.scene);
     if (!loaded) return fail(loaded.error());
-    SceneBakeOptions opt;
-    if (a.hasTime) opt.time = a.time;
-    opt.base = loaded->base ? &*loaded->base : nullptr;
-    opt.threads = a.threads;
-    auto maps = bakeScene(loaded->scene, loaded->model, loaded->images, opt);
-    if (!maps) return fail(maps.error());
+    const HeightImage* base = loaded->base ? &*loaded->base : nullptr;
+    std::optional<double> time;
+    if (a.hasTime) time = a.time;
+    HeightMaps maps;
+    std::string how = "CPU";
+    if (a.gpu) {
+        auto renderer = Renderer::create(backendOf(a.gl));
+        if (!renderer) return fail(renderer.error());
+        auto model = std::make_shared<const Model>(std::move(loaded->model));
+        auto frame = makeSceneFrame(loaded->scene, model, loaded->images, base, {time});
+        if (!frame) return fail(frame.error());
+        auto gpuMaps = (*renderer)->bakeHeightMaps(*frame->request.heights);
+        if (!gpuMaps) return fail(gpuMaps.error());
+        maps = std::move(*gpuMaps);
+        how = "GPU (" + (*renderer)->info().backend + ", " + (*renderer)->info().renderer + ")";
+    } else {
+        SceneBakeOptions opt;
+        opt.time = time;
+        opt.base = base;
+        opt.threads = a.threads;
+        auto cpuMaps = bakeScene(loaded->scene, loaded->model, loaded->images, opt);
+        if (!cpuMaps) return fail(cpuMaps.error());
+        maps = std::move(*cpuMaps);
+    }
     std::error_code ec;
     std::filesystem::create_directories(a.out, ec);
     if (ec)
         return fail(makeError(ErrorCode::Io, "dermis-server bake", a.out,
                               "cannot create the output folder: " + ec.message()));
-    const std::string bump = a.out + "/bump.exr", disp = a.out + "/displacement.exr";
-    if (auto s = writeFloatImage(bump, maps->bump); !s) return fail(s.error());
-    if (auto s = writeFloatImage(disp, maps->displacement); !s) return fail(s.error());
+    if (auto s = writeFloatImage(a.out + "/bump.exr", maps.bump); !s) return fail(s.error());
+    if (auto s = writeFloatImage(a.out + "/displacement.exr", maps.displacement); !s)
+        return fail(s.error());
     if (a.png) {
-        if (auto s = writeHeight16Png(a.out + "/bump.png", maps->bump); !s) return fail(s.error());
-        if (auto s = writeHeight16Png(a.out + "/displacement.png", maps->displacement); !s)
+        if (auto s = writeHeight16Png(a.out + "/bump.png", maps.bump); !s) return fail(s.error());
+        if (auto s = writeHeight16Png(a.out + "/displacement.png", maps.displacement); !s)
             return fail(s.error());
     }
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    std::cout << "baked " << maps->bump.width << "x" << maps->bump.height << " maps of "
-              << loaded->scene.placements.size() << " placements into " << a.out << " ("
-              << static_cast<int>(ms) << " ms)\n";
+    if (a.normals) {
+        // A bump-map unit rises bump_strength % of the map's width (in texels).
+        const double strength = 0.01 * loaded->scene.render.bumpStrength * maps.bump.width;
+        auto normal = normalMapFromBump(maps.bump, strength);
+        if (!normal) return fail(normal.error());
+        if (auto s = writeFrame(a.out + "/normal.png", encodeNormalMap8(*normal)); !s)
+            return fail(s.error());
+    }
+    std::cout << "baked " << maps.bump.width << "x" << maps.bump.height << " maps of "
+              << loaded->scene.placements.size() << " placements on the " << how << " into "
+              << a.out << " (" << static_cast<int>(msSince(t0)) << " ms)\n";
+    return 0;
+}
+
+// --- render ----------------------------------------------------------------------------------
+
+struct RenderArgs {
+    std::string scene, out, gl = "auto", frames, size;
+    double time = 0.0;
+    bool hasTime = false, heightmaps = false;
+};
+
+/// "A:B:STEP" in seconds → the times A, A+STEP, … ≤ B (inclusive within rounding).
+dermis::Result<std::vector<double>> parseFrames(const std::string& spec) {
+    const char* where = "dermis-server render";
+    std::smatch m;
+    static const std::regex re(R"(^\s*([0-9.eE+-]+):([0-9.eE+-]+):([0-9.eE+-]+)\s*$)");
+    double a = 0, b = 0, step = 0;
+    try {
+        if (!std::regex_match(spec, m, re)) throw std::invalid_argument("format");
+        a = std::stod(m[1]);
+        b = std::stod(m[2]);
+        step = std::stod(m[3]);
+    } catch (const std::exception&) {
+        return dermis::makeError(dermis::ErrorCode::InvalidArgument, where, "--frames",
+                                 "expected A:B:STEP in seconds, got \"" + spec + "\"");
+    }
+    if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(step) || a < 0 || b < a || step <= 0)
+        return dermis::makeError(dermis::ErrorCode::InvalidArgument, where, "--frames",
+                                 "need 0 <= A <= B and STEP > 0");
+    const double n = std::floor((b - a) / step + 1e-9) + 1;
+    if (n > 100000)
+        return dermis::makeError(dermis::ErrorCode::InvalidArgument, where, "--frames",
+                                 "more than 100000 frames");
+    std::vector<double> times;
+    for (int k = 0; k < static_cast<int>(n); ++k)
+        times.push_back(a + k * step);
+    return times;
+}
+
+/// Replaces the first printf-style integer field (%d, %04d) of `pattern` with `index`.
+std::string framePath(const std::string& pattern, int index) {
+    static const std::regex field(R"(%0?[0-9]*d)");
+    std::smatch m;
+    if (!std::regex_search(pattern, m, field)) return pattern;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, m.str().c_str(), index);
+    return m.prefix().str() + buf + m.suffix().str();
+}
+
+std::string withoutExtension(const std::string& path) {
+    const std::filesystem::path p(path);
+    return (p.parent_path() / p.stem()).string();
+}
+
+int runRender(const RenderArgs& a) {
+    using namespace dermis;
+    const char* where = "dermis-server render";
+    auto t0 = std::chrono::steady_clock::now();
+    if (!frameFormatFromPath(a.out))
+        return fail(makeError(ErrorCode::InvalidArgument, where, "--out",
+                              "the file name must end in .png, .jpg, .jpeg or .exr"));
+    std::vector<double> times;
+    bool animation = !a.frames.empty();
+    if (animation) {
+        auto t = parseFrames(a.frames);
+        if (!t) return fail(t.error());
+        times = *t;
+        if (times.size() > 1 && framePath(a.out, 0) == a.out)
+            return fail(makeError(ErrorCode::InvalidArgument, where, "--out",
+                                  "a frame range needs a %04d-style field in the file name"));
+    }
+    auto loaded = loadSceneFile(a.scene);
+    if (!loaded) return fail(loaded.error());
+    if (!a.size.empty()) {
+        int w = 0, h = 0;
+        char tail = 0;
+        if (std::sscanf(a.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 ||
+            w > kMaxRenderSize || h > kMaxRenderSize)
+            return fail(makeError(ErrorCode::InvalidArgument, where, "--size",
+                                  "expected WxH with each side in [1, " +
+                                      std::to_string(kMaxRenderSize) + "], got \"" + a.size + "\""));
+        loaded->scene.render.size = {w, h};
+    }
+    if (!animation) times = {a.hasTime ? a.time : loaded->scene.pose.time};
+
+    auto renderer = Renderer::create(backendOf(a.gl));
+    if (!renderer) return fail(renderer.error());
+    auto model = std::make_shared<const Model>(std::move(loaded->model));
+    const HeightImage* base = loaded->base ? &*loaded->base : nullptr;
+    for (std::size_t k = 0; k < times.size(); ++k) {
+        SceneFrameOptions opt;
+        opt.time = times[k];
+        opt.readHeightMaps = a.heightmaps;
+        auto frame = makeSceneFrame(loaded->scene, model, loaded->images, base, opt);
+        if (!frame) return fail(frame.error());
+        auto result = (*renderer)->renderFrame(frame->request);
+        if (!result) return fail(result.error());
+        const std::string path = animation ? framePath(a.out, static_cast<int>(k)) : a.out;
+        if (auto s = createFolderOf(path); !s) return fail(s.error());
+        if (auto s = writeFrame(path, result->image); !s) return fail(s.error());
+        if (a.heightmaps && result->maps) {
+            const std::string stem = withoutExtension(path);
+            if (auto s = writeFloatImage(stem + ".bump.exr", result->maps->bump); !s)
+                return fail(s.error());
+            if (auto s = writeFloatImage(stem + ".displacement.exr", result->maps->displacement); !s)
+                return fail(s.error());
+        }
+    }
+    std::cout << "rendered " << times.size() << (times.size() == 1 ? " frame" : " frames") << " of "
+              << loaded->scene.render.size[0] << "x" << loaded->scene.render.size[1] << " with "
+              << (*renderer)->info().backend << " (" << (*renderer)->info().renderer << ") to "
+              << (animation ? framePath(a.out, 0) + " …" : a.out) << " ("
+              << static_cast<int>(msSince(t0)) << " ms)\n";
+    return 0;
+}
+
+// --- info ------------------------------------------------------------------------------------
+
+int runInfo(const std::string& gl) {
+    using namespace dermis;
+    auto renderer = Renderer::create(backendOf(gl));
+    if (!renderer) return fail(renderer.error());
+    const RendererInfo& i = (*renderer)->info();
+    nlohmann::json j = {{"dermis_version", "0.1.0"},
+                        {"backend", i.backend},
+                        {"device", i.device},
+                        {"gl_vendor", i.vendor},
+                        {"gl_renderer", i.renderer},
+                        {"gl_version", i.version},
+                        {"glsl_version", i.glslVersion},
+                        {"max_texture_size", i.maxTextureSize},
+                        {"max_samples", i.maxSamples},
+                        {"tried", i.tried}};
+    std::cout << j.dump(2) << "\n";
     return 0;
 }
 
@@ -66,8 +257,8 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
 
     BakeArgs bake;
-    CLI::App* bakeCmd =
-        app.add_subcommand("bake", "Write the height maps of a scene (CPU reference) as EXR");
+    CLI::App* bakeCmd = app.add_subcommand(
+        "bake", "Write the height maps of a scene as EXR (CPU reference, or --gpu)");
     bakeCmd->add_option("--scene", bake.scene, "Scene document (dermis.scene/1)")
         ->required()
         ->check(CLI::ExistingFile);
@@ -75,9 +266,37 @@ int main(int argc, char** argv) {
         ->required();
     bakeCmd->add_option("--time", bake.time, "Animation time in seconds (overrides pose.time)")
         ->check(CLI::NonNegativeNumber);
-    bakeCmd->add_option("--threads", bake.threads, "Worker threads (0 = all cores)")
+    bakeCmd->add_option("--threads", bake.threads, "CPU worker threads (0 = all cores)")
         ->check(CLI::Range(0, 256));
     bakeCmd->add_flag("--png", bake.png, "Also write 16-bit PNG previews (0.5 grey = height 0)");
+    bakeCmd->add_flag("--gpu", bake.gpu, "Bake with the GL height pass instead of the CPU");
+    bakeCmd->add_flag("--normals", bake.normals,
+                      "Also write normal.png, a UV-space normal map of the bump map");
+    bakeCmd->add_option("--gl", bake.gl, "GL backend for --gpu")
+        ->check(CLI::IsMember(kBackendNames));
+
+    RenderArgs render;
+    CLI::App* renderCmd = app.add_subcommand("render", "Render frames of a scene to image files");
+    renderCmd->add_option("--scene", render.scene, "Scene document (dermis.scene/1)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    renderCmd->add_option("--out", render.out,
+                          "Output image (.png, .jpg, .exr); with --frames a pattern like "
+                          "dir/frame_%04d.png")
+        ->required();
+    auto* timeOpt = renderCmd->add_option("--time", render.time, "Animation time in seconds")
+                        ->check(CLI::NonNegativeNumber);
+    renderCmd->add_option("--frames", render.frames,
+                          "Animation range A:B:STEP in seconds (frame k at A + k·STEP)")
+        ->excludes(timeOpt);
+    renderCmd->add_option("--size", render.size, "Frame size WxH (overrides render.size)");
+    renderCmd->add_flag("--heightmaps", render.heightmaps,
+                        "Also write <frame>.bump.exr and <frame>.displacement.exr");
+    renderCmd->add_option("--gl", render.gl, "GL backend")->check(CLI::IsMember(kBackendNames));
+
+    std::string infoGl = "auto";
+    CLI::App* infoCmd = app.add_subcommand("info", "Print the GL backend and driver as JSON");
+    infoCmd->add_option("--gl", infoGl, "GL backend")->check(CLI::IsMember(kBackendNames));
 
     try {
         app.parse(argc, argv);
@@ -88,5 +307,10 @@ int main(int argc, char** argv) {
         bake.hasTime = bakeCmd->count("--time") > 0;
         return runBake(bake);
     }
+    if (renderCmd->parsed()) {
+        render.hasTime = renderCmd->count("--time") > 0;
+        return runRender(render);
+    }
+    if (infoCmd->parsed()) return runInfo(infoGl);
     return 2;
 }

@@ -18,6 +18,16 @@
 
 namespace dermis {
 
+std::string_view toString(DisplacementMode m) {
+    return m == DisplacementMode::Tessellated ? "tessellated" : "vertex";
+}
+
+std::optional<DisplacementMode> displacementModeFromString(std::string_view s) {
+    if (s == "vertex") return DisplacementMode::Vertex;
+    if (s == "tessellated") return DisplacementMode::Tessellated;
+    return std::nullopt;
+}
+
 using json = nlohmann::json;
 
 namespace {
@@ -614,6 +624,12 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
         if (*n == 3) return rd.bad(ptr + "/msaa", "must be 1, 2 or 4, got 3");
         render.msaa = *n;
     }
+    if (const json* dm = Reader::find(v, "displacement")) {
+        auto e = rd.enumeration(*dm, ptr + "/displacement", displacementModeFromString,
+                                "\"vertex\" or \"tessellated\"");
+        if (!e) return e.error();
+        render.displacement = *e;
+    }
     return Ok{};
 }
 
@@ -978,6 +994,7 @@ json toJson(const Scene& scene) {
     render["displacement_scale"] = r.displacementScale ? json(*r.displacementScale) : json("auto");
     render["bump_strength"] = r.bumpStrength;
     render["msaa"] = r.msaa;
+    render["displacement"] = std::string(toString(r.displacement));
     doc["render"] = std::move(render);
     return doc;
 }

@@ -18,6 +18,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace dermis {
@@ -76,12 +77,19 @@ struct Camera {
     std::optional<double> distance; ///< absent = "auto"
 };
 
+enum class DisplacementMode { Vertex, Tessellated };
+std::string_view toString(DisplacementMode m);
+std::optional<DisplacementMode> displacementModeFromString(std::string_view s);
+
 struct RenderSettings {
     std::array<int, 2> size{1024, 1024};
     Camera camera;
     std::optional<double> displacementScale; ///< absent = "auto"
     double bumpStrength = 1.0;
     int msaa = 4; ///< 1, 2 or 4
+    /// "vertex": displace the mesh's own vertices (the paper); "tessellated": subdivide each
+    /// triangle on the GPU first, so that bulges smaller than a triangle still move the surface.
+    DisplacementMode displacement = DisplacementMode::Vertex;
 };
 
 struct Scene {

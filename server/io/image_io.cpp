@@ -125,13 +125,18 @@ auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where,
     {
         OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
         ImageSpec config;
+        // Values as stored: no premultiplication of colour by alpha (glTF textures and pattern
+        // images are unassociated).
+        config.attribute("oiio:UnassociatedAlpha", 1);
         auto in = ImageInput::open(name, &config, &proxy);
         if (in) return fn(*in);
         OIIO::geterror(); // clear
     }
     auto tmp = writeTemp(bytes, name);
     if (!tmp) return tmp.error();
-    auto in = ImageInput::open(tmp->path);
+    ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = ImageInput::open(tmp->path, &config);
     if (!in) return oiioError(where, "", "unrecognised or corrupt image data");
     return fn(*in);
 }

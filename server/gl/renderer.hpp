@@ -1,0 +1,134 @@
+// Dermis GL shell — the GPU renderer: the paper's two stages (§4, Fig. 4), headless.
+//
+//   stage 1: height maps by render-to-texture — one quad per placement over its footprint, the
+//            deformation model of SPEC §2 in the fragment shader, additive blending into two
+//            float targets (bump, displacement), plus the static base map;
+//   stage 2: the character — linear blend skinning in the vertex shader, displacement along the
+//            skinned normal (per vertex, or per tessellated vertex), bump mapping, base colour,
+//            simple lighting, MSAA, sRGB output, an orbit camera framed on the posed bounds.
+//
+// Ownership and threads: a Renderer owns one GL context and one render thread that is the only
+// thread ever touching GL. Every public method may be called from any thread: it queues a job to
+// the render thread and waits for it, so calls are serialised. One Renderer per process at a time
+// (the GL entry points are process-wide). This header includes no EGL/GL.
+//
+// Caches: a model's buffers and textures are uploaded once per Model object (kept while the
+// caller's shared_ptr lives); pattern textures are cached by key and re-uploaded only when the key
+// names an image at a different address or size — callers that change an image in place call
+// forgetPatterns(). Errors: Result<…> with ErrorCode::Unavailable when no backend starts (the
+// message lists what was tried), InvalidArgument for bad inputs (field named), Internal for GL
+// failures (shader compile log, incomplete framebuffer).
+#pragma once
+
+#include "core/bake.hpp"
+#include "core/heightmap.hpp"
+#include "core/model.hpp"
+#include "core/result.hpp"
+#include "core/rig.hpp"
+#include "core/scene.hpp"
+
+#include <glm/glm.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace dermis {
+
+/// Where the GL context comes from. Auto tries EglDevice (a hardware EGL device, NVIDIA first),
+/// then EglSurfaceless (Mesa's surfaceless platform: llvmpipe without a GPU), then OsMesa.
+enum class GlBackend { Auto, EglDevice, EglSurfaceless, OsMesa };
+std::string_view toString(GlBackend b); ///< "auto", "egl-device", "egl-surfaceless", "osmesa"
+std::optional<GlBackend> glBackendFromString(std::string_view s);
+
+struct RendererInfo {
+    std::string backend;    ///< the backend that started: "egl-device", "egl-surfaceless", "osmesa"
+    std::string device;     ///< EGL device/driver description where known
+    std::string vendor, renderer, version, glslVersion; ///< glGetString
+    int maxTextureSize = 0;
+    int maxSamples = 0;
+    std::vector<std::string> tried; ///< one line per backend tried before this one, with why it failed
+};
+
+/// Input of the GPU height pass: the same placements as the CPU reference (bakeHeightMaps).
+struct HeightPassInput {
+    std::vector<BakePlacement> placements; ///< each `pattern` points into `images`
+    const PatternImages* images = nullptr; ///< key → image; textures are cached by key
+    const HeightImage* base = nullptr;     ///< optional static bump map
+    int width = 1024, height = 1024;
+};
+
+/// Wall-clock milliseconds of a frame's stages (with glFinish between them when profiling).
+struct FrameTimings {
+    double heightMs = 0.0;   ///< height pass (or upload of CPU maps)
+    double skinMs = 0.0;     ///< skin pass incl. MSAA resolve
+    double readbackMs = 0.0; ///< pixel-pack readback into the frame
+};
+
+struct FrameRequest {
+    std::shared_ptr<const Model> model;
+    std::vector<glm::mat4> world; ///< worldMatrices(model, pose): one per node
+    RenderSettings render;        ///< size, camera, displacement scale/mode, bump strength, MSAA
+    /// Height maps from the GPU height pass when set; else `cpuMaps` (uploaded); else flat.
+    std::optional<HeightPassInput> heights;
+    const HeightMaps* cpuMaps = nullptr;
+    bool readHeightMaps = false; ///< also return the maps the frame used (GPU pass only)
+    bool profile = false;        ///< glFinish after each stage so that timings are per stage
+};
+
+struct FrameResult {
+    Image8 image;                   ///< RGBA8, sRGB, row 0 = top; alpha 255
+    std::optional<HeightMaps> maps; ///< when readHeightMaps and the GPU pass ran
+    FrameTimings timings;
+    glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< posed bounds used for framing
+};
+
+class Renderer {
+public:
+    /// Starts the render thread and a GL 4.3 core context on it. Fails (Unavailable) with every
+    /// backend tried and why when none starts; never aborts the process.
+    static Result<std::unique_ptr<Renderer>> create(GlBackend backend = GlBackend::Auto);
+    ~Renderer(); ///< finishes queued jobs, destroys GL objects and the context, joins the thread
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    const RendererInfo& info() const;
+
+    /// Stage 1 alone: both maps at the input's size, read back (row 0 first, SPEC conventions).
+    /// Matches the CPU reference within float rounding away from footprint edges.
+    Result<HeightMaps> bakeHeightMaps(const HeightPassInput& in);
+
+    /// Stage 1 (optional) + stage 2 + readback of one frame.
+    Result<FrameResult> renderFrame(const FrameRequest& request);
+
+    /// Stage 2's skinning alone, captured with transform feedback: per part, the skinned
+    /// positions and unit normals without displacement — the GPU twin of dermis::skin.
+    Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
+                                               const std::vector<glm::mat4>& world);
+
+    /// Drops cached pattern textures (next use re-uploads) and models whose owner is gone.
+    void forgetPatterns();
+
+    /// Introspection for UniformBlockGLTest: the GL's size of a uniform block and the offsets of
+    /// its members, from the linked programs ("HeightPassBlock", "FrameBlock", "PartBlock").
+    struct BlockLayout {
+        int size = -1;
+        std::vector<std::pair<std::string, int>> offsets; ///< member name → byte offset
+    };
+    Result<BlockLayout> blockLayout(const std::string& block);
+
+    struct Impl;
+
+private:
+    explicit Renderer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The displacement scale "auto" resolves to: 1% of the largest extent of the rest-pose bounds
+/// (a bulge of L·h = 1 rises 1% of the character's height). Bump mapping uses 0.25 × this ×
+/// bump_strength as the height of a bump-map unit.
+double autoDisplacementScale(const Model& model);
+
+} // namespace dermis

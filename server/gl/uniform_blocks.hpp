@@ -1,0 +1,53 @@
+// Dermis GL shell — C++ mirrors of the std140 uniform blocks declared in shaders/common.glsl.
+//
+// Plain structs with the GLSL block's member order and std140 offsets (every member here is a
+// vec4, ivec4 or mat4, so each starts on a 16-byte boundary and the struct has no padding).
+// UniformBlockGLTest compares sizeof/offsetof with what the GL reports for the linked programs;
+// change both sides together. No GL includes: the renderer uploads these with glBufferSubData.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <cstddef>
+
+namespace dermis::gl {
+
+/// HeightPassBlock, binding 0: one placement of the height pass.
+struct HeightPassBlock {
+    glm::vec4 centerScale; ///< centre u, v; size u, v
+    glm::vec4 rotation;    ///< cos, sin, quad margin in pattern units (x, y)
+    glm::vec4 drive;       ///< h, t, 0, 0
+    glm::ivec4 mode;       ///< model (0 scale, 1 bias), target (0 bump, 1 displacement), response, 0
+    glm::vec4 mapSize;     ///< map width, height; pattern width, height
+};
+
+/// FrameBlock, binding 1: per-frame constants of the skin pass.
+struct FrameBlock {
+    glm::mat4 viewProj;
+    glm::vec4 cameraPos;
+    glm::vec4 lightDir;      ///< xyz towards the light, w ambient level
+    glm::vec4 heights;       ///< displacement scale, bump scale, 0, 0
+    glm::vec4 heightmapSize; ///< width, height, 1/width, 1/height
+    glm::vec4 viewport;      ///< width, height, tessellation edge target (px), max level
+};
+
+/// PartBlock, binding 2: per-part constants of the skin pass.
+struct PartBlock {
+    glm::vec4 baseColor;
+    glm::ivec4 part; ///< first palette matrix, has texture, has UVs, 0
+};
+
+/// GLSL binding points of the blocks above and of the palette storage buffer.
+enum BlockBinding : unsigned {
+    kHeightPassBinding = 0,
+    kFrameBinding = 1,
+    kPartBinding = 2,
+    kPaletteBinding = 0, // shader storage buffer binding
+};
+
+static_assert(sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
+static_assert(sizeof(HeightPassBlock) == 80);
+static_assert(sizeof(FrameBlock) == 144);
+static_assert(sizeof(PartBlock) == 32);
+
+} // namespace dermis::gl

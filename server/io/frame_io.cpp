@@ -1,0 +1,354 @@
+// Frame encoders (libpng, libjpeg-turbo, OpenImageIO for EXR) and file writing. See frame_io.hpp
+// for the formats and failure modes.
+//
+// PNG settings, measured on 1024² RGBA frames on the 2-core development machine (median of 7):
+// zlib level 1 with zlib's Z_RLE strategy and the fixed SUB filter. On a rendered-looking frame
+// (smooth gradients, a shaded body, ±4 noise, opaque) that is 45 ms for 1.87 MB, against 60 ms /
+// 2.21 MB at level 1 with the default strategy (UP within 2% of SUB there), 93 ms with libpng's
+// adaptive filtering, and 589 ms / 1.95 MB for OpenImageIO's default PNG write (level 6, all
+// filters). Over the other frames tried (transparent background, no noise, ±12 noise, a
+// photographic texture) Z_RLE was always faster and smaller than the default strategy, SUB as fast
+// as or faster than UP (20% faster and 15% smaller without noise), and the result 4–7× faster
+// than OpenImageIO's write and 4–10% smaller, except the noise-free frame (48% larger).
+#include "frame_io.hpp"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+#include <png.h>
+#include <turbojpeg.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <memory>
+#include <unistd.h>
+
+namespace dermis {
+namespace {
+
+std::string dims(int w, int h) {
+    return std::to_string(w) + "x" + std::to_string(h);
+}
+
+/// Checks a frame's size and buffer.
+Status checkFrame(const char* where, const Image8& img) {
+    if (img.width <= 0 || img.height <= 0)
+        return makeError(ErrorCode::InvalidArgument, where, "image",
+                         "empty image (" + dims(img.width, img.height) + ")");
+    if (img.width > kMaxFrameSide || img.height > kMaxFrameSide)
+        return makeError(ErrorCode::InvalidArgument, where, "image",
+                         "image is " + dims(img.width, img.height) + ", larger than the limit of " +
+                             std::to_string(kMaxFrameSide) + " per side");
+    const std::size_t expected = static_cast<std::size_t>(img.width) * img.height * 4;
+    if (img.rgba.size() != expected)
+        return makeError(ErrorCode::InvalidArgument, where, "image.rgba",
+                         "has " + std::to_string(img.rgba.size()) +
+                             " bytes, expected width*height*4 = " + std::to_string(expected));
+    return Ok{};
+}
+
+// --- PNG -------------------------------------------------------------------------------------
+
+constexpr int kPngZlibLevel = 1;
+constexpr int kPngFilter = PNG_FILTER_SUB;
+constexpr int kPngZlibStrategy = Z_RLE;
+
+/// Shared by libpng's error and write callbacks (png_get_error_ptr / png_get_io_ptr).
+struct PngState {
+    std::vector<std::uint8_t>* out = nullptr;
+    bool outOfMemory = false;
+    char message[256] = {};
+};
+
+void pngError(png_structp png, png_const_charp msg) {
+    auto* st = static_cast<PngState*>(png_get_error_ptr(png));
+    std::snprintf(st->message, sizeof st->message, "%s", msg ? msg : "unknown libpng error");
+    png_longjmp(png, 1);
+}
+
+void pngWarning(png_structp, png_const_charp) {}
+
+void pngWrite(png_structp png, png_bytep data, png_size_t size) {
+    auto* st = static_cast<PngState*>(png_get_io_ptr(png));
+    try {
+        st->out->insert(st->out->end(), data, data + size);
+    } catch (...) {
+        st->outOfMemory = true;
+    }
+    // No C++ object is alive here, so leaving through libpng's longjmp is well defined.
+    if (st->outOfMemory) png_error(png, "out of memory");
+}
+
+void pngFlush(png_structp) {}
+
+/// The libpng calls between setjmp and the end of the stream, kept apart so that no C++ object
+/// with a destructor lives in the frame that longjmp unwinds. Returns false after a libpng error.
+bool pngWriteStream(png_structp png, png_infop info, const Image8& img, bool keepAlpha,
+                    png_bytep* rows) {
+    if (setjmp(png_jmpbuf(png))) return false;
+    png_set_IHDR(png, info, static_cast<png_uint_32>(img.width),
+                 static_cast<png_uint_32>(img.height), 8,
+                 keepAlpha ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_compression_level(png, kPngZlibLevel);
+    png_set_compression_strategy(png, kPngZlibStrategy);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, kPngFilter);
+    png_write_info(png, info);
+    if (!keepAlpha) png_set_filler(png, 0, PNG_FILLER_AFTER); // strip the 4th byte of each pixel
+    png_write_image(png, rows);
+    png_write_end(png, nullptr);
+    return true;
+}
+
+// --- JPEG ------------------------------------------------------------------------------------
+
+struct TjDestroy {
+    void operator()(void* h) const { tjDestroy(h); }
+};
+using TjHandle = std::unique_ptr<void, TjDestroy>;
+
+struct TjFree {
+    void operator()(unsigned char* p) const { tjFree(p); }
+};
+
+// --- EXR -------------------------------------------------------------------------------------
+
+/// The exact sRGB EOTF of every 8-bit code.
+const std::array<float, 256>& srgbToLinearTable() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int c = 0; c < 256; ++c) {
+            const double v = c / 255.0;
+            t[static_cast<std::size_t>(c)] =
+                static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+        }
+        return t;
+    }();
+    return table;
+}
+
+Result<std::vector<std::uint8_t>> encodeExr(const Image8& img) {
+    const char* where = "dermis::encodeFrame";
+    if (auto s = checkFrame(where, img); !s) return s.error();
+    const auto& lut = srgbToLinearTable();
+    std::vector<float> px(img.rgba.size());
+    for (std::size_t k = 0; k < px.size(); k += 4) {
+        px[k + 0] = lut[img.rgba[k + 0]];
+        px[k + 1] = lut[img.rgba[k + 1]];
+        px[k + 2] = lut[img.rgba[k + 2]];
+        px[k + 3] = img.rgba[k + 3] / 255.0f;
+    }
+    std::vector<unsigned char> buf;
+    OIIO::Filesystem::IOVecOutput proxy(buf);
+    auto out = OIIO::ImageOutput::create("frame.exr", &proxy);
+    if (!out) {
+        std::string detail = OIIO::geterror();
+        return makeError(ErrorCode::Unsupported, where, "format",
+                         "OpenImageIO has no EXR writer" +
+                             (detail.empty() ? "" : " (" + detail + ")"));
+    }
+    OIIO::ImageSpec spec(img.width, img.height, 4, OIIO::TypeDesc::HALF);
+    if (!out->open("frame.exr", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, px.data()) ||
+        !out->close())
+        return makeError(ErrorCode::Io, where, "", "cannot encode EXR: " + out->geterror());
+    return std::vector<std::uint8_t>(buf.begin(), buf.end());
+}
+
+// --- files -----------------------------------------------------------------------------------
+
+std::string errnoText(int err) {
+    return std::strerror(err);
+}
+
+/// Writes all of `bytes` to fd, retrying short writes and EINTR. Returns 0 or an errno value.
+int writeAll(int fd, const std::vector<std::uint8_t>& bytes) {
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    return 0;
+}
+
+/// Writes `bytes` to a fresh temporary file beside `path`, then renames it over `path`.
+Status writeFileAtomically(const char* where, const std::string& path,
+                           const std::vector<std::uint8_t>& bytes) {
+    static std::atomic<unsigned> counter{0};
+    std::string tmp;
+    int fd = -1;
+    for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+        tmp = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+        fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST) break;
+    }
+    if (fd < 0)
+        return makeError(ErrorCode::Io, where, path,
+                         "cannot create the temporary file " + tmp + ": " + errnoText(errno));
+    int err = writeAll(fd, bytes);
+    if (::close(fd) != 0 && err == 0) err = errno;
+    if (err == 0 && std::rename(tmp.c_str(), path.c_str()) != 0) err = errno;
+    if (err != 0) {
+        ::unlink(tmp.c_str());
+        return makeError(ErrorCode::Io, where, path, "cannot write: " + errnoText(err));
+    }
+    return Ok{};
+}
+
+} // namespace
+
+std::optional<FrameFormat> frameFormatFromPath(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext == ".png") return FrameFormat::Png;
+    if (ext == ".jpg" || ext == ".jpeg") return FrameFormat::Jpeg;
+    if (ext == ".exr") return FrameFormat::Exr;
+    return std::nullopt;
+}
+
+Result<std::vector<std::uint8_t>> encodePng(const Image8& img, bool keepAlpha) {
+    const char* where = "dermis::encodePng";
+    if (auto s = checkFrame(where, img); !s) return s.error();
+    std::vector<std::uint8_t> out;
+    std::vector<png_bytep> rows(static_cast<std::size_t>(img.height));
+    try {
+        out.reserve(img.rgba.size() / 2);
+    } catch (...) {
+        return makeError(ErrorCode::Io, where, "", "out of memory");
+    }
+    const std::size_t stride = static_cast<std::size_t>(img.width) * 4;
+    for (std::size_t y = 0; y < rows.size(); ++y)
+        rows[y] = const_cast<png_bytep>(img.rgba.data() + y * stride); // libpng only reads rows
+
+    PngState st;
+    st.out = &out;
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &st, pngError, pngWarning);
+    if (!png) return makeError(ErrorCode::Io, where, "", "cannot create a libpng writer");
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_destroy_write_struct(&png, nullptr);
+        return makeError(ErrorCode::Io, where, "", "cannot create a libpng writer");
+    }
+    png_set_write_fn(png, &st, pngWrite, pngFlush);
+    const bool ok = pngWriteStream(png, info, img, keepAlpha, rows.data());
+    png_destroy_write_struct(&png, &info);
+    if (!ok) return makeError(ErrorCode::Io, where, "", std::string("libpng: ") + st.message);
+    return out;
+}
+
+Result<std::vector<std::uint8_t>> encodeJpeg(const Image8& img, int quality) {
+    const char* where = "dermis::encodeJpeg";
+    if (auto s = checkFrame(where, img); !s) return s.error();
+    if (quality < 1 || quality > 100)
+        return makeError(ErrorCode::InvalidArgument, where, "quality",
+                         "must be in [1, 100], got " + std::to_string(quality));
+    TjHandle tj(tjInitCompress());
+    if (!tj)
+        return makeError(ErrorCode::Io, where, "",
+                         std::string("cannot create a libjpeg-turbo compressor: ") +
+                             tjGetErrorStr2(nullptr));
+    unsigned char* raw = nullptr;
+    unsigned long size = 0;
+    const int rc = tjCompress2(tj.get(), img.rgba.data(), img.width, img.width * 4, img.height,
+                               TJPF_RGBA, &raw, &size, TJSAMP_420, quality, 0);
+    std::unique_ptr<unsigned char, TjFree> buf(raw);
+    if (rc != 0)
+        return makeError(ErrorCode::Io, where, "",
+                         std::string("libjpeg-turbo: ") + tjGetErrorStr2(tj.get()));
+    return std::vector<std::uint8_t>(buf.get(), buf.get() + size);
+}
+
+Result<std::vector<std::uint8_t>> encodeFrame(const Image8& img, FrameFormat f) {
+    switch (f) {
+    case FrameFormat::Png:
+        return encodePng(img, true);
+    case FrameFormat::Jpeg:
+        return encodeJpeg(img, 90);
+    case FrameFormat::Exr:
+        return encodeExr(img);
+    }
+    return makeError(ErrorCode::InvalidArgument, "dermis::encodeFrame", "format",
+                     "unknown frame format");
+}
+
+Status writeFrame(const std::string& path, const Image8& img) {
+    const char* where = "dermis::writeFrame";
+    const auto format = frameFormatFromPath(path);
+    if (!format)
+        return makeError(ErrorCode::InvalidArgument, where, path,
+                         "unknown frame format: the extension must be .png, .jpg, .jpeg or .exr");
+    if (auto s = checkFrame(where, img); !s) return s.error();
+    auto bytes = encodeFrame(img, *format);
+    if (!bytes) return bytes.error();
+    return writeFileAtomically(where, path, *bytes);
+}
+
+Result<Image8> decodeFrame(const std::vector<std::uint8_t>& bytes) {
+    const char* where = "dermis::decodeFrame";
+    auto tooLarge = [&](unsigned long w, unsigned long h) -> Error {
+        return makeError(ErrorCode::Parse, where, "",
+                         "image is " + std::to_string(w) + "x" + std::to_string(h) +
+                             ", not within 1.." + std::to_string(kMaxFrameSide) + " per side");
+    };
+    const bool png = bytes.size() >= 8 && png_sig_cmp(bytes.data(), 0, 8) == 0;
+    const bool jpeg = bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+    if (png) {
+        png_image image;
+        std::memset(&image, 0, sizeof image);
+        image.version = PNG_IMAGE_VERSION;
+        if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size()))
+            return makeError(ErrorCode::Parse, where, "", std::string("libpng: ") + image.message);
+        if (image.width < 1 || image.height < 1 || image.width > kMaxFrameSide ||
+            image.height > kMaxFrameSide) {
+            png_image_free(&image);
+            return tooLarge(image.width, image.height);
+        }
+        image.format = PNG_FORMAT_RGBA;
+        Image8 out;
+        out.width = static_cast<int>(image.width);
+        out.height = static_cast<int>(image.height);
+        out.rgba.resize(PNG_IMAGE_SIZE(image));
+        if (!png_image_finish_read(&image, nullptr, out.rgba.data(), 0, nullptr))
+            return makeError(ErrorCode::Parse, where, "", std::string("libpng: ") + image.message);
+        return out;
+    }
+    if (jpeg) {
+        TjHandle tj(tjInitDecompress());
+        if (!tj)
+            return makeError(ErrorCode::Io, where, "",
+                             std::string("cannot create a libjpeg-turbo decompressor: ") +
+                                 tjGetErrorStr2(nullptr));
+        int w = 0, h = 0, subsamp = 0, colorspace = 0;
+        // libjpeg-turbo's API takes non-const buffers but does not write to them.
+        auto* src = const_cast<unsigned char*>(bytes.data());
+        if (tjDecompressHeader3(tj.get(), src, bytes.size(), &w, &h, &subsamp, &colorspace) != 0)
+            return makeError(ErrorCode::Parse, where, "",
+                             std::string("libjpeg-turbo: ") + tjGetErrorStr2(tj.get()));
+        if (w < 1 || h < 1 || w > kMaxFrameSide || h > kMaxFrameSide)
+            return tooLarge(static_cast<unsigned long>(w), static_cast<unsigned long>(h));
+        Image8 out;
+        out.width = w;
+        out.height = h;
+        out.rgba.resize(static_cast<std::size_t>(w) * h * 4);
+        if (tjDecompress2(tj.get(), src, bytes.size(), out.rgba.data(), w, 0, h, TJPF_RGBA,
+                          TJFLAG_STOPONWARNING) != 0)
+            return makeError(ErrorCode::Parse, where, "",
+                             std::string("libjpeg-turbo: ") + tjGetErrorStr2(tj.get()));
+        return out;
+    }
+    return makeError(ErrorCode::Parse, where, "", "not a PNG or JPEG image");
+}
+
+} // namespace dermis

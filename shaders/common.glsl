@@ -1,0 +1,28 @@
+// Dermis — declarations shared by every program. Prepended after "#version" and the variant
+// #defines by the renderer (server/gl/programs.cpp). Each uniform block here has a C++ mirror in
+// server/gl/uniform_blocks.hpp with the same std140 layout; UniformBlockGLTest checks it.
+
+// Per-placement constants of the height pass (paper §4 stage 1; SPEC §2).
+layout(std140, binding = 0) uniform HeightPassBlock {
+    vec4 u_centerScale;  // footprint centre (u, v), footprint size (u, v) in UV units
+    vec4 u_rotation;     // cos(rotation), sin(rotation), quad margin (s units, x and y)
+    vec4 u_drive;        // h, t, 0, 0
+    ivec4 u_mode;        // model (0 scale, 1 bias), target (0 bump, 1 displacement), response, 0
+    vec4 u_mapSize;      // map width, height, pattern width, height (texels)
+};
+
+// Per-frame constants of the skin pass (paper §4 stage 2).
+layout(std140, binding = 1) uniform FrameBlock {
+    mat4 u_viewProj;       // world → clip (picture row 0 at the top)
+    vec4 u_cameraPos;      // world camera position, 0
+    vec4 u_lightDir;       // unit vector towards the key light (world), ambient level
+    vec4 u_heights;        // displacement scale, bump scale (model units per height unit), 0, 0
+    vec4 u_heightmapSize;  // width, height, 1/width, 1/height of the height maps
+    vec4 u_viewport;       // frame width, height, target edge length of a tessellated edge (px), max level
+};
+
+// Per-part constants of the skin pass.
+layout(std140, binding = 2) uniform PartBlock {
+    vec4 u_baseColor;  // material base colour factor (linear)
+    ivec4 u_part;      // first palette matrix of the part, has base-colour texture, has UVs, 0
+};

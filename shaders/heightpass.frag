@@ -1,0 +1,61 @@
+// Height pass (paper §4 stage 1): L_out of one placement at this texel (SPEC §2), written to the
+// red (bump) or green (displacement) channel of the RG32F height target; additive blending sums
+// placements.
+
+layout(binding = 0) uniform sampler2D u_pattern; // R32F, values L ∈ [−1, 1], row 0 = s.y near 0
+
+layout(location = 0) out vec2 o_heights; // bump, displacement
+
+// Bilinear sample at s ∈ [0,1]² with texel centres at (k+0.5)/N, clamped to the edge texels —
+// the same arithmetic as dermis::sampleBilinear (texelFetch: no filtering precision loss).
+float samplePattern(vec2 s) {
+    ivec2 n = ivec2(u_mapSize.zw);
+    vec2 x = s * vec2(n) - 0.5;
+    vec2 f0 = floor(x);
+    vec2 f = x - f0;
+    ivec2 i0 = clamp(ivec2(f0), ivec2(0), n - 1);
+    ivec2 i1 = clamp(ivec2(f0) + 1, ivec2(0), n - 1);
+    float a = texelFetch(u_pattern, ivec2(i0.x, i0.y), 0).r;
+    float b = texelFetch(u_pattern, ivec2(i1.x, i0.y), 0).r;
+    float c = texelFetch(u_pattern, ivec2(i0.x, i1.y), 0).r;
+    float d = texelFetch(u_pattern, ivec2(i1.x, i1.y), 0).r;
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+// gain(t) of the scale model and offset(t) of the bias model (SPEC §2 table).
+float gainOrOffset(int model, int response, float t) {
+    float smooth_t = t * t * (3.0 - 2.0 * t);
+    if (model == 0) {
+        if (response == 0) return log2(1.0 + t);
+        if (response == 1) return log(1.0 + t);
+        if (response == 2) return t;
+        return smooth_t;
+    }
+    if (response == 0) return log2(2.0 - t);
+    if (response == 1) return log(2.0 - t);
+    if (response == 2) return 1.0 - t;
+    return 1.0 - smooth_t;
+}
+
+void main() {
+    vec2 uv = gl_FragCoord.xy / u_mapSize.xy;
+    vec2 d = uv - u_centerScale.xy;
+    float c = u_rotation.x, sn = u_rotation.y;
+    // s = R(−rotation)·(p − center)/scale + 0.5 (SPEC "Conventions").
+    vec2 s = vec2(c * d.x + sn * d.y, -sn * d.x + c * d.y) / u_centerScale.zw + 0.5;
+    if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) discard;
+
+    float L = samplePattern(s);
+    float h = u_drive.x, t = u_drive.y;
+    float value;
+    if (t <= 0.0) {
+        value = 0.0;
+    } else if (t >= 1.0) {
+        value = L * h;                                        // both models at t = 1
+    } else if (u_mode.x == 0) {
+        value = L * h * gainOrOffset(0, u_mode.z, t);         // scale model, paper eq. 1
+    } else {
+        value = max(h * (L - gainOrOffset(1, u_mode.z, t)), 0.0); // bias model, paper eq. 2
+    }
+    o_heights = u_mode.y == 0 ? vec2(value, 0.0) : vec2(0.0, value);
+}

@@ -1,0 +1,55 @@
+// Skin pass, fragment stage: bump mapping from the height maps without precomputed tangents
+// (Mikkelsen, "Bump Mapping Unparametrized Surfaces on the GPU", 2010: the surface gradient from
+// screen-space derivatives), base colour, simple lighting. Writes linear colour; the sRGB render
+// target encodes it.
+
+layout(binding = 0) uniform sampler2D u_heightMap;        // RG32F: bump, displacement
+layout(binding = 2) uniform sampler2D u_baseColorTexture; // sRGB8_A8, decoded to linear by the sampler
+
+in vec3 v_position;
+in vec3 v_normal;
+in vec2 v_uv;
+
+layout(location = 0) out vec4 o_color;
+
+// Height of the shaded surface in model units: bump map · bump scale, plus the displacement map ·
+// displacement scale (its relief shades the bulge at pixel, not vertex, resolution).
+float surfaceHeight(vec2 uv) {
+    return dot(textureLod(u_heightMap, uv, 0.0).rg, u_heights.yx);
+}
+
+vec3 perturbedNormal(vec3 n) {
+    // dH/du, dH/dv by differences one texel apart (three samples of the RG map).
+    vec2 e = u_heightmapSize.zw;
+    vec2 uv0 = v_uv - 0.5 * e;
+    float h0 = surfaceHeight(uv0);
+    float dHdu = (surfaceHeight(uv0 + vec2(e.x, 0.0)) - h0) / e.x;
+    float dHdv = (surfaceHeight(uv0 + vec2(0.0, e.y)) - h0) / e.y;
+    vec2 dUVdx = dFdx(v_uv), dUVdy = dFdy(v_uv);
+    float dBs = dHdu * dUVdx.x + dHdv * dUVdx.y; // dH along screen x
+    float dBt = dHdu * dUVdy.x + dHdv * dUVdy.y; // dH along screen y
+    vec3 sigmaS = dFdx(v_position), sigmaT = dFdy(v_position);
+    vec3 r1 = cross(sigmaT, n), r2 = cross(n, sigmaS);
+    float det = dot(sigmaS, r1);
+    if (abs(det) < 1e-20) return n;
+    vec3 grad = sign(det) * (dBs * r1 + dBt * r2);
+    return normalize(abs(det) * n - grad);
+}
+
+void main() {
+    vec3 n = normalize(v_normal);
+    vec3 toCamera = normalize(u_cameraPos.xyz - v_position);
+    if (dot(n, toCamera) < 0.0) n = -n; // two-sided: back faces are lit like front faces
+    if (u_part.z != 0) n = perturbedNormal(n);
+
+    vec4 base = u_baseColor;
+    if (u_part.y != 0 && u_part.z != 0) base *= texture(u_baseColorTexture, v_uv);
+
+    vec3 l = u_lightDir.xyz;
+    float diffuse = max(dot(n, l), 0.0);
+    float fill = 0.5 + 0.5 * n.y; // sky/ground hemisphere
+    vec3 h = normalize(l + toCamera);
+    float specular = pow(max(dot(n, h), 0.0), 48.0) * 0.15 * step(0.0, dot(n, l));
+    vec3 color = base.rgb * (0.85 * diffuse + u_lightDir.w * fill) + vec3(specular);
+    o_color = vec4(color, 1.0);
+}

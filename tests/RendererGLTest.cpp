@@ -1,0 +1,544 @@
+// RendererGLTest — the GPU renderer on a real GL context (Mesa's llvmpipe in CI; an NVIDIA EGL
+// device where there is one). The backend comes from $DERMIS_TEST_GL (ctest runs this suite once
+// per backend: osmesa and egl-surfaceless); without it, auto. A backend that cannot start fails
+// the suite: nothing is skipped.
+//
+// Checks: uniform-block mirrors; GPU height maps equal the CPU reference within 2e-3 away from
+// footprint edges (rotated, non-square, overlapping placements, every model and response, base
+// map; and the default scene); GPU skinning equals CPU skinning within 1e-4 (CesiumMan, default
+// character); reference images of the default character in three poses; frames of CesiumMan
+// and KayKit Barbarian are non-empty and change with time; MSAA, tessellation, displacement.
+#include "core/bake.hpp"
+#include "gl/renderer.hpp"
+#include "gl/scene_frame.hpp"
+#include "gl/uniform_blocks.hpp"
+#include "io/gltf_loader.hpp"
+#include "io/scene_files.hpp"
+#include "ImageCompare.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdlib>
+#include <map>
+
+using namespace dermis;
+using namespace dermis::test;
+
+namespace {
+
+const std::string kShared = DERMIS_SHARED_DIR;
+const std::string kSource = DERMIS_SOURCE_DIR;
+const std::string kCesium = kShared + "/models/CesiumMan/CesiumMan.glb";
+const std::string kBarbarian = kShared + "/models/KayKitBarbarian/Barbarian.glb";
+
+GlBackend requestedBackend() {
+    const char* env = std::getenv("DERMIS_TEST_GL");
+    if (!env || !*env) return GlBackend::Auto;
+    auto b = glBackendFromString(env);
+    return b ? *b : GlBackend::Auto;
+}
+
+class RendererGLTest : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        auto r = Renderer::create(requestedBackend());
+        if (!r) {
+            createError_ = r.error().message;
+            return;
+        }
+        renderer_ = std::move(*r);
+    }
+    static void TearDownTestSuite() { renderer_.reset(); }
+    void SetUp() override {
+        ASSERT_TRUE(renderer_) << "no GL context for backend " << toString(requestedBackend())
+                               << ": " << createError_;
+    }
+    Renderer& gl() { return *renderer_; }
+
+    static std::unique_ptr<Renderer> renderer_;
+    static std::string createError_;
+};
+std::unique_ptr<Renderer> RendererGLTest::renderer_;
+std::string RendererGLTest::createError_;
+
+std::shared_ptr<const Model> loadModel(const std::string& path) {
+    auto m = loadGltfFile(path);
+    EXPECT_TRUE(m) << (m ? "" : m.error().message);
+    return m ? std::make_shared<const Model>(std::move(*m)) : nullptr;
+}
+
+/// Fraction of pixels that differ from the top-left (background) pixel.
+double coverage(const Image8& img) {
+    std::size_t n = 0;
+    const std::size_t pixels = static_cast<std::size_t>(img.width) * img.height;
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(int(img.rgba[p * 4 + c]) - int(img.rgba[c])) > 8) {
+                ++n;
+                break;
+            }
+    return static_cast<double>(n) / static_cast<double>(pixels);
+}
+
+double meanAbsDiff(const Image8& a, const Image8& b) {
+    if (a.rgba.size() != b.rgba.size() || a.rgba.empty()) return 1e9;
+    double s = 0.0;
+    for (std::size_t i = 0; i < a.rgba.size(); ++i)
+        s += std::abs(int(a.rgba[i]) - int(b.rgba[i]));
+    return s / static_cast<double>(a.rgba.size());
+}
+
+// --- context and uniform blocks -----------------------------------------------------------------
+
+TEST_F(RendererGLTest, ReportsTheBackendAndDriver) {
+    const RendererInfo& i = gl().info();
+    if (requestedBackend() != GlBackend::Auto) EXPECT_EQ(i.backend, toString(requestedBackend()));
+    EXPECT_FALSE(i.vendor.empty());
+    EXPECT_FALSE(i.renderer.empty());
+    EXPECT_NE(i.version.find("4."), std::string::npos) << i.version;
+    EXPECT_GE(i.maxTextureSize, 4096);
+    EXPECT_GE(i.maxSamples, 4);
+}
+
+TEST_F(RendererGLTest, UniformBlocksMatchTheirCppMirrors) {
+    struct Member {
+        const char* name;
+        std::size_t offset;
+    };
+    const std::map<std::string, std::pair<std::size_t, std::vector<Member>>> expected = {
+        {"HeightPassBlock",
+         {sizeof(gl::HeightPassBlock),
+          {{"u_centerScale", offsetof(gl::HeightPassBlock, centerScale)},
+           {"u_rotation", offsetof(gl::HeightPassBlock, rotation)},
+           {"u_drive", offsetof(gl::HeightPassBlock, drive)},
+           {"u_mode", offsetof(gl::HeightPassBlock, mode)},
+           {"u_mapSize", offsetof(gl::HeightPassBlock, mapSize)}}}},
+        {"FrameBlock",
+         {sizeof(gl::FrameBlock),
+          {{"u_viewProj", offsetof(gl::FrameBlock, viewProj)},
+           {"u_cameraPos", offsetof(gl::FrameBlock, cameraPos)},
+           {"u_lightDir", offsetof(gl::FrameBlock, lightDir)},
+           {"u_heights", offsetof(gl::FrameBlock, heights)},
+           {"u_heightmapSize", offsetof(gl::FrameBlock, heightmapSize)},
+           {"u_viewport", offsetof(gl::FrameBlock, viewport)}}}},
+        {"PartBlock",
+         {sizeof(gl::PartBlock),
+          {{"u_baseColor", offsetof(gl::PartBlock, baseColor)},
+           {"u_part", offsetof(gl::PartBlock, part)}}}},
+    };
+    for (const auto& [block, want] : expected) {
+        auto layout = gl().blockLayout(block);
+        ASSERT_TRUE(layout) << layout.error().message;
+        EXPECT_EQ(static_cast<std::size_t>(layout->size), want.first) << block;
+        std::map<std::string, int> got(layout->offsets.begin(), layout->offsets.end());
+        EXPECT_EQ(got.size(), want.second.size()) << block << ": members the mirror lacks";
+        for (const Member& m : want.second) {
+            ASSERT_TRUE(got.count(m.name)) << block << "." << m.name << " is not active";
+            EXPECT_EQ(static_cast<std::size_t>(got[m.name]), m.offset) << block << "." << m.name;
+        }
+    }
+    EXPECT_FALSE(gl().blockLayout("NoSuchBlock"));
+}
+
+// --- stage 1: height maps -----------------------------------------------------------------------
+
+/// A smooth signed test pattern of size w×h with values in [−1, 1].
+HeightImage testPattern(int w, int h, double fx, double fy) {
+    HeightImage img(w, h);
+    for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i)
+            img.at(i, j) = static_cast<float>(std::sin(fx * (i + 0.5) / w * 6.283 + 0.3) *
+                                              std::cos(fy * (j + 0.5) / h * 6.283 - 0.2));
+    return img;
+}
+
+/// True when texel (i, j)'s centre lies within `margin` UV of some active footprint's edge.
+bool nearAnEdge(const std::vector<BakePlacement>& ps, int i, int j, int W, int H, double margin) {
+    const glm::dvec2 uv((i + 0.5) / W, (j + 0.5) / H);
+    for (const BakePlacement& p : ps) {
+        if (p.t <= 0.0) continue;
+        const glm::dvec2 s = p.footprint.toPattern(uv);
+        const double du = std::min(std::abs(s.x), std::abs(1.0 - s.x)) * p.footprint.scale.x;
+        const double dv = std::min(std::abs(s.y), std::abs(1.0 - s.y)) * p.footprint.scale.y;
+        const bool insideU = s.x > -margin / p.footprint.scale.x && s.x < 1.0 + margin / p.footprint.scale.x;
+        const bool insideV = s.y > -margin / p.footprint.scale.y && s.y < 1.0 + margin / p.footprint.scale.y;
+        if ((du < margin && insideV) || (dv < margin && insideU)) return true;
+    }
+    return false;
+}
+
+struct MapComparison {
+    float maxDiff = 0.0f;
+    std::size_t compared = 0, nonZero = 0;
+};
+
+MapComparison compareMaps(const HeightImage& gpu, const HeightImage& cpu,
+                          const std::vector<BakePlacement>& ps) {
+    MapComparison c;
+    const int W = cpu.width, H = cpu.height;
+    const double margin = 2.0 * std::max(1.0 / W, 1.0 / H);
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            if (nearAnEdge(ps, i, j, W, H, margin)) continue;
+            ++c.compared;
+            if (cpu.at(i, j) != 0.0f) ++c.nonZero;
+            c.maxDiff = std::max(c.maxDiff, std::abs(gpu.at(i, j) - cpu.at(i, j)));
+        }
+    return c;
+}
+
+TEST_F(RendererGLTest, HeightPassEqualsTheCpuReference) {
+    PatternImages images;
+    images["a"] = testPattern(64, 40, 1.5, 2.0); // non-square
+    images["b"] = testPattern(32, 32, 3.0, 1.0);
+    images["c"] = testPattern(50, 70, 0.7, 2.5);
+    HeightImage base = testPattern(97, 61, 4.0, 4.0); // a static map of another size
+    for (float& v : base.data) v *= 0.1f;
+
+    std::vector<BakePlacement> ps;
+    const char* keys[] = {"a", "b", "c"};
+    const double rotations[] = {0.0, 30.0, -75.0, 90.0, 200.0, 12.5, 145.0, -160.0};
+    int n = 0;
+    for (DeformModel m : {DeformModel::Scale, DeformModel::Bias})
+        for (Response r : {Response::Log2, Response::Ln, Response::Linear, Response::Smoothstep}) {
+            BakePlacement p;
+            p.pattern = &images[keys[n % 3]];
+            // Overlapping footprints along a diagonal, non-square and rotated.
+            p.footprint.center = {0.2 + 0.08 * n, 0.25 + 0.06 * n};
+            p.footprint.scale = {0.22 + 0.02 * (n % 3), 0.13 + 0.03 * (n % 2)};
+            p.footprint.rotationDeg = rotations[n];
+            p.model = m;
+            p.response = r;
+            p.target = n % 2 ? Target::Displacement : Target::Bump;
+            p.h = 0.5 + 0.25 * n;
+            p.t = n == 3 ? 1.0 : 0.15 + 0.1 * n; // every response mid-range, one at t = 1
+            ps.push_back(p);
+            ++n;
+        }
+    BakePlacement off = ps[0]; // t = 0 contributes nothing
+    off.t = 0.0;
+    off.footprint.center = {0.8, 0.2};
+    ps.push_back(off);
+
+    HeightPassInput in;
+    in.placements = ps;
+    in.images = &images;
+    in.base = &base;
+    in.width = 320;
+    in.height = 200; // non-square map
+    auto gpu = gl().bakeHeightMaps(in);
+    ASSERT_TRUE(gpu) << gpu.error().message;
+    BakeSettings bs;
+    bs.width = in.width;
+    bs.height = in.height;
+    bs.base = &base;
+    auto cpu = bakeHeightMaps(ps, bs);
+    ASSERT_TRUE(cpu) << cpu.error().message;
+    ASSERT_EQ(gpu->bump.width, 320);
+    ASSERT_EQ(gpu->bump.height, 200);
+    for (auto [g, c, name] : {std::tuple{&gpu->bump, &cpu->bump, "bump"},
+                              std::tuple{&gpu->displacement, &cpu->displacement, "displacement"}}) {
+        const MapComparison r = compareMaps(*g, *c, ps);
+        EXPECT_LE(r.maxDiff, 2e-3f) << name;
+        EXPECT_GT(r.compared, 320u * 200u / 2) << name;
+        EXPECT_GT(r.nonZero, 2000u) << name << ": the comparison must cover deformed texels";
+    }
+    // Row 0 is v near 0: the map is not flipped (a placement near v = 0.25 lands in the top half).
+    double topHalf = 0.0, bottomHalf = 0.0;
+    for (int j = 0; j < 200; ++j)
+        for (int i = 0; i < 320; ++i)
+            (j < 100 ? topHalf : bottomHalf) += std::abs(gpu->displacement.at(i, j));
+    EXPECT_GT(topHalf, 0.0);
+    EXPECT_GT(bottomHalf, 0.0);
+}
+
+TEST_F(RendererGLTest, HeightPassOfTheDefaultSceneEqualsTheCpuReference) {
+    auto loaded = loadSceneFile(kSource + "/models/default.scene.json");
+    ASSERT_TRUE(loaded) << loaded.error().message;
+    auto model = std::make_shared<const Model>(loaded->model);
+    for (double time : {0.5, 1.25}) {
+        auto frame = makeSceneFrame(loaded->scene, model, loaded->images, nullptr, {time});
+        ASSERT_TRUE(frame) << frame.error().message;
+        const HeightPassInput& in = *frame->request.heights;
+        auto gpu = gl().bakeHeightMaps(in);
+        ASSERT_TRUE(gpu) << gpu.error().message;
+        BakeSettings bs;
+        bs.width = in.width;
+        bs.height = in.height;
+        auto cpu = bakeHeightMaps(in.placements, bs);
+        ASSERT_TRUE(cpu);
+        for (auto [g, c] : {std::pair{&gpu->bump, &cpu->bump},
+                            std::pair{&gpu->displacement, &cpu->displacement}}) {
+            const MapComparison r = compareMaps(*g, *c, in.placements);
+            EXPECT_LE(r.maxDiff, 2e-3f) << "time " << time;
+            EXPECT_GT(r.nonZero, 1000u) << "time " << time;
+        }
+    }
+}
+
+TEST_F(RendererGLTest, HeightPassRejectsBadInput) {
+    HeightPassInput in;
+    in.width = 0;
+    auto r = gl().bakeHeightMaps(in);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().field, "/heightmap/size");
+    in.width = 64;
+    in.height = 64;
+    BakePlacement p; // no pattern
+    p.t = 0.5;
+    in.placements.push_back(p);
+    r = gl().bakeHeightMaps(in);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().field, "/placements/0/pattern");
+    // The renderer is still usable afterwards.
+    in.placements.clear();
+    auto ok = gl().bakeHeightMaps(in);
+    ASSERT_TRUE(ok) << ok.error().message;
+    EXPECT_EQ(ok->bump.data, std::vector<float>(64 * 64, 0.0f));
+}
+
+// --- stage 2: skinning --------------------------------------------------------------------------
+
+void expectGpuSkinningMatchesCpu(Renderer& gl, const std::shared_ptr<const Model>& model) {
+    ASSERT_TRUE(model);
+    std::vector<LocalPose> poses = {restPose(*model)};
+    for (std::size_t c = 0; c < model->clips.size() && c < 4; ++c)
+        for (float f : {0.3f, 0.8f})
+            poses.push_back(sampleClip(*model, static_cast<int>(c), f * model->clips[c].duration));
+    std::size_t vertices = 0;
+    for (const LocalPose& pose : poses) {
+        const auto world = worldMatrices(*model, pose);
+        const auto cpu = skin(*model, world);
+        auto gpu = gl.skinOnGpu(model, world);
+        ASSERT_TRUE(gpu) << gpu.error().message;
+        ASSERT_EQ(gpu->size(), cpu.size());
+        float maxPos = 0.0f, minDot = 1.0f;
+        for (std::size_t pi = 0; pi < cpu.size(); ++pi) {
+            ASSERT_EQ((*gpu)[pi].positions.size(), cpu[pi].positions.size());
+            for (std::size_t v = 0; v < cpu[pi].positions.size(); ++v) {
+                maxPos = std::max(maxPos, glm::length((*gpu)[pi].positions[v] - cpu[pi].positions[v]));
+                minDot = std::min(minDot, glm::dot((*gpu)[pi].normals[v], cpu[pi].normals[v]));
+                ++vertices;
+            }
+        }
+        EXPECT_LE(maxPos, 1e-4f);
+        EXPECT_GE(minDot, 0.9999f);
+    }
+    EXPECT_GT(vertices, 1000u);
+}
+
+TEST_F(RendererGLTest, GpuSkinningEqualsCpuSkinningOnCesiumMan) {
+    expectGpuSkinningMatchesCpu(gl(), loadModel(kCesium));
+}
+
+TEST_F(RendererGLTest, GpuSkinningEqualsCpuSkinningOnTheDefaultCharacter) {
+    expectGpuSkinningMatchesCpu(gl(), loadModel(kSource + "/models/default.glb"));
+}
+
+// --- stage 2: frames ----------------------------------------------------------------------------
+
+/// Renders `model` posed by clip 0 at `time` with no placements.
+Result<FrameResult> renderModel(Renderer& gl, const std::shared_ptr<const Model>& model,
+                                double time, int size = 192) {
+    Scene scene;
+    scene.render.size = {size, size};
+    scene.heightmapSize = {256, 256};
+    PatternImages none;
+    auto frame = makeSceneFrame(scene, model, none, nullptr, {time});
+    if (!frame) return frame.error();
+    return gl.renderFrame(frame->request);
+}
+
+void expectFramesChangeWithTime(Renderer& gl, const std::string& path, int clip) {
+    auto model = loadModel(path);
+    ASSERT_TRUE(model);
+    ASSERT_GT(model->clips.size(), static_cast<std::size_t>(clip));
+    const double d = model->clips[static_cast<std::size_t>(clip)].duration;
+    std::vector<Image8> frames;
+    for (double f : {0.1, 0.45, 0.8}) {
+        auto r = renderModel(gl, model, f * d);
+        ASSERT_TRUE(r) << r.error().message;
+        EXPECT_EQ(r->image.width, 192);
+        EXPECT_EQ(r->image.rgba.size(), 192u * 192u * 4u);
+        const double cov = coverage(r->image);
+        EXPECT_GT(cov, 0.04) << path << " at " << f * d << " s is (nearly) empty";
+        EXPECT_LT(cov, 0.9) << path << ": the character should not fill the frame";
+        frames.push_back(std::move(r->image));
+    }
+    EXPECT_GT(meanAbsDiff(frames[0], frames[1]), 0.2) << path;
+    EXPECT_GT(meanAbsDiff(frames[1], frames[2]), 0.2) << path;
+}
+
+TEST_F(RendererGLTest, FramesOfCesiumManAreNonEmptyAndChangeWithTime) {
+    expectFramesChangeWithTime(gl(), kCesium, 0);
+}
+
+TEST_F(RendererGLTest, FramesOfTheBarbarianAreNonEmptyAndChangeWithTime) {
+    auto model = loadModel(kBarbarian);
+    ASSERT_TRUE(model);
+    // A clip with visible motion: the first whose name says it walks or runs, else clip 0.
+    int clip = 0;
+    for (std::size_t c = 0; c < model->clips.size(); ++c)
+        if (model->clips[c].name.find("Walking") != std::string::npos) {
+            clip = static_cast<int>(c);
+            break;
+        }
+    expectFramesChangeWithTime(gl(), kBarbarian, clip);
+}
+
+/// The default scene with the pose, size and MSAA of a test.
+Result<FrameResult> renderDefault(Renderer& gl, const LoadedScene& loaded,
+                                  const std::shared_ptr<const Model>& model, const Pose& pose,
+                                  RenderSettings render, bool cpuMaps = false) {
+    Scene scene = loaded.scene;
+    scene.pose = pose;
+    scene.render = render;
+    SceneFrameOptions opt;
+    opt.cpuHeightMaps = cpuMaps;
+    auto frame = makeSceneFrame(scene, model, loaded.images, nullptr, opt);
+    if (!frame) return frame.error();
+    return gl.renderFrame(frame->request);
+}
+
+class DefaultCharacterGLTest : public RendererGLTest {
+protected:
+    void SetUp() override {
+        RendererGLTest::SetUp();
+        auto l = loadSceneFile(kSource + "/models/default.scene.json");
+        ASSERT_TRUE(l) << l.error().message;
+        loaded_ = std::make_unique<LoadedScene>(std::move(*l));
+        model_ = std::make_shared<const Model>(loaded_->model);
+        settings_.size = {256, 256};
+    }
+    static Pose pose(const std::string& clip, double time) {
+        Pose p;
+        p.animation = clip;
+        p.time = time;
+        return p;
+    }
+    std::unique_ptr<LoadedScene> loaded_;
+    std::shared_ptr<const Model> model_;
+    RenderSettings settings_;
+};
+
+TEST_F(DefaultCharacterGLTest, MatchesReferenceImagesInThreePoses) {
+    struct Case {
+        const char* name;
+        const char* clip;
+        double time, yaw, pitch;
+    };
+    const Case cases[] = {{"default_rest", "squat", 0.0, 0.0, 10.0},
+                          {"default_squat", "squat", 1.25, 20.0, 10.0},
+                          {"default_elbow_curl", "elbow_curl", 1.0, -35.0, 5.0}};
+    std::vector<Image8> frames;
+    for (const Case& c : cases) {
+        RenderSettings rs = settings_;
+        rs.camera.yaw = c.yaw;
+        rs.camera.pitch = c.pitch;
+        auto r = renderDefault(gl(), *loaded_, model_, pose(c.clip, c.time), rs);
+        ASSERT_TRUE(r) << r.error().message;
+        EXPECT_TRUE(compareWithReference(r->image, kSource + "/tests/reference/" + c.name + ".png"));
+        frames.push_back(std::move(r->image));
+    }
+    // The tolerance still tells poses apart: the squat is not the rest pose.
+    const char* update = std::getenv("DERMIS_UPDATE_REFERENCES");
+    if (!update || std::string(update) != "1")
+        EXPECT_FALSE(compareWithReference(frames[1], kSource + "/tests/reference/default_rest.png"));
+}
+
+TEST_F(DefaultCharacterGLTest, CpuAndGpuHeightMapsGiveTheSameFrame) {
+    auto gpu = renderDefault(gl(), *loaded_, model_, pose("squat", 1.25), settings_, false);
+    auto cpu = renderDefault(gl(), *loaded_, model_, pose("squat", 1.25), settings_, true);
+    ASSERT_TRUE(gpu) << gpu.error().message;
+    ASSERT_TRUE(cpu) << cpu.error().message;
+    EXPECT_LT(meanAbsDiff(gpu->image, cpu->image), 0.05);
+}
+
+TEST_F(DefaultCharacterGLTest, DeformationChangesTheFrame) {
+    // The same pose with strong displacement and bump mapping, and with neither: the bulges
+    // change the silhouette (coverage) and the shading.
+    RenderSettings strong = settings_;
+    strong.displacementScale = 0.05;
+    RenderSettings none = settings_;
+    none.displacementScale = 0.0;
+    none.bumpStrength = 0.0;
+    auto a = renderDefault(gl(), *loaded_, model_, pose("elbow_curl", 1.0), strong);
+    auto b = renderDefault(gl(), *loaded_, model_, pose("elbow_curl", 1.0), none);
+    ASSERT_TRUE(a && b);
+    EXPECT_GT(meanAbsDiff(a->image, b->image), 0.1);
+    EXPECT_NE(coverage(a->image), coverage(b->image));
+}
+
+TEST_F(DefaultCharacterGLTest, MsaaLevelsAndTessellationRender) {
+    std::map<int, Image8> byMsaa;
+    for (int msaa : {1, 2, 4}) {
+        RenderSettings rs = settings_;
+        rs.msaa = msaa;
+        auto r = renderDefault(gl(), *loaded_, model_, pose("squat", 1.25), rs);
+        ASSERT_TRUE(r) << "msaa " << msaa << ": " << r.error().message;
+        EXPECT_GT(coverage(r->image), 0.05);
+        byMsaa[msaa] = std::move(r->image);
+    }
+    const double d14 = meanAbsDiff(byMsaa[1], byMsaa[4]);
+    EXPECT_GT(d14, 0.0) << "4x MSAA should smooth edges";
+    EXPECT_LT(d14, 3.0) << "…without changing the picture";
+
+    RenderSettings tess = settings_;
+    tess.displacement = DisplacementMode::Tessellated;
+    auto t = renderDefault(gl(), *loaded_, model_, pose("squat", 1.25), tess);
+    ASSERT_TRUE(t) << t.error().message;
+    EXPECT_GT(coverage(t->image), 0.05);
+    const double dt = meanAbsDiff(t->image, byMsaa[4]);
+    EXPECT_LT(dt, 4.0) << "tessellation refines, it does not change the character";
+    // Without displacement, tessellating the same triangles gives (nearly) the same frame.
+    RenderSettings tessFlat = tess, vertFlat = settings_;
+    tessFlat.displacementScale = vertFlat.displacementScale = 0.0;
+    auto tf = renderDefault(gl(), *loaded_, model_, pose("squat", 1.25), tessFlat);
+    auto vf = renderDefault(gl(), *loaded_, model_, pose("squat", 1.25), vertFlat);
+    ASSERT_TRUE(tf && vf);
+    EXPECT_LT(meanAbsDiff(tf->image, vf->image), 0.5);
+}
+
+TEST_F(DefaultCharacterGLTest, FrameOptionsAreValidated) {
+    RenderSettings rs = settings_;
+    rs.size = {0, 10};
+    auto r = renderDefault(gl(), *loaded_, model_, pose("squat", 0.5), rs);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().field, "/render/size");
+    rs = settings_;
+    rs.msaa = 3;
+    r = renderDefault(gl(), *loaded_, model_, pose("squat", 0.5), rs);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().field, "/render/msaa");
+    rs = settings_;
+    rs.bumpStrength = std::nan("");
+    r = renderDefault(gl(), *loaded_, model_, pose("squat", 0.5), rs);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().field, "/render/bump_strength");
+    FrameRequest empty;
+    auto e = gl().renderFrame(empty);
+    ASSERT_FALSE(e);
+    // Still renders after the errors.
+    auto ok = renderDefault(gl(), *loaded_, model_, pose("squat", 0.5), settings_);
+    ASSERT_TRUE(ok) << ok.error().message;
+}
+
+TEST_F(DefaultCharacterGLTest, ReadsBackTheMapsItUsed) {
+    Scene scene = loaded_->scene;
+    scene.render.size = {64, 64};
+    SceneFrameOptions opt;
+    opt.readHeightMaps = true;
+    auto frame = makeSceneFrame(scene, model_, loaded_->images, nullptr, opt);
+    ASSERT_TRUE(frame);
+    auto r = gl().renderFrame(frame->request);
+    ASSERT_TRUE(r) << r.error().message;
+    ASSERT_TRUE(r->maps);
+    auto direct = gl().bakeHeightMaps(*frame->request.heights);
+    ASSERT_TRUE(direct);
+    EXPECT_EQ(r->maps->bump.data, direct->bump.data);
+    EXPECT_EQ(r->maps->displacement.data, direct->displacement.data);
+}
+
+} // namespace
