@@ -115,6 +115,31 @@ TEST(FrameIoTest, PngRoundTripIsExactIncludingAlpha) {
     EXPECT_EQ(nc, 4);
 }
 
+TEST(FrameIoTest, PngOfManyStripsIsOneValidStream) {
+    // Tall frames are compressed in strips on several threads and joined into one zlib stream:
+    // libpng and OpenImageIO both read it back exactly, with and without alpha.
+    const Image8 img = noiseImage(301, 517, 7);
+    for (bool alpha : {true, false}) {
+        auto png = encodePng(img, alpha);
+        ASSERT_TRUE(png.ok()) << png.error().message;
+        auto back = decodeFrame(*png);
+        ASSERT_TRUE(back.ok()) << back.error().message;
+        std::vector<std::uint8_t> want = img.rgba;
+        if (!alpha)
+            for (std::size_t p = 3; p < want.size(); p += 4) want[p] = 255;
+        EXPECT_EQ(back->rgba, want) << "alpha " << alpha;
+        TempDir dir;
+        writeBytes(dir / "t.png", *png);
+        int w = 0, h = 0, nc = 0;
+        auto oiio = readWithOiio(dir / "t.png", w, h, nc);
+        EXPECT_EQ(w, 301);
+        EXPECT_EQ(h, 517);
+        EXPECT_EQ(nc, alpha ? 4 : 3);
+        EXPECT_EQ(oiio.size(), 301u * 517u * static_cast<std::size_t>(nc));
+        if (alpha) EXPECT_EQ(oiio, img.rgba);
+    }
+}
+
 TEST(FrameIoTest, PngWithoutAlpha) {
     const Image8 img = noiseImage(16, 9, 2);
     auto png = encodePng(img, false);

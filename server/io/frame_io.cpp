@@ -29,6 +29,7 @@
 #include <fcntl.h>
 #include <filesystem>
 #include <memory>
+#include <thread>
 #include <unistd.h>
 
 namespace dermis {
@@ -58,54 +59,70 @@ Status checkFrame(const char* where, const Image8& img) {
 // --- PNG -------------------------------------------------------------------------------------
 
 constexpr int kPngZlibLevel = 1;
-constexpr int kPngFilter = PNG_FILTER_SUB;
 constexpr int kPngZlibStrategy = Z_RLE;
+constexpr std::uint8_t kPngFilterSub = 1; // PNG filter type 1: each byte minus the one bpp before
 
-/// Shared by libpng's error and write callbacks (png_get_error_ptr / png_get_io_ptr).
-struct PngState {
-    std::vector<std::uint8_t>* out = nullptr;
-    bool outOfMemory = false;
-    char message[256] = {};
+void putU32(std::vector<std::uint8_t>& out, std::uint32_t v) {
+    for (int shift = 24; shift >= 0; shift -= 8)
+        out.push_back(static_cast<std::uint8_t>(v >> shift));
+}
+
+/// Appends a PNG chunk: length, type, data, CRC-32 of type and data (zlib's crc32).
+void putChunk(std::vector<std::uint8_t>& out, const char type[4], const std::uint8_t* data,
+              std::size_t size) {
+    putU32(out, static_cast<std::uint32_t>(size));
+    const std::size_t typeAt = out.size();
+    out.insert(out.end(), type, type + 4);
+    if (size) out.insert(out.end(), data, data + size);
+    const uLong crc = crc32(0L, out.data() + typeAt, static_cast<uInt>(4 + size));
+    putU32(out, static_cast<std::uint32_t>(crc));
+}
+
+/// One strip of rows [y0, y1): SUB-filtered scanlines compressed as raw deflate (no zlib
+/// header), ending with a sync flush (byte aligned, not final) or, for the last strip, the final
+/// block. Concatenated strips form one valid deflate stream (the approach of pigz).
+struct Strip {
+    int y0 = 0, y1 = 0;
+    bool last = false;
+    std::vector<std::uint8_t> deflated;
+    uLong adler = 1;
+    std::size_t filteredBytes = 0;
+    bool ok = false;
 };
 
-void pngError(png_structp png, png_const_charp msg) {
-    auto* st = static_cast<PngState*>(png_get_error_ptr(png));
-    std::snprintf(st->message, sizeof st->message, "%s", msg ? msg : "unknown libpng error");
-    png_longjmp(png, 1);
-}
-
-void pngWarning(png_structp, png_const_charp) {}
-
-void pngWrite(png_structp png, png_bytep data, png_size_t size) {
-    auto* st = static_cast<PngState*>(png_get_io_ptr(png));
-    try {
-        st->out->insert(st->out->end(), data, data + size);
-    } catch (...) {
-        st->outOfMemory = true;
+void compressStrip(const Image8& img, int channels, Strip& strip) {
+    const std::size_t w = static_cast<std::size_t>(img.width);
+    const std::size_t lineBytes = 1 + w * static_cast<std::size_t>(channels);
+    std::vector<std::uint8_t> line(lineBytes);
+    z_stream zs{};
+    if (deflateInit2(&zs, kPngZlibLevel, Z_DEFLATED, -15, 8, kPngZlibStrategy) != Z_OK) return;
+    const std::size_t rows = static_cast<std::size_t>(strip.y1 - strip.y0);
+    strip.deflated.resize(deflateBound(&zs, static_cast<uLong>(rows * lineBytes)) + 64);
+    zs.next_out = strip.deflated.data();
+    zs.avail_out = static_cast<uInt>(strip.deflated.size());
+    bool ok = true;
+    for (int y = strip.y0; y < strip.y1 && ok; ++y) {
+        const std::uint8_t* src = img.rgba.data() + static_cast<std::size_t>(y) * w * 4;
+        line[0] = kPngFilterSub;
+        std::uint8_t* dst = line.data() + 1;
+        for (std::size_t x = 0; x < w; ++x)
+            for (int c = 0; c < channels; ++c) {
+                const std::uint8_t left = x ? src[(x - 1) * 4 + static_cast<std::size_t>(c)] : 0;
+                dst[x * static_cast<std::size_t>(channels) + static_cast<std::size_t>(c)] =
+                    static_cast<std::uint8_t>(src[x * 4 + static_cast<std::size_t>(c)] - left);
+            }
+        strip.adler = adler32(strip.adler, line.data(), static_cast<uInt>(lineBytes));
+        zs.next_in = line.data();
+        zs.avail_in = static_cast<uInt>(lineBytes);
+        const bool lastRow = y + 1 == strip.y1;
+        const int flush = lastRow ? (strip.last ? Z_FINISH : Z_SYNC_FLUSH) : Z_NO_FLUSH;
+        const int rc = deflate(&zs, flush);
+        ok = (rc == Z_OK || rc == Z_STREAM_END || rc == Z_BUF_ERROR) && zs.avail_in == 0;
     }
-    // No C++ object is alive here, so leaving through libpng's longjmp is well defined.
-    if (st->outOfMemory) png_error(png, "out of memory");
-}
-
-void pngFlush(png_structp) {}
-
-/// The libpng calls between setjmp and the end of the stream, kept apart so that no C++ object
-/// with a destructor lives in the frame that longjmp unwinds. Returns false after a libpng error.
-bool pngWriteStream(png_structp png, png_infop info, const Image8& img, bool keepAlpha,
-                    png_bytep* rows) {
-    if (setjmp(png_jmpbuf(png))) return false;
-    png_set_IHDR(png, info, static_cast<png_uint_32>(img.width),
-                 static_cast<png_uint_32>(img.height), 8,
-                 keepAlpha ? PNG_COLOR_TYPE_RGB_ALPHA : PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_set_compression_level(png, kPngZlibLevel);
-    png_set_compression_strategy(png, kPngZlibStrategy);
-    png_set_filter(png, PNG_FILTER_TYPE_BASE, kPngFilter);
-    png_write_info(png, info);
-    if (!keepAlpha) png_set_filler(png, 0, PNG_FILLER_AFTER); // strip the 4th byte of each pixel
-    png_write_image(png, rows);
-    png_write_end(png, nullptr);
-    return true;
+    strip.deflated.resize(strip.deflated.size() - zs.avail_out);
+    strip.filteredBytes = rows * lineBytes;
+    deflateEnd(&zs);
+    strip.ok = ok;
 }
 
 // --- JPEG ------------------------------------------------------------------------------------
@@ -221,30 +238,47 @@ std::optional<FrameFormat> frameFormatFromPath(const std::string& path) {
 Result<std::vector<std::uint8_t>> encodePng(const Image8& img, bool keepAlpha) {
     const char* where = "dermis::encodePng";
     if (auto s = checkFrame(where, img); !s) return s.error();
-    std::vector<std::uint8_t> out;
-    std::vector<png_bytep> rows(static_cast<std::size_t>(img.height));
+    const int channels = keepAlpha ? 4 : 3;
+    // Strips of at least 64 rows, one per core (at most 8), compressed in parallel.
+    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    const int nStrips = std::clamp(img.height / 64, 1, std::min(cores, 8));
+    std::vector<Strip> strips(static_cast<std::size_t>(nStrips));
+    for (int k = 0; k < nStrips; ++k) {
+        strips[static_cast<std::size_t>(k)].y0 = img.height * k / nStrips;
+        strips[static_cast<std::size_t>(k)].y1 = img.height * (k + 1) / nStrips;
+        strips[static_cast<std::size_t>(k)].last = k + 1 == nStrips;
+    }
     try {
-        out.reserve(img.rgba.size() / 2);
-    } catch (...) {
-        return makeError(ErrorCode::Io, where, "", "out of memory");
+        std::vector<std::thread> workers;
+        for (std::size_t k = 1; k < strips.size(); ++k)
+            workers.emplace_back(compressStrip, std::cref(img), channels, std::ref(strips[k]));
+        compressStrip(img, channels, strips[0]);
+        for (std::thread& t : workers)
+            t.join();
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Io, where, "", std::string("cannot compress: ") + e.what());
     }
-    const std::size_t stride = static_cast<std::size_t>(img.width) * 4;
-    for (std::size_t y = 0; y < rows.size(); ++y)
-        rows[y] = const_cast<png_bytep>(img.rgba.data() + y * stride); // libpng only reads rows
+    std::vector<std::uint8_t> zdata = {0x78, 0x01}; // zlib header: deflate, 32K window, fastest
+    uLong adler = 1;
+    for (const Strip& st : strips) {
+        if (!st.ok) return makeError(ErrorCode::Io, where, "", "zlib failed to compress the frame");
+        zdata.insert(zdata.end(), st.deflated.begin(), st.deflated.end());
+        adler = adler32_combine(adler, st.adler, static_cast<z_off_t>(st.filteredBytes));
+    }
+    putU32(zdata, static_cast<std::uint32_t>(adler));
 
-    PngState st;
-    st.out = &out;
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &st, pngError, pngWarning);
-    if (!png) return makeError(ErrorCode::Io, where, "", "cannot create a libpng writer");
-    png_infop info = png_create_info_struct(png);
-    if (!info) {
-        png_destroy_write_struct(&png, nullptr);
-        return makeError(ErrorCode::Io, where, "", "cannot create a libpng writer");
-    }
-    png_set_write_fn(png, &st, pngWrite, pngFlush);
-    const bool ok = pngWriteStream(png, info, img, keepAlpha, rows.data());
-    png_destroy_write_struct(&png, &info);
-    if (!ok) return makeError(ErrorCode::Io, where, "", std::string("libpng: ") + st.message);
+    std::vector<std::uint8_t> out = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    out.reserve(zdata.size() + 64);
+    std::vector<std::uint8_t> ihdr;
+    putU32(ihdr, static_cast<std::uint32_t>(img.width));
+    putU32(ihdr, static_cast<std::uint32_t>(img.height));
+    // bit depth 8; colour type 6 (RGBA) or 2 (RGB); deflate; adaptive filtering; no interlace
+    for (std::uint8_t b : {std::uint8_t{8}, std::uint8_t(keepAlpha ? 6 : 2), std::uint8_t{0},
+                           std::uint8_t{0}, std::uint8_t{0}})
+        ihdr.push_back(b);
+    putChunk(out, "IHDR", ihdr.data(), ihdr.size());
+    putChunk(out, "IDAT", zdata.data(), zdata.size());
+    putChunk(out, "IEND", nullptr, 0);
     return out;
 }
 

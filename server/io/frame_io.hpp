@@ -34,11 +34,12 @@ enum class FrameFormat { Png, Jpeg, Exr };
 /// case-insensitive; std::nullopt for anything else (including no extension).
 std::optional<FrameFormat> frameFormatFromPath(const std::string& path);
 
-/// Encodes a frame as PNG in memory with libpng: 8-bit RGBA (keepAlpha) or RGB (alpha dropped),
-/// not interlaced, no colour chunks; zlib level 1 with the Z_RLE strategy and the fixed SUB
-/// filter on every row (4–13× faster than OpenImageIO's default PNG write, mostly at a similar
-/// size; measurements in frame_io.cpp). Decodes to exactly the input bytes (alpha included when
-/// kept).
+/// Encodes a frame as PNG in memory: 8-bit RGBA (keepAlpha) or RGB (alpha dropped), not
+/// interlaced, no colour chunks; the fixed SUB filter on every row, zlib level 1 with the Z_RLE
+/// strategy (4–13× faster than OpenImageIO's default PNG write at a similar size), compressed in
+/// horizontal strips on up to 8 threads whose raw deflate streams are joined by sync flushes into
+/// one zlib stream (pigz's approach; any PNG decoder reads it). Decodes to exactly the input
+/// bytes (alpha included when kept).
 Result<std::vector<std::uint8_t>> encodePng(const Image8& img, bool keepAlpha = true);
 
 /// Encodes a frame as baseline JPEG in memory with libjpeg-turbo: 4:2:0 chroma subsampling,
