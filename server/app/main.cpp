@@ -3,6 +3,7 @@
 //   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH]
 //                        [--heightmaps] [--gl B]
 //   dermis-server info   [--gl B]
+//   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B] [limits]
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
 #include "core/normalmap.hpp"
 #include "gl/renderer.hpp"
@@ -10,6 +11,8 @@
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
 #include "io/scene_files.hpp"
+#include "http/api.hpp"
+#include "http/service.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -20,6 +23,8 @@
 #include <filesystem>
 #include <iostream>
 #include <regex>
+#include <csignal>
+#include <thread>
 
 namespace {
 
@@ -249,12 +254,86 @@ int runInfo(const std::string& gl) {
     return 0;
 }
 
+// --- serve -----------------------------------------------------------------------------------
+
+struct ServeArgs {
+    std::string bind = "127.0.0.1", data = "dermis-data", token, gl = "auto", web;
+    int port = 8080;
+    dermis::ServerLimits limits;
+    double maxUploadMb = 64;
+};
+
+int runServe(ServeArgs a) {
+    using namespace dermis;
+    if (a.token.empty())
+        if (const char* env = std::getenv("DERMIS_TOKEN")) a.token = env;
+    a.limits.maxUploadBytes = static_cast<std::size_t>(a.maxUploadMb * 1024.0 * 1024.0);
+    // SIGINT/SIGTERM are taken by a waiting thread (blocked here, before any thread starts).
+    sigset_t signals;
+    sigemptyset(&signals);
+    sigaddset(&signals, SIGINT);
+    sigaddset(&signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    std::signal(SIGPIPE, SIG_IGN);
+
+    auto service = Service::open(a.data, backendOf(a.gl), a.limits);
+    if (!service) return fail(service.error());
+    for (const std::string& w : (*service)->warnings())
+        std::cerr << "dermis-server: warning: skipped " << w << "\n";
+    ApiOptions opt;
+    opt.bind = a.bind;
+    opt.port = a.port;
+    opt.token = a.token;
+    opt.webDir = a.web.empty() ? dermisDataDir() + "/web" : a.web;
+    Api api(**service, opt);
+    auto port = api.bind();
+    if (!port) return fail(port.error());
+    const nlohmann::json info = (*service)->info();
+    std::cout << "dermis-server: serving http://" << a.bind << ":" << *port << "/ (editor), API http://"
+              << a.bind << ":" << *port << "/api/v1 — " << info["backend"].get<std::string>() << ", "
+              << info["gl"]["renderer"].get<std::string>() << "; data in " << a.data
+              << (a.token.empty() ? "" : "; bearer token required") << std::endl;
+    std::thread waiter([&api, signals] {
+        int sig = 0;
+        sigwait(&signals, &sig);
+        api.stop();
+    });
+    api.run();
+    // Wake the waiter if the server stopped for another reason.
+    pthread_kill(waiter.native_handle(), SIGTERM);
+    waiter.join();
+    std::cout << "dermis-server: stopped" << std::endl;
+    return 0;
+}
+
+void addServeOptions(CLI::App& app, ServeArgs& s) {
+    app.add_option("--bind", s.bind, "Address to listen on (127.0.0.1 = this machine only)");
+    app.add_option("--port", s.port, "TCP port (0 = any free port)")->check(CLI::Range(0, 65535));
+    app.add_option("--data", s.data, "Data directory (uploads and scenes, written atomically)");
+    app.add_option("--token", s.token, "Bearer token every route but /health requires (or $DERMIS_TOKEN)");
+    app.add_option("--web", s.web, "Folder of the web editor served at / (default: the data folder's web/)");
+    app.add_option("--max-upload-mb", s.maxUploadMb, "Largest request body / upload")->check(CLI::Range(0.001, 4096.0));
+    app.add_option("--max-render-side", s.limits.maxRenderSide, "Largest frame side")->check(CLI::Range(16, 8192));
+    app.add_option("--max-map-side", s.limits.maxMapSide, "Largest height-map side")->check(CLI::Range(16, 4096));
+    app.add_option("--max-image-side", s.limits.maxImageSide, "Largest uploaded pattern side")->check(CLI::Range(16, 8192));
+    app.add_option("--max-placements", s.limits.maxPlacements, "Most placements per scene")->check(CLI::Range(1, 100000));
+    app.add_option("--max-triangles", s.limits.maxTriangles, "Most triangles per model");
+    app.add_option("--max-joints", s.limits.maxJoints, "Most joints per model");
+    app.add_option("--queue", s.limits.queueLength, "Renders that may wait for the GL thread")->check(CLI::Range(1, 10000));
+    app.add_option("--timeout", s.limits.requestTimeoutSeconds, "Request read/write timeout (s)")->check(CLI::Range(1, 3600));
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"Dermis render server: skin deformation with dynamic height patterns"};
     app.set_version_flag("--version", "dermis-server 0.1.0");
-    app.require_subcommand(1);
+    app.require_subcommand(0, 1);
+    ServeArgs serve;
+    addServeOptions(app, serve);
+    app.add_option("--gl", serve.gl, "GL backend")->check(CLI::IsMember(kBackendNames));
+    CLI::App* serveCmd = app.add_subcommand("serve", "Run the HTTP server (the default)");
+    serveCmd->fallthrough();
 
     BakeArgs bake;
     CLI::App* bakeCmd = app.add_subcommand(
@@ -312,5 +391,5 @@ int main(int argc, char** argv) {
         return runRender(render);
     }
     if (infoCmd->parsed()) return runInfo(infoGl);
-    return 2;
+    return runServe(serve);
 }

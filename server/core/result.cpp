@@ -9,6 +9,8 @@ const char* errorCodeName(ErrorCode code) {
     case ErrorCode::Parse: return "parse_error";
     case ErrorCode::Io: return "io_error";
     case ErrorCode::Unsupported: return "unsupported";
+    case ErrorCode::Conflict: return "conflict";
+    case ErrorCode::TooLarge: return "too_large";
     case ErrorCode::Unavailable: return "unavailable";
     case ErrorCode::Internal: return "internal";
     }

@@ -21,6 +21,8 @@ enum class ErrorCode {
     Parse,           ///< bytes could not be decoded (JSON, glTF, image)
     Io,              ///< a file could not be read or written
     Unsupported,     ///< valid input that this version does not handle
+    Conflict,        ///< the request conflicts with current state (delete of a model in use)
+    TooLarge,        ///< a body, image or size exceeds a configured limit
     Unavailable,     ///< a needed resource cannot be had now (no GL backend starts, queue full)
     Internal,        ///< a failure of a lower layer that is not the caller's fault (GL errors)
 };

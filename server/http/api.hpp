@@ -1,0 +1,55 @@
+// Dermis HTTP shell — the `/api/v1` routes over cpp-httplib, in front of a Service.
+//
+// One error policy: every failure answers {"error": {"code", "message", "field"}} with the status
+// of its ErrorCode (mapped in one place, api.cpp statusOf): 400 malformed JSON or undecodable
+// bytes, 401 missing/wrong token, 404 unknown ids, 409 conflicts, 413 over a limit, 415 wrong
+// content type or file type, 422 invalid values, 503 full render queue (with Retry-After).
+// HTTP threads never touch GL: renders go through the Service to the renderer's thread.
+// TCP_NODELAY is on (keep-alive requests otherwise stall ~26 ms on the delayed ACK).
+#pragma once
+
+#include "http/service.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+struct ApiOptions {
+    std::string bind = "127.0.0.1";
+    int port = 8080;        ///< 0 = any free port
+    std::string token;      ///< bearer token every route but /health requires; empty = none
+    std::string webDir;     ///< static files served at / (the editor); empty = none
+    int threads = 32;       ///< HTTP worker threads (event streams hold one each)
+};
+
+/// A route of the API: method and OpenAPI path template ("/scenes/{id}").
+struct Route {
+    std::string method, path;
+};
+
+class Api {
+public:
+    Api(Service& service, ApiOptions options);
+    ~Api();
+    /// Binds the socket; returns the port (useful with port 0). Fails (Io) when it cannot bind.
+    Result<int> bind();
+    /// Serves until stop(); call after bind().
+    void run();
+    /// Stops serving (from any thread) and closes event streams.
+    void stop();
+
+    /// Every route served under /api/v1, for the OpenAPI coverage test.
+    static const std::vector<Route>& routes();
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The OpenAPI 3 description served at /api/v1/openapi.yaml (embedded at build time).
+std::string_view openapiYaml();
+
+} // namespace dermis

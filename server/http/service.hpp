@@ -1,0 +1,156 @@
+// Dermis HTTP shell — the server's state and operations, without HTTP: models, patterns and
+// scene documents (persisted through Store), edits, renders through the one Renderer, live
+// change events. The HTTP layer (api.cpp) maps requests to these calls and their errors to
+// statuses in one place.
+//
+// Threads: every method may be called from any HTTP thread. State is guarded by one
+// reader/writer lock; an edit validates the whole new document first, writes it durably, then
+// swaps it in, so a failed edit changes nothing and an acknowledged one survives a crash. GL
+// work goes to the renderer's thread; at most `limits.queueLength` renders wait for it, more are
+// refused with ErrorCode::Unavailable (503 + Retry-After).
+//
+// Documents that arrive here name models and patterns only by generated ids ("m_…", "p_…") or
+// built-in names ("builtin:default", "crease"); never by path.
+#pragma once
+
+#include "core/result.hpp"
+#include "core/scene.hpp"
+#include "gl/renderer.hpp"
+#include "http/store.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <shared_mutex>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+/// Configurable limits, reported by GET /info.
+struct ServerLimits {
+    std::size_t maxUploadBytes = 64u << 20; ///< model and pattern uploads, request bodies
+    int maxImageSide = 4096;                ///< uploaded pattern images
+    int maxMapSide = 4096;                  ///< heightmap.size
+    int maxRenderSide = 4096;               ///< frame width/height
+    std::size_t maxTriangles = 1000000;
+    std::size_t maxJoints = 1024;
+    std::size_t maxPlacements = 256;
+    int queueLength = 16;          ///< renders waiting for the GL thread
+    int requestTimeoutSeconds = 30;
+    std::size_t maxBatchFrames = 512;
+    nlohmann::json toJson() const;
+};
+
+/// An encoded image answer.
+struct EncodedImage {
+    std::vector<std::uint8_t> bytes;
+    std::string contentType;
+    std::string backend; ///< which GL backend rendered it ("" for CPU-only answers)
+};
+
+/// Query parameters of a frame.
+struct FrameParams {
+    std::string format = "png"; ///< png | jpeg
+    std::optional<int> width, height, msaa;
+    std::optional<double> yaw, pitch, distance, time;
+};
+
+/// A server-sent-events subscription to one scene: events queue up until taken.
+class Subscription {
+public:
+    /// Waits up to `timeoutMs` for an event; nullopt on timeout or when closed.
+    std::optional<std::string> next(int timeoutMs);
+    void push(std::string event);
+    void close();
+    bool closed() const;
+
+private:
+    mutable std::mutex mutex_;
+    std::condition_variable cv_;
+    std::deque<std::string> events_;
+    bool closed_ = false;
+};
+
+class Service {
+public:
+    /// Opens the data directory (loading every stored model, pattern and scene; unreadable files
+    /// are skipped and listed in warnings()), loads the built-in content and starts the renderer.
+    static Result<std::unique_ptr<Service>> open(const std::string& dataDir, GlBackend backend,
+                                                 const ServerLimits& limits);
+    ~Service();
+
+    const ServerLimits& limits() const { return limits_; }
+    const std::vector<std::string>& warnings() const { return warnings_; }
+    nlohmann::json info() const;
+
+    // --- models
+    nlohmann::json listModels() const;
+    Result<nlohmann::json> addModel(const std::vector<std::uint8_t>& glb, const std::string& name);
+    Result<nlohmann::json> getModel(const std::string& id) const;
+    Status deleteModel(const std::string& id);
+    /// The UV wireframe: {"width","height"? no: "edges": [u0,v0,u1,v1, …]} (json) or a PNG.
+    Result<nlohmann::json> uvLayout(const std::string& id) const;
+    Result<EncodedImage> uvLayoutPng(const std::string& id, int size) const;
+
+    // --- patterns
+    nlohmann::json listPatterns() const;
+    Result<nlohmann::json> addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name);
+    Result<EncodedImage> patternImage(const std::string& id, int size) const;
+    Status deletePattern(const std::string& id);
+
+    // --- scenes (every answer is {"id", "revision", "scene"})
+    nlohmann::json listScenes() const;
+    /// `body` is a scene document, or {"model": …, "default_patterns": true} to start from the
+    /// default pattern set (only on builtin:default).
+    Result<nlohmann::json> createScene(const nlohmann::json& body);
+    Result<nlohmann::json> getScene(const std::string& id) const;
+    Result<nlohmann::json> replaceScene(const std::string& id, const nlohmann::json& doc);
+    Status deleteScene(const std::string& id);
+    Result<nlohmann::json> addPlacement(const std::string& id, const nlohmann::json& placement);
+    Result<nlohmann::json> patchPlacement(const std::string& id, const std::string& pid,
+                                          const nlohmann::json& patch);
+    Result<nlohmann::json> deletePlacement(const std::string& id, const std::string& pid);
+    /// `order`: every placement id once, in the new order.
+    Result<nlohmann::json> reorderPlacements(const std::string& id, const nlohmann::json& order);
+    Result<nlohmann::json> putPose(const std::string& id, const nlohmann::json& pose);
+    /// Merges: "animation"/"time" replace, "joints" entries replace per joint (null removes).
+    Result<nlohmann::json> patchPose(const std::string& id, const nlohmann::json& patch);
+
+    // --- renders
+    Result<EncodedImage> frame(const std::string& id, const FrameParams& params);
+    /// which: bump | displacement | normal; format: png16 | exr | f32 (normal: png | exr).
+    Result<EncodedImage> heightmap(const std::string& id, const std::string& which,
+                                   const std::string& format);
+    /// Validates a stateless batch ({"scene", "frames": [{"time"} | {"pose"}], "format",
+    /// "size"?}); returns a job that renders frame k on demand.
+    struct BatchJob {
+        std::size_t frames = 0;
+        std::function<Result<EncodedImage>(std::size_t k)> render;
+    };
+    Result<BatchJob> batch(const nlohmann::json& body);
+
+    // --- events
+    Result<std::shared_ptr<Subscription>> subscribe(const std::string& id);
+    void unsubscribe(const std::string& id, const std::shared_ptr<Subscription>& s);
+    /// Closes every subscription (server shutdown).
+    void closeSubscriptions();
+
+    struct State;
+
+private:
+    Service() = default;
+    std::unique_ptr<State> state_;
+    ServerLimits limits_;
+    std::vector<std::string> warnings_;
+};
+
+} // namespace dermis

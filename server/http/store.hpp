@@ -1,0 +1,67 @@
+// Dermis HTTP shell — the server's data directory: uploaded models and patterns, and scene
+// documents, each written atomically and durably before a call returns (temp file in the same
+// folder, fsync, rename over the target, fsync of the folder), so that an acknowledged edit
+// survives a crash or kill -9.
+//
+// Layout under the data directory:
+//   models/<id>.glb      + models/<id>.json    (metadata, written last: the commit record)
+//   patterns/<id>.<ext>  + patterns/<id>.json
+//   scenes/<id>.json     ({"id", "revision", "scene"})
+// Ids are generated ("m_…", "p_…", "s_…": 16 hex digits) — never taken from a client — so no file
+// name comes from a request. Thread-safe: the caller serialises mutations (Service's lock).
+#pragma once
+
+#include "core/result.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+class Store {
+public:
+    /// Creates the folders if needed. Fails (Io) when the directory cannot be created or written.
+    static Result<Store> open(const std::string& dataDir);
+
+    const std::string& dir() const { return dir_; }
+
+    /// A fresh id: `prefix` + "_" + 16 random hex digits.
+    static std::string newId(const std::string& prefix);
+    /// True for ids this store generates (prefix "m", "p" or "s").
+    static bool isGeneratedId(const std::string& id, char prefix);
+
+    struct Blob {
+        std::string id;
+        std::string file;   ///< absolute path of the bytes
+        nlohmann::json meta; ///< as stored by putBlob
+    };
+    /// Writes <kind>/<id>.<ext> then <kind>/<id>.json (`meta` plus "id", "file").
+    Status putBlob(const std::string& kind, const std::string& id, const std::string& ext,
+                   const std::vector<std::uint8_t>& bytes, nlohmann::json meta);
+    /// Every blob of `kind` with a readable metadata record (others are reported in `skipped`).
+    std::vector<Blob> listBlobs(const std::string& kind, std::vector<std::string>& skipped) const;
+    Status removeBlob(const std::string& kind, const std::string& id);
+
+    /// Writes scenes/<id>.json = {"id", "revision", "scene": doc}.
+    Status putScene(const std::string& id, std::uint64_t revision, const nlohmann::json& doc);
+    Status removeScene(const std::string& id);
+    struct SceneRecord {
+        std::string id;
+        std::uint64_t revision = 0;
+        nlohmann::json doc;
+    };
+    std::vector<SceneRecord> listScenes(std::vector<std::string>& skipped) const;
+
+    /// Reads a whole file (empty result with an error for a missing/unreadable file).
+    static Result<std::vector<std::uint8_t>> readFile(const std::string& path);
+    /// Durable atomic write of `bytes` to `path` (same-folder temp file, fsync, rename, fsync dir).
+    static Status writeFileDurably(const std::string& path, const std::vector<std::uint8_t>& bytes);
+
+private:
+    std::string dir_;
+};
+
+} // namespace dermis
