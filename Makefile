@@ -4,7 +4,7 @@ ASAN_BUILD ?= build-asan
 JOBS ?= 2
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-asan run bench patterns character clean format
+.PHONY: all deps build test test-asan run offline bench loadbench patterns character clean format
 
 all: build
 
@@ -30,10 +30,14 @@ test-asan: deps
 	# from llvmpipe's JIT code (no module to suppress by) alive at exit.
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=0:suppressions=$(CURDIR)/tests/asan.supp UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS) -L gl
 
-# Installs, builds and runs the product's main job (for now: bake the default character's
-# pattern set at the deepest point of its squat on the GPU, and render that frame; the HTTP
-# server replaces this).
+# Installs, builds and runs the product's main job: the HTTP render server on 127.0.0.1:8080
+# with the built-in character and pattern set (data in out/data; Ctrl-C stops it).
+PORT ?= 8080
 run: build
+	$(BUILD)/dermis-server serve --port $(PORT) --data out/data
+
+# The offline commands on the default scene: GPU bake (+ normal map) and one rendered frame.
+offline: build
 	$(BUILD)/dermis-server info
 	$(BUILD)/dermis-server bake --gpu --normals --scene models/default.scene.json --out out/default --png
 	$(BUILD)/dermis-server render --scene models/default.scene.json --out out/default/frame.png
@@ -41,6 +45,9 @@ run: build
 
 bench: build
 	$(BUILD)/bench/dermis-bench $(BENCH_ARGS)
+
+loadbench: build
+	$(BUILD)/bench/dermis-loadbench $(BENCH_ARGS)
 
 # Regenerates the built-in pattern library (patterns/*.png, manifest.json, contact sheet).
 patterns: build

@@ -525,6 +525,38 @@ TEST_F(DefaultCharacterGLTest, FrameOptionsAreValidated) {
     ASSERT_TRUE(ok) << ok.error().message;
 }
 
+TEST_F(DefaultCharacterGLTest, SkipsTheHeightPassWhenNoDriverChanged) {
+    Scene scene = loaded_->scene;
+    scene.render.size = {64, 64};
+    SceneFrameOptions opt;
+    opt.readHeightMaps = true;
+    auto a = makeSceneFrame(scene, model_, loaded_->images, nullptr, opt);
+    ASSERT_TRUE(a);
+    auto first = gl().renderFrame(a->request);
+    ASSERT_TRUE(first) << first.error().message;
+    const auto before = gl().stats();
+    // Only the camera moves: same maps, no height pass.
+    scene.render.camera.yaw = 90.0;
+    auto b = makeSceneFrame(scene, model_, loaded_->images, nullptr, opt);
+    ASSERT_TRUE(b);
+    auto second = gl().renderFrame(b->request);
+    ASSERT_TRUE(second);
+    auto after = gl().stats();
+    EXPECT_EQ(after.heightPasses, before.heightPasses);
+    EXPECT_EQ(after.heightPassesSkipped, before.heightPassesSkipped + 1);
+    EXPECT_EQ(second->maps->bump.data, first->maps->bump.data);
+    EXPECT_NE(second->image.rgba, first->image.rgba);
+    // The pose moves a driving joint: the pass runs again and the maps change.
+    opt.time = 0.4;
+    auto c = makeSceneFrame(scene, model_, loaded_->images, nullptr, opt);
+    ASSERT_TRUE(c);
+    auto third = gl().renderFrame(c->request);
+    ASSERT_TRUE(third);
+    after = gl().stats();
+    EXPECT_EQ(after.heightPasses, before.heightPasses + 1);
+    EXPECT_NE(third->maps->bump.data, first->maps->bump.data);
+}
+
 TEST_F(DefaultCharacterGLTest, ReadsBackTheMapsItUsed) {
     Scene scene = loaded_->scene;
     scene.render.size = {64, 64};

@@ -280,6 +280,12 @@ int runServe(ServeArgs a) {
     if (!service) return fail(service.error());
     for (const std::string& w : (*service)->warnings())
         std::cerr << "dermis-server: warning: skipped " << w << "\n";
+    // A fresh data folder starts with one scene: the default character and pattern set.
+    if ((*service)->listScenes()["scenes"].empty()) {
+        auto created = (*service)->createScene({{"default_patterns", true}});
+        if (!created) return fail(created.error());
+    }
+    const std::string firstScene = (*service)->listScenes()["scenes"][0]["id"].get<std::string>();
     ApiOptions opt;
     opt.bind = a.bind;
     opt.port = a.port;
@@ -292,7 +298,9 @@ int runServe(ServeArgs a) {
     std::cout << "dermis-server: serving http://" << a.bind << ":" << *port << "/ (editor), API http://"
               << a.bind << ":" << *port << "/api/v1 — " << info["backend"].get<std::string>() << ", "
               << info["gl"]["renderer"].get<std::string>() << "; data in " << a.data
-              << (a.token.empty() ? "" : "; bearer token required") << std::endl;
+              << (a.token.empty() ? "" : "; bearer token required") << "\n"
+              << "dermis-server: scene " << firstScene << ": http://" << a.bind << ":" << *port
+              << "/api/v1/scenes/" << firstScene << "/frame" << std::endl;
     std::thread waiter([&api, signals] {
         int sig = 0;
         sigwait(&signals, &sig);

@@ -118,6 +118,16 @@ struct GpuModel {
     }
 };
 
+/// What the height targets were last rendered from: when a frame asks for the same, the height
+/// pass is skipped (a camera move or a pose change that moves no driving joint).
+struct HeightKey {
+    int width = 0, height = 0;
+    GLuint base = 0;
+    std::vector<GLuint> textures;
+    std::vector<double> params; ///< per placement: centre, scale, rotation, h, t, model, target, response
+    bool operator==(const HeightKey&) const = default;
+};
+
 struct PatternTexture {
     GLuint tex = 0;
     const HeightImage* source = nullptr;
@@ -208,6 +218,8 @@ struct Renderer::Impl {
     std::map<const Model*, GpuModel> models;
     std::map<std::string, PatternTexture> patterns;
     GLuint baseTexture = 0;
+    std::optional<HeightKey> lastHeights; ///< what `heights` holds now, if from a height pass
+    std::size_t heightPasses = 0, heightPassesSkipped = 0;
     const HeightImage* baseSource = nullptr;
     int baseWidth = 0, baseHeight = 0;
 
@@ -467,6 +479,7 @@ Result<GLuint> Renderer::Impl::patternTexture(const std::string& key, const Heig
         return makeError(ErrorCode::InvalidArgument, kWhere, "/patterns/" + key,
                          "pattern is larger than the GL's maximum texture size " +
                              std::to_string(info.maxTextureSize));
+    lastHeights.reset(); // a texture name may be reused for other content
     PatternTexture pt;
     pt.tex = makeFloatTexture(image.width, image.height, image.data.data(), GL_NEAREST);
     pt.source = &image;
@@ -479,6 +492,7 @@ Result<GLuint> Renderer::Impl::patternTexture(const std::string& key, const Heig
 Status Renderer::Impl::ensureHeightTargets(int w, int h) {
     if (heights.fbo && heights.width == w && heights.height == h) return Ok{};
     heights.destroy();
+    lastHeights.reset();
     heights.width = w;
     heights.height = h;
     heights.maps = makeFloatTexture(w, h, nullptr, GL_LINEAR, 2);
@@ -532,6 +546,7 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
             return makeError(ErrorCode::InvalidArgument, kWhere, "/heightmap/base", "empty or oversized base map");
         if (base != baseSource || base->width != baseWidth || base->height != baseHeight) {
             glDeleteTextures(1, &baseTexture);
+            lastHeights.reset();
             baseTexture = makeFloatTexture(base->width, base->height, base->data.data(), GL_NEAREST);
             baseSource = base;
             baseWidth = base->width;
@@ -539,6 +554,26 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
         }
     }
     if (auto s = ensureHeightTargets(W, H); !s) return s;
+
+    HeightKey key;
+    key.width = W;
+    key.height = H;
+    key.base = base ? baseTexture : 0;
+    key.textures = textures;
+    for (std::size_t k = 0; k < in.placements.size(); ++k) {
+        if (!textures[k]) continue;
+        const BakePlacement& p = in.placements[k];
+        key.params.insert(key.params.end(),
+                          {p.footprint.center.x, p.footprint.center.y, p.footprint.scale.x,
+                           p.footprint.scale.y, p.footprint.rotationDeg, p.h, p.t,
+                           double(static_cast<int>(p.model)), double(static_cast<int>(p.target)),
+                           double(static_cast<int>(p.response))});
+    }
+    if (lastHeights && *lastHeights == key) {
+        ++heightPassesSkipped;
+        return Ok{};
+    }
+    lastHeights.reset();
 
     // One block per placement in one buffer, bound by range per draw.
     const std::size_t stride =
@@ -608,7 +643,10 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
         glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     }
     glDisable(GL_BLEND);
-    return checkGl("height pass");
+    if (auto st = checkGl("height pass"); !st) return st;
+    lastHeights = std::move(key);
+    ++heightPasses;
+    return Ok{};
 }
 
 Status Renderer::Impl::readHeightTargets(HeightMaps& maps) {
@@ -632,6 +670,7 @@ Status Renderer::Impl::uploadHeightMaps(const HeightMaps& maps) {
         return makeError(ErrorCode::InvalidArgument, kWhere, "cpuMaps",
                          "bump and displacement maps must be non-empty and of one size");
     if (auto s = ensureHeightTargets(W, H); !s) return s;
+    lastHeights.reset(); // the targets now hold CPU maps
     const std::size_t n = static_cast<std::size_t>(W) * H;
     heights.staging.resize(2 * n);
     const float* b = maps.bump.data.data();
@@ -1003,8 +1042,13 @@ void Renderer::forgetPatterns() {
         glDeleteTextures(1, &impl_->baseTexture);
         impl_->baseTexture = 0;
         impl_->baseSource = nullptr;
+        impl_->lastHeights.reset();
         return 0;
     });
+}
+
+Renderer::Stats Renderer::stats() {
+    return impl_->run([&] { return Stats{impl_->heightPasses, impl_->heightPassesSkipped}; });
 }
 
 Result<Renderer::BlockLayout> Renderer::blockLayout(const std::string& block) {

@@ -1,8 +1,9 @@
 // Dermis GL shell — the GPU renderer: the paper's two stages (§4, Fig. 4), headless.
 //
 //   stage 1: height maps by render-to-texture — one quad per placement over its footprint, the
-//            deformation model of SPEC §2 in the fragment shader, additive blending into two
-//            float targets (bump, displacement), plus the static base map;
+//            deformation model of SPEC §2 in the fragment shader, additive blending into the
+//            bump and displacement channels of one float target, plus the static base map;
+//            skipped when a frame's inputs equal those of the maps already rendered;
 //   stage 2: the character — linear blend skinning in the vertex shader, displacement along the
 //            skinned normal (per vertex, or per tessellated vertex), bump mapping, base colour,
 //            simple lighting, MSAA, sRGB output, an orbit camera framed on the posed bounds.
@@ -107,6 +108,13 @@ public:
     /// positions and unit normals without displacement — the GPU twin of dermis::skin.
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
                                                const std::vector<glm::mat4>& world);
+
+    /// Counters since creation: height passes run, and skipped because the targets already held
+    /// the same inputs (same placements, t values, patterns, base and size).
+    struct Stats {
+        std::size_t heightPasses = 0, heightPassesSkipped = 0;
+    };
+    Stats stats();
 
     /// Drops cached pattern textures (next use re-uploads) and models whose owner is gone.
     void forgetPatterns();
