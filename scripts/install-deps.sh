@@ -10,6 +10,7 @@ PKGS=(
   libpng-dev zlib1g-dev libturbojpeg0-dev
   python3-glad libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6
   libcpp-httplib-dev
+  chromium
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 missing=()
@@ -27,12 +28,14 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# npm packages of the tests (pinned by package-lock.json), installed once per lock change.
+# npm packages of the tests (pinned by package-lock.json), installed once per lock change:
+# the Khronos glTF validator and playwright-core (drives Debian's Chromium in the viewer test).
 here="$(cd "$(dirname "$0")/.." && pwd)"
-validator="$here/tests/gltf-validator"
-if [ -f "$validator/package-lock.json" ] &&
-   { [ ! -d "$validator/node_modules" ] ||
-     [ "$validator/package-lock.json" -nt "$validator/node_modules/.package-lock.json" ]; }; then
-  echo "install-deps: npm ci in tests/gltf-validator"
-  (cd "$validator" && npm ci --no-audit --no-fund --loglevel=error)
-fi
+for dir in "$here/tests/gltf-validator" "$here/tests/web"; do
+  if [ -f "$dir/package-lock.json" ] &&
+     { [ ! -d "$dir/node_modules" ] ||
+       [ "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]; }; then
+    echo "install-deps: npm ci in ${dir#$here/}"
+    (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+done
