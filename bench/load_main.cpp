@@ -82,6 +82,7 @@ int main(int argc, char** argv) {
     auto client = [&] {
         auto c = std::make_unique<httplib::Client>("127.0.0.1", *port);
         c->set_keep_alive(true);
+        c->set_tcp_nodelay(true); // else a PATCH (headers, then body) waits on the delayed ACK
         c->set_read_timeout(60, 0);
         return c;
     };
