@@ -83,10 +83,13 @@ Result<Store> Store::open(const std::string& dataDir) {
                              std::string("cannot create ") + sub + "/: " + ec.message());
     }
     // Leftover temp files of an interrupted write are garbage: the rename never happened.
+    std::vector<fs::path> leftovers;
     for (const char* sub : {"models", "patterns", "scenes"})
         for (const auto& e : fs::directory_iterator(fs::path(s.dir_) / sub, ec))
             if (e.path().filename().string().find(".tmp.") != std::string::npos)
-                fs::remove(e.path(), ec);
+                leftovers.push_back(e.path());
+    for (const fs::path& p : leftovers)
+        fs::remove_all(p, ec);
     return s;
 }
 
@@ -112,6 +115,48 @@ Status Store::putBlob(const std::string& kind, const std::string& id, const std:
     if (auto s = writeFileDurably(file, bytes); !s) return s;
     meta["id"] = id;
     meta["file"] = id + "." + ext;
+    const std::string text = meta.dump();
+    return writeFileDurably((folder / (id + ".json")).string(),
+                            std::vector<std::uint8_t>(text.begin(), text.end()));
+}
+
+bool Store::isSafeFileName(const std::string& name) {
+    if (name.empty() || name.size() > 128 || name == "." || name == ".." || name[0] == '.') return false;
+    for (char c : name)
+        if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' || c == ' '))
+            return false;
+    return true;
+}
+
+Status Store::putBlobFolder(const std::string& kind, const std::string& id,
+                            const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files,
+                            const std::string& mainFile, nlohmann::json meta) {
+    const char* where = "dermis::Store::putBlobFolder";
+    const fs::path folder = fs::path(dir_) / kind;
+    const fs::path tmp = folder / (id + ".d.tmp." + std::to_string(::getpid()));
+    const fs::path final = folder / (id + ".d");
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    fs::create_directories(tmp, ec);
+    if (ec) return makeError(ErrorCode::Io, where, tmp.string(), "cannot create: " + ec.message());
+    for (const auto& [name, bytes] : files) {
+        if (!isSafeFileName(name)) {
+            fs::remove_all(tmp, ec);
+            return makeError(ErrorCode::InvalidArgument, where, name, "not a plain file name");
+        }
+        if (auto s = writeFileDurably((tmp / name).string(), bytes); !s) {
+            fs::remove_all(tmp, ec);
+            return s;
+        }
+    }
+    fs::rename(tmp, final, ec);
+    if (ec) {
+        fs::remove_all(tmp, ec);
+        return makeError(ErrorCode::Io, where, final.string(), "rename failed: " + ec.message());
+    }
+    if (auto s = fsyncPath(folder.string(), O_RDONLY | O_DIRECTORY); !s) return s;
+    meta["id"] = id;
+    meta["file"] = id + ".d/" + mainFile;
     const std::string text = meta.dump();
     return writeFileDurably((folder / (id + ".json")).string(),
                             std::vector<std::uint8_t>(text.begin(), text.end()));
@@ -155,8 +200,11 @@ Status Store::removeBlob(const std::string& kind, const std::string& id) {
     // Metadata first: without it the blob is no longer listed, even if the data file stays.
     fs::remove(folder / (id + ".json"), ec);
     if (ec) return makeError(ErrorCode::Io, "dermis::Store::removeBlob", id, ec.message());
+    std::vector<fs::path> doomed;
     for (const auto& e : fs::directory_iterator(folder, ec))
-        if (e.path().stem() == id) fs::remove(e.path(), ec);
+        if (e.path().stem() == id) doomed.push_back(e.path());
+    for (const fs::path& path : doomed)
+        fs::remove_all(path, ec);
     return fsyncPath(folder.string(), O_RDONLY | O_DIRECTORY);
 }
 

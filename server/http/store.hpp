@@ -41,6 +41,14 @@ public:
     /// Writes <kind>/<id>.<ext> then <kind>/<id>.json (`meta` plus "id", "file").
     Status putBlob(const std::string& kind, const std::string& id, const std::string& ext,
                    const std::vector<std::uint8_t>& bytes, nlohmann::json meta);
+    /// Writes a multi-file blob: every file into <kind>/<id>.d/ (a temp folder renamed into place,
+    /// each file fsync'd), then <kind>/<id>.json with "file" = "<id>.d/<mainFile>". Names must be
+    /// plain file names (checked: no '/', no "..", [A-Za-z0-9._ -] only).
+    Status putBlobFolder(const std::string& kind, const std::string& id,
+                         const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files,
+                         const std::string& mainFile, nlohmann::json meta);
+    /// A plain file name a client may give a file: [A-Za-z0-9._ -], not "." or "..", ≤ 128 chars.
+    static bool isSafeFileName(const std::string& name);
     /// Every blob of `kind` with a readable metadata record (others are reported in `skipped`).
     std::vector<Blob> listBlobs(const std::string& kind, std::vector<std::string>& skipped) const;
     Status removeBlob(const std::string& kind, const std::string& id);
