@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <regex>
 
 namespace dermis {
 
@@ -69,10 +70,42 @@ bool hasContentType(const httplib::Request& req, std::initializer_list<const cha
     return false;
 }
 
+/// Deepest nesting of arrays and objects any request body may have (the deepest valid body, a
+/// batch frame's pose joint, nests 7). nlohmann::json copies values recursively, so a body nested
+/// a hundred thousand levels deep overflowed a handler thread's stack (a crash) once parsed.
+constexpr int kMaxJsonDepth = 64;
+
+/// True when the JSON text opens more than `limit` arrays/objects at once (strings skipped). Does
+/// not validate: malformed text is left to the parser.
+bool nestedDeeperThan(const std::string& text, int limit) {
+    int depth = 0;
+    bool inString = false, escaped = false;
+    for (const char c : text) {
+        if (inString) {
+            if (escaped) escaped = false;
+            else if (c == '\\') escaped = true;
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > limit) return true;
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return false;
+}
+
 /// Parses a JSON body; false (and the answer sent) when the type or syntax is wrong.
 bool jsonBody(const httplib::Request& req, httplib::Response& res, json& out) {
     if (!hasContentType(req, {"application/json"})) {
         sendError(res, 415, "unsupported", "dermis-server: body: expected Content-Type application/json", "body");
+        return false;
+    }
+    if (nestedDeeperThan(req.body, kMaxJsonDepth)) {
+        sendError(res, 400, "parse_error",
+                  "dermis-server: body: JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels",
+                  "body");
         return false;
     }
     out = json::parse(req.body, nullptr, false);
@@ -164,11 +197,49 @@ const std::vector<Route>& Api::routes() {
     return r;
 }
 
+namespace {
+
+/// The methods served for `path` (a request path under /api/v1), comma-separated; "" when the path
+/// is no route at all. Path parameters match what the routes accept.
+std::string allowedMethods(const std::string& path) {
+    if (path.rfind(kPrefix, 0) != 0) return "";
+    const std::string rest = path.substr(kPrefix.size());
+    static const std::vector<std::pair<std::regex, std::string>> templates = [] {
+        std::vector<std::pair<std::regex, std::string>> out;
+        for (const Route& r : Api::routes()) {
+            std::string re;
+            for (std::size_t i = 0; i < r.path.size(); ++i) {
+                if (r.path[i] == '{') { // a path parameter
+                    re += "[A-Za-z0-9_:.-]+";
+                    i = r.path.find('}', i);
+                } else {
+                    if (r.path[i] == '.') re += '\\';
+                    re += r.path[i];
+                }
+            }
+            out.emplace_back(std::regex(re), r.method);
+        }
+        return out;
+    }();
+    std::string allow;
+    for (const auto& [re, method] : templates)
+        if (std::regex_match(rest, re) && allow.find(method) == std::string::npos)
+            allow += (allow.empty() ? "" : ", ") + method;
+    return allow;
+}
+
+} // namespace
+
 struct Api::Impl {
     Service& svc;
     ApiOptions opt;
     httplib::Server server;
     std::atomic<bool> stopping{false};
+    /// Open event streams. Each holds an HTTP worker thread for as long as it is open, so at most
+    /// half the workers may stream; more are refused with 503 (otherwise a few dozen open editor
+    /// tabs, or one client, would leave no thread to answer anything else: a hang).
+    std::atomic<int> streams{0};
+    int maxStreams() const { return std::max(1, opt.threads / 2); }
 
     Impl(Service& s, ApiOptions o) : svc(s), opt(std::move(o)) {}
     void install();
@@ -199,8 +270,20 @@ void Api::Impl::install() {
         return httplib::Server::HandlerResponse::Unhandled;
     });
     // Statuses httplib produces itself (404 no route, 413 payload, 400 bad request) get JSON too.
+    // A known path asked with a method it does not serve is 405 with Allow, not "no such route".
     s.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
         if (!res.body.empty()) return;
+        if (res.status == 404) {
+            const std::string allow = allowedMethods(req.path);
+            if (!allow.empty()) {
+                res.set_header("Allow", allow);
+                sendError(res, 405, "method_not_allowed",
+                          "dermis-server: " + req.method + " " + req.path + ": method not allowed (allowed: " +
+                              allow + ")",
+                          "");
+                return;
+            }
+        }
         const std::string code = res.status == 404   ? "not_found"
                                  : res.status == 413 ? "too_large"
                                  : res.status == 405 ? "method_not_allowed"
@@ -240,7 +323,11 @@ void Api::Impl::install() {
             return sendError(res, 415, "unsupported",
                              "dermis-server: body: expected Content-Type model/gltf-binary", "body");
         auto r = svc.addModel(bytesOf(req.body), req.get_param_value("name"));
-        if (!r) return sendError(res, r.error());
+        if (!r) {
+            Error e = r.error();
+            if (e.field.empty() && e.code == ErrorCode::Parse) e.field = "body"; // undecodable bytes
+            return sendError(res, e);
+        }
         sendJson(res, 201, *r);
     });
     s.Get(P + "/models/" + ID, [this](const httplib::Request& req, httplib::Response& res) {
@@ -383,8 +470,18 @@ void Api::Impl::install() {
     });
     s.Get(P + "/scenes/" + ID + "/events", [this](const httplib::Request& req, httplib::Response& res) {
         const std::string id = req.matches[1];
+        if (streams.fetch_add(1) >= maxStreams()) {
+            streams.fetch_sub(1);
+            return sendError(res, 503, "unavailable",
+                             "dermis-server: " + std::to_string(maxStreams()) +
+                                 " event streams are open, the most this server keeps; retry later",
+                             "");
+        }
         auto sub = svc.subscribe(id);
-        if (!sub) return sendError(res, sub.error());
+        if (!sub) {
+            streams.fetch_sub(1);
+            return sendError(res, sub.error());
+        }
         res.set_header("Cache-Control", "no-cache");
         auto subscription = *sub;
         res.set_chunked_content_provider(
@@ -402,7 +499,10 @@ void Api::Impl::install() {
                 }
                 return sink.write(e->data(), e->size());
             },
-            [this, id, subscription](bool) { svc.unsubscribe(id, subscription); });
+            [this, id, subscription](bool) { // runs once, when the response is destroyed
+                svc.unsubscribe(id, subscription);
+                streams.fetch_sub(1);
+            });
     });
 
     // --- stateless batch: frames streamed as multipart/mixed parts as they finish
@@ -445,7 +545,6 @@ void Api::Impl::install() {
             });
     });
 
-    // Anything else under the API prefix with a known path but another method: 405.
     if (!opt.webDir.empty() && std::filesystem::is_directory(opt.webDir)) s.set_mount_point("/", opt.webDir);
 }
 

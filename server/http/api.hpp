@@ -2,7 +2,8 @@
 //
 // One error policy: every failure answers {"error": {"code", "message", "field"}} with the status
 // of its ErrorCode (mapped in one place, api.cpp statusOf): 400 malformed JSON or undecodable
-// bytes, 401 missing/wrong token, 404 unknown ids, 409 conflicts, 413 over a limit, 415 wrong
+// bytes or JSON nested deeper than 64 levels, 401 missing/wrong token, 404 unknown ids or
+// routes, 405 known path with another method, 409 conflicts, 413 over a limit, 415 wrong
 // content type or file type, 422 invalid values, 503 full render queue (with Retry-After).
 // HTTP threads never touch GL: renders go through the Service to the renderer's thread.
 // TCP_NODELAY is on (keep-alive requests otherwise stall ~26 ms on the delayed ACK).
