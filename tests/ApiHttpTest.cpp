@@ -590,6 +590,76 @@ TEST_F(ApiHttpTest, CesiumManUploadsInspectsAndDeletes) {
     expectError(h.del("/models/" + id), 404, "id");
 }
 
+/// A one-triangle .gltf whose buffer is the external file `binName`.
+std::pair<std::string, std::string> triangleGltf(const std::string& binName) {
+    std::string bin(44, '\0');
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const std::uint16_t idx[3] = {0, 1, 2};
+    std::memcpy(bin.data(), pos, sizeof pos);
+    std::memcpy(bin.data() + 36, idx, sizeof idx);
+    const json gltf = {
+        {"asset", {{"version", "2.0"}}},
+        {"scene", 0},
+        {"scenes", {{{"nodes", {0}}}}},
+        {"nodes", {{{"mesh", 0}, {"name", "tri"}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
+        {"buffers", {{{"uri", binName}, {"byteLength", 44}}}},
+        {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 36}},
+                         {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 6}}}},
+        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
+                        {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
+                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}}}}};
+    return {gltf.dump(), bin};
+}
+
+TEST_F(ApiHttpTest, GltfWithExternalFilesUploadsAsMultipart) {
+    auto post = [&](const httplib::MultipartFormDataItems& items) {
+        httplib::Client cli("127.0.0.1", server_->port());
+        auto r = cli.Post((std::string(kApi) + "/models?name=tri").c_str(), items);
+        Reply out;
+        if (r) {
+            out.status = r->status;
+            out.body = r->body;
+        }
+        return out;
+    };
+    const auto [gltf, bin] = triangleGltf("tri.bin");
+    Reply ok = post({{"gltf", gltf, "tri.gltf", "model/gltf+json"},
+                     {"buffer", bin, "tri.bin", "application/octet-stream"}});
+    ASSERT_EQ(ok.status, 201) << ok;
+    const std::string id = ok.js()["id"];
+    EXPECT_EQ(ok.js()["triangles"], 1);
+    Reply got = http().get("/models/" + id);
+    ASSERT_EQ(got.status, 200) << got;
+    EXPECT_EQ(got.js()["vertices"], 3);
+    // A scene on it renders.
+    const std::string sid = createScene({{"format", "dermis.scene/1"}, {"model", id},
+                                         {"render", {{"size", {64, 64}}}}});
+    Reply frame = http().get("/scenes/" + sid + "/frame");
+    EXPECT_EQ(frame.status, 200) << frame;
+    EXPECT_EQ(http().del("/scenes/" + sid).status, 204);
+    EXPECT_EQ(http().del("/models/" + id).status, 204);
+
+    // The buffer is missing; the .gltf points outside its folder; a part name with a folder;
+    // no .gltf part at all: 4xx JSON errors, nothing stored.
+    const auto [escaping, bin2] = triangleGltf("../tri.bin");
+    const std::vector<std::pair<std::string, httplib::MultipartFormDataItems>> bad = {
+        {"missing buffer", {{"gltf", gltf, "tri.gltf", ""}}},
+        {"escaping uri", {{"gltf", escaping, "tri.gltf", ""}, {"buffer", bin2, "tri.bin", ""}}},
+        {"folder in a part name", {{"gltf", gltf, "tri.gltf", ""}, {"buffer", bin, "../tri.bin", ""}}},
+        {"no gltf part", {{"buffer", bin, "tri.bin", ""}}},
+        {"not json", {{"gltf", "not json", "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}}},
+    };
+    const std::size_t models = http().get("/models").js()["models"].size();
+    for (const auto& [name, items] : bad) {
+        Reply r = post(items);
+        EXPECT_GE(r.status, 400) << name << ": " << r;
+        EXPECT_LT(r.status, 500) << name << ": " << r;
+        EXPECT_TRUE(r.js().contains("error")) << name << ": " << r;
+    }
+    EXPECT_EQ(http().get("/models").js()["models"].size(), models);
+}
+
 TEST_F(ApiHttpTest, BarbarianAndRiggedFigureUpload) {
     Http h = http();
     Reply barb = h.upload("/models", readBytes(kBarbarian), "model/gltf-binary");

@@ -12,6 +12,7 @@
 #include <fcntl.h>
 #include <chrono>
 #include <csignal>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <random>
@@ -99,6 +100,30 @@ httplib::Client client(int port) {
     return c;
 }
 
+/// Uploads a one-triangle .gltf with an external buffer (multipart); the model id.
+std::string uploadTriangleGltf(httplib::Client& c) {
+    std::string bin(44, '\0');
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const std::uint16_t idx[3] = {0, 1, 2};
+    std::memcpy(bin.data(), pos, sizeof pos);
+    std::memcpy(bin.data() + 36, idx, sizeof idx);
+    const json gltf = {
+        {"asset", {{"version", "2.0"}}},
+        {"nodes", {{{"mesh", 0}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
+        {"buffers", {{{"uri", "tri.bin"}, {"byteLength", 44}}}},
+        {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}, {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 6}}}},
+        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
+                        {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
+                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}}}}};
+    auto r = c.Post("/api/v1/models", httplib::MultipartFormDataItems{{"gltf", gltf.dump(), "tri.gltf", ""},
+                                                                       {"buffer", bin, "tri.bin", ""}});
+    EXPECT_TRUE(r);
+    if (!r) return "";
+    EXPECT_EQ(r->status, 201) << r->body;
+    return json::parse(r->body, nullptr, false).value("id", "");
+}
+
 json createScene(httplib::Client& c) {
     auto r = c.Post("/api/v1/scenes",
                     R"({"default_patterns": true, "heightmap": {"size": [256, 256]},
@@ -120,10 +145,13 @@ TEST(ServerProcessHttpTest, AcknowledgedEditsSurviveKillDashNine) {
     };
     std::vector<Ack> acks;
     std::vector<std::string> scenes;
+    std::string gltfModel;
     {
         ServerProcess server(data, dir / "log1.txt");
         ASSERT_GT(server.port(), 0) << server.log();
         httplib::Client c = client(server.port());
+        gltfModel = uploadTriangleGltf(c);
+        ASSERT_FALSE(gltfModel.empty());
         for (int s = 0; s < 3; ++s) {
             json created = createScene(c);
             ASSERT_TRUE(created.contains("id"));
@@ -170,6 +198,10 @@ TEST(ServerProcessHttpTest, AcknowledgedEditsSurviveKillDashNine) {
         if (doc["revision"].get<std::uint64_t>() == last->revision)
             EXPECT_DOUBLE_EQ(doc["scene"]["pose"]["time"].get<double>(), last->time) << sid;
     }
+    // The multi-file .gltf upload is back too.
+    auto m = c.Get("/api/v1/models/" + gltfModel);
+    ASSERT_TRUE(m);
+    EXPECT_EQ(m->status, 200) << m->body;
     // And the restarted server renders them.
     auto f = c.Get("/api/v1/scenes/" + scenes[0] + "/frame?width=64&height=64");
     ASSERT_TRUE(f);

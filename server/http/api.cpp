@@ -319,9 +319,25 @@ void Api::Impl::install() {
     // --- models
     s.Get(P + "/models", [this](const httplib::Request&, httplib::Response& res) { sendJson(res, 200, svc.listModels()); });
     s.Post(P + "/models", [this](const httplib::Request& req, httplib::Response& res) {
+        if (req.is_multipart_form_data()) {
+            // A .gltf and its external files: part "gltf" (or the part whose file name ends in
+            // .gltf) and one part per buffer/image, named by its file name (the URI in the .gltf).
+            std::vector<UploadFile> files;
+            std::string gltfName;
+            for (const auto& [field, part] : req.files) {
+                const std::string name = part.filename.empty() ? field : part.filename;
+                files.push_back({name, bytesOf(part.content)});
+                const bool isGltf = name.size() > 5 && name.compare(name.size() - 5, 5, ".gltf") == 0;
+                if (field == "gltf" || (gltfName.empty() && isGltf)) gltfName = name;
+            }
+            auto r = svc.addModelFiles(files, gltfName, req.get_param_value("name"));
+            if (!r) return sendError(res, r.error());
+            return sendJson(res, 201, *r);
+        }
         if (!hasContentType(req, {"model/gltf-binary", "application/octet-stream"}))
             return sendError(res, 415, "unsupported",
-                             "dermis-server: body: expected Content-Type model/gltf-binary", "body");
+                             "dermis-server: body: expected Content-Type model/gltf-binary, or "
+                             "multipart/form-data with a .gltf and its files", "body");
         auto r = svc.addModel(bytesOf(req.body), req.get_param_value("name"));
         if (!r) {
             Error e = r.error();

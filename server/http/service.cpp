@@ -324,6 +324,17 @@ Result<std::unique_ptr<Service>> Service::open(const std::string& dataDir, GlBac
 
     // Stored uploads and scenes.
     for (const Store::Blob& b : st.store->listBlobs("models", svc->warnings_)) {
+        if (b.file.size() > 5 && b.file.compare(b.file.size() - 5, 5, ".gltf") == 0) {
+            auto model = loadGltfFile(b.file); // a multi-file upload: resources beside it only
+            if (!model) {
+                svc->warnings_.push_back(b.file + ": " + model.error().message);
+                continue;
+            }
+            st.models[b.id] = ModelEntry{b.id, b.meta.value("name", ""),
+                                         std::make_shared<const Model>(std::move(*model)),
+                                         b.meta.value("bytes", std::size_t{0}), false};
+            continue;
+        }
         auto bytes = Store::readFile(b.file);
         if (!bytes) {
             svc->warnings_.push_back(b.file + ": unreadable");
@@ -436,6 +447,68 @@ Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::
     std::unique_lock<std::shared_mutex> lock(state_->mutex);
     if (auto s = state_->store->putBlob("models", e.id, "glb", glb,
                                         {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
+        !s)
+        return s.error();
+    json summary = modelSummary(e);
+    state_->models[e.id] = std::move(e);
+    return summary;
+}
+
+Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const std::string& gltfName,
+                                    const std::string& name) {
+    const char* where = "dermis::Service::addModelFiles";
+    std::size_t total = 0;
+    std::set<std::string> names;
+    for (const UploadFile& f : files) {
+        total += f.bytes.size();
+        if (!Store::isSafeFileName(f.name))
+            return makeError(ErrorCode::InvalidArgument, where, "files/" + f.name,
+                             "a file name must be plain ([A-Za-z0-9._ -], no folders)");
+        if (!names.insert(f.name).second)
+            return makeError(ErrorCode::InvalidArgument, where, "files/" + f.name, "given twice");
+    }
+    if (total > limits_.maxUploadBytes)
+        return makeError(ErrorCode::TooLarge, where, "body",
+                         "larger than " + std::to_string(limits_.maxUploadBytes) + " bytes");
+    if (gltfName.empty() || !names.count(gltfName))
+        return makeError(ErrorCode::InvalidArgument, where, "gltf",
+                         "no .gltf part (name the part \"gltf\" or give it a .gltf file name)");
+    // Parse from a private scratch folder: the loader reads external URIs only inside it.
+    const fs::path scratch = fs::path(state_->store->dir()) / ("upload.tmp." + Store::newId("u"));
+    std::error_code ec;
+    fs::create_directories(scratch, ec);
+    if (ec) return makeError(ErrorCode::Io, where, "", "cannot create a scratch folder: " + ec.message());
+    struct Cleanup {
+        fs::path p;
+        ~Cleanup() {
+            std::error_code e;
+            fs::remove_all(p, e);
+        }
+    } cleanup{scratch};
+    for (const UploadFile& f : files)
+        if (auto s = Store::writeFileDurably((scratch / f.name).string(), f.bytes); !s) return s.error();
+    auto model = loadGltfFile((scratch / gltfName).string());
+    if (!model) return model.error();
+    if (model->parts.empty()) return makeError(ErrorCode::InvalidArgument, where, "/meshes", "no triangle meshes");
+    if (model->triangleCount() > limits_.maxTriangles)
+        return makeError(ErrorCode::TooLarge, where, "/meshes",
+                         std::to_string(model->triangleCount()) + " triangles, the limit is " +
+                             std::to_string(limits_.maxTriangles));
+    if (model->joints.size() > limits_.maxJoints)
+        return makeError(ErrorCode::TooLarge, where, "/skins",
+                         std::to_string(model->joints.size()) + " joints, the limit is " +
+                             std::to_string(limits_.maxJoints));
+    ModelEntry e;
+    e.id = Store::newId("m");
+    e.name = sanitizeName(name.empty() ? gltfName : name);
+    e.bytes = total;
+    e.model = std::make_shared<const Model>(std::move(*model));
+    std::vector<std::pair<std::string, std::vector<std::uint8_t>>> stored;
+    for (const UploadFile& f : files)
+        stored.emplace_back(f.name, f.bytes);
+    std::unique_lock<std::shared_mutex> lock(state_->mutex);
+    if (auto s = state_->store->putBlobFolder("models", e.id, stored, gltfName,
+                                              {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
         !s)
         return s.error();
     json summary = modelSummary(e);

@@ -57,6 +57,12 @@ struct EncodedImage {
     std::string backend; ///< which GL backend rendered it ("" for CPU-only answers)
 };
 
+/// One file of a multi-file upload.
+struct UploadFile {
+    std::string name; ///< plain file name, as the .gltf's URIs name it
+    std::vector<std::uint8_t> bytes;
+};
+
 /// Query parameters of a frame.
 struct FrameParams {
     std::string format = "png"; ///< png | jpeg
@@ -95,6 +101,10 @@ public:
     // --- models
     nlohmann::json listModels() const;
     Result<nlohmann::json> addModel(const std::vector<std::uint8_t>& glb, const std::string& name);
+    /// A .gltf (`gltfName`, one of `files`) with its external buffers and images as the other
+    /// files. File names must be plain ([A-Za-z0-9._ -]); the loader reads only these files.
+    Result<nlohmann::json> addModelFiles(const std::vector<UploadFile>& files,
+                                         const std::string& gltfName, const std::string& name);
     Result<nlohmann::json> getModel(const std::string& id) const;
     Status deleteModel(const std::string& id);
     /// The UV wireframe: {"width","height"? no: "edges": [u0,v0,u1,v1, …]} (json) or a PNG.

@@ -88,6 +88,10 @@ Result<Store> Store::open(const std::string& dataDir) {
         for (const auto& e : fs::directory_iterator(fs::path(s.dir_) / sub, ec))
             if (e.path().filename().string().find(".tmp.") != std::string::npos)
                 leftovers.push_back(e.path());
+    for (const auto& e : fs::directory_iterator(fs::path(s.dir_), ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind("upload.tmp.", 0) == 0 || name.rfind("tmp_", 0) == 0) leftovers.push_back(e.path());
+    }
     for (const fs::path& p : leftovers)
         fs::remove_all(p, ec);
     return s;
