@@ -38,7 +38,7 @@ double ms(Clock::time_point a, Clock::time_point b) {
 json percentiles(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     auto at = [&](double q) {
-        const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * v.size())) - 1);
+        const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1);
         return std::round(v[i] * 100) / 100;
     };
     return {{"p50_ms", at(0.5)}, {"p99_ms", at(0.99)}, {"requests", v.size()}};

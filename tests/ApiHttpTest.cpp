@@ -590,28 +590,6 @@ TEST_F(ApiHttpTest, CesiumManUploadsInspectsAndDeletes) {
     expectError(h.del("/models/" + id), 404, "id");
 }
 
-/// A one-triangle .gltf whose buffer is the external file `binName`.
-std::pair<std::string, std::string> triangleGltf(const std::string& binName) {
-    std::string bin(44, '\0');
-    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-    const std::uint16_t idx[3] = {0, 1, 2};
-    std::memcpy(bin.data(), pos, sizeof pos);
-    std::memcpy(bin.data() + 36, idx, sizeof idx);
-    const json gltf = {
-        {"asset", {{"version", "2.0"}}},
-        {"scene", 0},
-        {"scenes", {{{"nodes", {0}}}}},
-        {"nodes", {{{"mesh", 0}, {"name", "tri"}}}},
-        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
-        {"buffers", {{{"uri", binName}, {"byteLength", 44}}}},
-        {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 36}},
-                         {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 6}}}},
-        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
-                        {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
-                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}}}}};
-    return {gltf.dump(), bin};
-}
-
 TEST_F(ApiHttpTest, GltfWithExternalFilesUploadsAsMultipart) {
     auto post = [&](const httplib::MultipartFormDataItems& items) {
         httplib::Client cli("127.0.0.1", server_->port());

@@ -23,22 +23,6 @@ const std::string kRigged =
     std::string(DERMIS_SHARED_DIR) + "/models/RiggedFigure/RiggedFigure.glb";
 const char* kJoint = "Skeleton_torso_joint_2";
 
-struct CliRun {
-    int code = -1;
-    std::string err, out;
-};
-
-CliRun runServer(const TempDir& dir, const std::string& args) {
-    const std::string cmd = std::string(DERMIS_SERVER_EXE) + " " + args + " >" + (dir / "out.txt") +
-                            " 2>" + (dir / "err.txt");
-    const int status = std::system(cmd.c_str());
-    CliRun r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    auto out = readBytes(dir / "out.txt"), err = readBytes(dir / "err.txt");
-    r.out.assign(out.begin(), out.end());
-    r.err.assign(err.begin(), err.end());
-    return r;
-}
 
 /// A 32×32 dome pattern: positive inside a disc, 0 at the border.
 void writeDome(const std::string& path) {

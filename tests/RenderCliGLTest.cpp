@@ -28,22 +28,6 @@ std::string backend() {
     return env && *env ? env : "auto";
 }
 
-struct CliRun {
-    int code = -1;
-    std::string out, err;
-};
-
-CliRun runServer(const TempDir& dir, const std::string& args) {
-    const std::string cmd = std::string(DERMIS_SERVER_EXE) + " " + args + " >" + (dir / "out.txt") +
-                            " 2>" + (dir / "err.txt");
-    const int status = std::system(cmd.c_str());
-    CliRun r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    auto out = readBytes(dir / "out.txt"), err = readBytes(dir / "err.txt");
-    r.out.assign(out.begin(), out.end());
-    r.err.assign(err.begin(), err.end());
-    return r;
-}
 
 std::string gl() { return " --gl " + backend(); }
 

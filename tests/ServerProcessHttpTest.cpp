@@ -102,21 +102,8 @@ httplib::Client client(int port) {
 
 /// Uploads a one-triangle .gltf with an external buffer (multipart); the model id.
 std::string uploadTriangleGltf(httplib::Client& c) {
-    std::string bin(44, '\0');
-    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-    const std::uint16_t idx[3] = {0, 1, 2};
-    std::memcpy(bin.data(), pos, sizeof pos);
-    std::memcpy(bin.data() + 36, idx, sizeof idx);
-    const json gltf = {
-        {"asset", {{"version", "2.0"}}},
-        {"nodes", {{{"mesh", 0}}}},
-        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
-        {"buffers", {{{"uri", "tri.bin"}, {"byteLength", 44}}}},
-        {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}, {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 6}}}},
-        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
-                        {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
-                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}}}}};
-    auto r = c.Post("/api/v1/models", httplib::MultipartFormDataItems{{"gltf", gltf.dump(), "tri.gltf", ""},
+    const auto [gltf, bin] = triangleGltf("tri.bin");
+    auto r = c.Post("/api/v1/models", httplib::MultipartFormDataItems{{"gltf", gltf, "tri.gltf", ""},
                                                                        {"buffer", bin, "tri.bin", ""}});
     EXPECT_TRUE(r);
     if (!r) return "";

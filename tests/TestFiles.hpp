@@ -1,16 +1,23 @@
 // Helpers shared by tests that touch files: a temporary folder, whole-file reads and writes,
-// and image writers that produce exact pixel values through OpenImageIO.
+// image writers that produce exact pixel values through OpenImageIO, the command-line runner and
+// a tiny multi-file glTF.
 #pragma once
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
 
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dermis::test {
@@ -60,6 +67,48 @@ void writeImage(const std::string& path, int w, int h, int channels, const std::
     ASSERT_TRUE(out->open(path, spec)) << out->geterror();
     ASSERT_TRUE(out->write_image(type, pixels.data())) << out->geterror();
     ASSERT_TRUE(out->close());
+}
+
+/// What a run of the dermis-server command line printed and returned.
+struct CliRun {
+    int code = -1;
+    std::string err, out;
+};
+
+/// Runs `DERMIS_SERVER_EXE <args>` (a test target defines it), capturing stdout and stderr in `dir`.
+inline CliRun runServer(const TempDir& dir, const std::string& args) {
+    const std::string cmd = std::string(DERMIS_SERVER_EXE) + " " + args + " >" + (dir / "out.txt") +
+                            " 2>" + (dir / "err.txt");
+    const int status = std::system(cmd.c_str());
+    CliRun r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    auto out = readBytes(dir / "out.txt"), err = readBytes(dir / "err.txt");
+    r.out.assign(out.begin(), out.end());
+    r.err.assign(err.begin(), err.end());
+    return r;
+}
+
+/// A one-triangle glTF 2.0 document whose only buffer is the external file `binName`, and that
+/// buffer's bytes (3 float positions, 3 uint16 indices).
+inline std::pair<std::string, std::string> triangleGltf(const std::string& binName) {
+    std::string bin(44, '\0');
+    const float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const std::uint16_t idx[3] = {0, 1, 2};
+    std::memcpy(bin.data(), pos, sizeof pos);
+    std::memcpy(bin.data() + 36, idx, sizeof idx);
+    const nlohmann::json gltf = {
+        {"asset", {{"version", "2.0"}}},
+        {"scene", 0},
+        {"scenes", {{{"nodes", {0}}}}},
+        {"nodes", {{{"mesh", 0}, {"name", "tri"}}}},
+        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}}}}}},
+        {"buffers", {{{"uri", binName}, {"byteLength", 44}}}},
+        {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 36}},
+                         {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 6}}}},
+        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"},
+                        {"min", {0, 0, 0}}, {"max", {1, 1, 0}}},
+                       {{"bufferView", 1}, {"componentType", 5123}, {"count", 3}, {"type", "SCALAR"}}}}};
+    return {gltf.dump(), bin};
 }
 
 } // namespace dermis::test

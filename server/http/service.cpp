@@ -157,6 +157,8 @@ struct Service::State {
     const HeightImage* baseOf(const Scene& scene) const;
     void publish(const std::string& sceneId, const json& event);
     Result<json> commit(const std::string& id, const json& newDoc, const char* what, bool create);
+    /// Locks, copies scene `id`'s document, lets `change` modify the copy, then commits it.
+    Result<json> edit(const std::string& id, const char* what, const std::function<Status(json&)>& change);
     Result<EncodedImage> render(const Scene& scene, const std::shared_ptr<const Model>& model,
                                 const FrameParams& p);
 };
@@ -261,6 +263,16 @@ Result<json> Service::State::commit(const std::string& id, const json& newDoc, c
     e.revision = revision;
     publish(id, {{"type", what}, {"scene", id}, {"revision", revision}});
     return json{{"id", id}, {"revision", revision}, {"scene", e.doc}};
+}
+
+Result<json> Service::State::edit(const std::string& id, const char* what,
+                                  const std::function<Status(json&)>& change) {
+    std::unique_lock<std::shared_mutex> lock(mutex);
+    auto it = scenes.find(id);
+    if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
+    json doc = it->second.doc;
+    if (auto s = change(doc); !s) return s.error();
+    return commit(id, doc, what, false);
 }
 
 Result<EncodedImage> Service::State::render(const Scene& sceneIn,
@@ -397,6 +409,25 @@ json Service::info() const {
 
 namespace {
 
+Error bodyTooLarge(const ServerLimits& limits, const char* where) {
+    return makeError(ErrorCode::TooLarge, where, "body",
+                     "larger than " + std::to_string(limits.maxUploadBytes) + " bytes");
+}
+
+/// An uploaded model must have triangles and stay within the triangle and joint limits.
+Status checkModel(const Model& m, const ServerLimits& limits, const char* where) {
+    if (m.parts.empty()) return makeError(ErrorCode::InvalidArgument, where, "/meshes", "no triangle meshes");
+    if (m.triangleCount() > limits.maxTriangles)
+        return makeError(ErrorCode::TooLarge, where, "/meshes",
+                         std::to_string(m.triangleCount()) + " triangles, the limit is " +
+                             std::to_string(limits.maxTriangles));
+    if (m.joints.size() > limits.maxJoints)
+        return makeError(ErrorCode::TooLarge, where, "/skins",
+                         std::to_string(m.joints.size()) + " joints, the limit is " +
+                             std::to_string(limits.maxJoints));
+    return Ok{};
+}
+
 json modelSummary(const ModelEntry& e) {
     return {{"id", e.id},
             {"name", e.name},
@@ -420,25 +451,15 @@ json Service::listModels() const {
 
 Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::string& name) {
     const char* where = "dermis::Service::addModel";
-    if (glb.size() > limits_.maxUploadBytes)
-        return makeError(ErrorCode::TooLarge, where, "body",
-                         "larger than " + std::to_string(limits_.maxUploadBytes) + " bytes");
+    if (glb.size() > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
     if (glb.size() < 12 || std::memcmp(glb.data(), "glTF", 4) != 0)
         return makeError(ErrorCode::Unsupported, where, "body",
-                         "not a binary glTF (.glb); a .gltf with external files is not accepted");
+                         "not a binary glTF (.glb); send a .gltf with its files as multipart/form-data");
     auto parsed = parseGltf(glb, ""); // no base folder: no file of this machine is read
     if (!parsed) return parsed.error();
     if (auto s = loadGltfResources(*parsed); !s) return s.error();
     Model& m = parsed->model;
-    if (m.parts.empty()) return makeError(ErrorCode::InvalidArgument, where, "/meshes", "no triangle meshes");
-    if (m.triangleCount() > limits_.maxTriangles)
-        return makeError(ErrorCode::TooLarge, where, "/meshes",
-                         std::to_string(m.triangleCount()) + " triangles, the limit is " +
-                             std::to_string(limits_.maxTriangles));
-    if (m.joints.size() > limits_.maxJoints)
-        return makeError(ErrorCode::TooLarge, where, "/skins",
-                         std::to_string(m.joints.size()) + " joints, the limit is " +
-                             std::to_string(limits_.maxJoints));
+    if (auto st = checkModel(m, limits_, where); !st) return st.error();
     ModelEntry e;
     e.id = Store::newId("m");
     e.name = sanitizeName(name);
@@ -467,9 +488,7 @@ Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const 
         if (!names.insert(f.name).second)
             return makeError(ErrorCode::InvalidArgument, where, "files/" + f.name, "given twice");
     }
-    if (total > limits_.maxUploadBytes)
-        return makeError(ErrorCode::TooLarge, where, "body",
-                         "larger than " + std::to_string(limits_.maxUploadBytes) + " bytes");
+    if (total > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
     if (gltfName.empty() || !names.count(gltfName))
         return makeError(ErrorCode::InvalidArgument, where, "gltf",
                          "no .gltf part (name the part \"gltf\" or give it a .gltf file name)");
@@ -489,15 +508,7 @@ Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const 
         if (auto s = Store::writeFileDurably((scratch / f.name).string(), f.bytes); !s) return s.error();
     auto model = loadGltfFile((scratch / gltfName).string());
     if (!model) return model.error();
-    if (model->parts.empty()) return makeError(ErrorCode::InvalidArgument, where, "/meshes", "no triangle meshes");
-    if (model->triangleCount() > limits_.maxTriangles)
-        return makeError(ErrorCode::TooLarge, where, "/meshes",
-                         std::to_string(model->triangleCount()) + " triangles, the limit is " +
-                             std::to_string(limits_.maxTriangles));
-    if (model->joints.size() > limits_.maxJoints)
-        return makeError(ErrorCode::TooLarge, where, "/skins",
-                         std::to_string(model->joints.size()) + " joints, the limit is " +
-                             std::to_string(limits_.maxJoints));
+    if (auto st = checkModel(*model, limits_, where); !st) return st.error();
     ModelEntry e;
     e.id = Store::newId("m");
     e.name = sanitizeName(name.empty() ? gltfName : name);
@@ -654,9 +665,7 @@ json Service::listPatterns() const {
 
 Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name) {
     const char* where = "dermis::Service::addPattern";
-    if (bytes.size() > limits_.maxUploadBytes)
-        return makeError(ErrorCode::TooLarge, where, "body",
-                         "larger than " + std::to_string(limits_.maxUploadBytes) + " bytes");
+    if (bytes.size() > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
     auto img = readHeightImageFromMemory(bytes);
     if (!img) return img.error();
     if (img->width > limits_.maxImageSide || img->height > limits_.maxImageSide)
@@ -767,9 +776,10 @@ Result<json> Service::getScene(const std::string& id) const {
 }
 
 Result<json> Service::replaceScene(const std::string& id, const json& doc) {
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    if (!state_->scenes.count(id)) return notFound("id", "no scene \"" + id + "\"");
-    return state_->commit(id, doc, "replaced", false);
+    return state_->edit(id, "replaced", [&](json& d) -> Status {
+        d = doc;
+        return Ok{};
+    });
 }
 
 Status Service::deleteScene(const std::string& id) {
@@ -800,104 +810,92 @@ int placementIndex(const json& doc, const std::string& pid) {
 
 Result<json> Service::addPlacement(const std::string& id, const json& placement) {
     if (!placement.is_object()) return bad("", "a placement must be a JSON object");
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    auto it = state_->scenes.find(id);
-    if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    json doc = it->second.doc;
-    json p = placement;
-    if (!p.contains("id")) { // a fresh id that no other placement has
-        std::string pid;
-        for (int k = static_cast<int>(doc["placements"].size());; ++k) {
-            pid = "p" + std::to_string(k);
-            if (placementIndex(doc, pid) < 0) break;
+    return state_->edit(id, "placement_added", [&](json& doc) -> Status {
+        json p = placement;
+        if (!p.contains("id")) { // a fresh id that no other placement has
+            std::string pid;
+            for (int k = static_cast<int>(doc["placements"].size());; ++k) {
+                pid = "p" + std::to_string(k);
+                if (placementIndex(doc, pid) < 0) break;
+            }
+            p["id"] = pid;
         }
-        p["id"] = pid;
-    }
-    doc["placements"].push_back(p);
-    return state_->commit(id, doc, "placement_added", false);
+        doc["placements"].push_back(p);
+        return Ok{};
+    });
 }
 
 Result<json> Service::patchPlacement(const std::string& id, const std::string& pid, const json& patch) {
     if (!patch.is_object()) return bad("", "a placement patch must be a JSON object");
     if (auto i = patch.find("id"); i != patch.end() && (!i->is_string() || i->get<std::string>() != pid))
         return bad("/id", "a placement's id cannot be changed");
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    auto it = state_->scenes.find(id);
-    if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    json doc = it->second.doc;
-    const int k = placementIndex(doc, pid);
-    if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
-    doc["placements"][static_cast<std::size_t>(k)].merge_patch(patch);
-    return state_->commit(id, doc, "placement_updated", false);
+    return state_->edit(id, "placement_updated", [&](json& doc) -> Status {
+        const int k = placementIndex(doc, pid);
+        if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
+        doc["placements"][static_cast<std::size_t>(k)].merge_patch(patch);
+        return Ok{};
+    });
 }
 
 Result<json> Service::deletePlacement(const std::string& id, const std::string& pid) {
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    auto it = state_->scenes.find(id);
-    if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    json doc = it->second.doc;
-    const int k = placementIndex(doc, pid);
-    if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
-    doc["placements"].erase(static_cast<std::size_t>(k));
-    return state_->commit(id, doc, "placement_deleted", false);
+    return state_->edit(id, "placement_deleted", [&](json& doc) -> Status {
+        const int k = placementIndex(doc, pid);
+        if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
+        doc["placements"].erase(static_cast<std::size_t>(k));
+        return Ok{};
+    });
 }
 
 Result<json> Service::reorderPlacements(const std::string& id, const json& order) {
     if (!order.is_array()) return bad("", "the order must be an array of placement ids");
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    auto it = state_->scenes.find(id);
-    if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    json doc = it->second.doc;
-    const json& old = doc["placements"];
-    if (order.size() != old.size())
-        return bad("", "the order must list each of the " + std::to_string(old.size()) + " placements once");
-    json reordered = json::array();
-    std::set<std::string> seen;
-    for (std::size_t i = 0; i < order.size(); ++i) {
-        const std::string f = "/" + std::to_string(i);
-        if (!order[i].is_string()) return bad(f, "must be a placement id");
-        const std::string pid = order[i].get<std::string>();
-        const int k = placementIndex(doc, pid);
-        if (k < 0) return notFound(f, "no placement \"" + pid + "\"");
-        if (!seen.insert(pid).second) return bad(f, "placement \"" + pid + "\" listed twice");
-        reordered.push_back(old[static_cast<std::size_t>(k)]);
-    }
-    doc["placements"] = std::move(reordered);
-    return state_->commit(id, doc, "placements_reordered", false);
+    return state_->edit(id, "placements_reordered", [&](json& doc) -> Status {
+        const json& old = doc["placements"];
+        if (order.size() != old.size())
+            return bad("", "the order must list each of the " + std::to_string(old.size()) + " placements once");
+        json reordered = json::array();
+        std::set<std::string> seen;
+        for (std::size_t i = 0; i < order.size(); ++i) {
+            const std::string f = "/" + std::to_string(i);
+            if (!order[i].is_string()) return bad(f, "must be a placement id");
+            const std::string pid = order[i].get<std::string>();
+            const int k = placementIndex(doc, pid);
+            if (k < 0) return notFound(f, "no placement \"" + pid + "\"");
+            if (!seen.insert(pid).second) return bad(f, "placement \"" + pid + "\" listed twice");
+            reordered.push_back(old[static_cast<std::size_t>(k)]);
+        }
+        doc["placements"] = std::move(reordered);
+        return Ok{};
+    });
 }
 
 Result<json> Service::putPose(const std::string& id, const json& pose) {
     if (!pose.is_object()) return bad("/pose", "a pose must be a JSON object");
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    auto it = state_->scenes.find(id);
-    if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    json doc = it->second.doc;
-    doc["pose"] = pose;
-    return state_->commit(id, doc, "pose", false);
+    return state_->edit(id, "pose", [&](json& doc) -> Status {
+        doc["pose"] = pose;
+        return Ok{};
+    });
 }
 
 Result<json> Service::patchPose(const std::string& id, const json& patch) {
     if (!patch.is_object()) return bad("/pose", "a pose patch must be a JSON object");
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    auto it = state_->scenes.find(id);
-    if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    json doc = it->second.doc;
-    json& pose = doc["pose"];
-    if (!pose.is_object()) pose = json::object();
-    for (auto e = patch.begin(); e != patch.end(); ++e) {
-        if (e.key() == "joints" && e->is_object()) {
-            if (!pose["joints"].is_object()) pose["joints"] = json::object();
-            for (auto j = e->begin(); j != e->end(); ++j) {
-                if (j->is_null()) pose["joints"].erase(j.key());
-                else pose["joints"][j.key()] = *j;
+    return state_->edit(id, "pose", [&](json& doc) -> Status {
+        json& pose = doc["pose"];
+        if (!pose.is_object()) pose = json::object();
+        for (auto e = patch.begin(); e != patch.end(); ++e) {
+            if (e.key() == "joints" && e->is_object()) {
+                if (!pose["joints"].is_object()) pose["joints"] = json::object();
+                for (auto j = e->begin(); j != e->end(); ++j) {
+                    if (j->is_null()) pose["joints"].erase(j.key());
+                    else pose["joints"][j.key()] = *j;
+                }
+            } else if (e->is_null()) {
+                pose.erase(e.key());
+            } else {
+                pose[e.key()] = *e;
             }
-        } else if (e->is_null()) {
-            pose.erase(e.key());
-        } else {
-            pose[e.key()] = *e;
         }
-    }
-    return state_->commit(id, doc, "pose", false);
+        return Ok{};
+    });
 }
 
 // --- renders ------------------------------------------------------------------------------------
