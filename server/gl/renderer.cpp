@@ -213,6 +213,13 @@ struct Renderer::Impl {
     GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
     GLuint whiteTexture = 0; ///< 1×1 white, for parts without a base-colour texture
     GLint uboAlignment = 256;
+    GLint maxRenderbufferSize = 0;
+
+    /// Bytes between consecutive blocks of `size` in one uniform buffer bound by range.
+    std::size_t uboStride(std::size_t size) const {
+        const auto a = static_cast<std::size_t>(uboAlignment);
+        return (size + a - 1) / a * a;
+    }
     HeightTargets heights;
     FrameTargets frame;
     std::map<const Model*, GpuModel> models;
@@ -268,6 +275,7 @@ Status Renderer::Impl::init(GlBackend backend) {
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &info.maxTextureSize);
     glGetIntegerv(GL_MAX_SAMPLES, &info.maxSamples);
     glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &uboAlignment);
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &maxRenderbufferSize);
     uboAlignment = std::max(uboAlignment, 16);
 
     struct Build {
@@ -576,9 +584,7 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
     lastHeights.reset();
 
     // One block per placement in one buffer, bound by range per draw.
-    const std::size_t stride =
-        (sizeof(HeightPassBlock) + static_cast<std::size_t>(uboAlignment) - 1) /
-        static_cast<std::size_t>(uboAlignment) * static_cast<std::size_t>(uboAlignment);
+    const std::size_t stride = uboStride(sizeof(HeightPassBlock));
     const std::size_t count = in.placements.size() + 1;
     std::vector<std::uint8_t> blocks(stride * count, 0);
     const glm::vec4 mapSize(static_cast<float>(W), static_cast<float>(H), 0.0f, 0.0f);
@@ -738,8 +744,7 @@ Status Renderer::Impl::ensureFrameTargets(int w, int h, int samples) {
 Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     const RenderSettings& rs = req.render;
     const int W = rs.size[0], H = rs.size[1];
-    GLint maxRb = 0;
-    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &maxRb);
+    const GLint maxRb = maxRenderbufferSize;
     if (W <= 0 || H <= 0 || W > kMaxRenderSize || H > kMaxRenderSize || W > maxRb || H > maxRb)
         return makeError(ErrorCode::InvalidArgument, kWhere, "/render/size",
                          "each side must be in [1, " + std::to_string(std::min(kMaxRenderSize, maxRb)) + "]");
@@ -822,9 +827,7 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof fb, &fb);
     glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBinding, frameUbo);
 
-    const std::size_t stride =
-        (sizeof(PartBlock) + static_cast<std::size_t>(uboAlignment) - 1) /
-        static_cast<std::size_t>(uboAlignment) * static_cast<std::size_t>(uboAlignment);
+    const std::size_t stride = uboStride(sizeof(PartBlock));
     std::vector<std::uint8_t> partBlocks(stride * std::max<std::size_t>(1, (*gm)->parts.size()), 0);
     for (std::size_t pi = 0; pi < (*gm)->parts.size(); ++pi) {
         const GpuModel::Part& gp = (*gm)->parts[pi];

@@ -154,6 +154,12 @@ struct Service::State {
     };
     Result<Prepared> prepare(const json& doc) const; // caller holds `mutex` (shared or exclusive)
     Scene resolved(const Scene& scene) const;        // placement patterns alias → id
+    /// A copy of scene `id` and its model, taken under the shared lock (renders then run unlocked).
+    struct Snapshot {
+        Scene scene;
+        std::shared_ptr<const Model> model;
+    };
+    Result<Snapshot> snapshot(const std::string& id) const;
     const HeightImage* baseOf(const Scene& scene) const;
     void publish(const std::string& sceneId, const json& event);
     Result<json> commit(const std::string& id, const json& newDoc, const char* what, bool create);
@@ -226,6 +232,13 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn) cons
     out.scene = std::move(*scene);
     out.model = model->second.model;
     return out;
+}
+
+Result<Service::State::Snapshot> Service::State::snapshot(const std::string& id) const {
+    std::shared_lock<std::shared_mutex> lock(mutex);
+    auto it = scenes.find(id);
+    if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
+    return Snapshot{it->second.scene, models.at(it->second.scene.model).model};
 }
 
 Scene Service::State::resolved(const Scene& scene) const {
@@ -934,16 +947,9 @@ Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p)
     if (p.time && !(*p.time >= 0.0 && std::isfinite(*p.time))) return bad("time", "must be >= 0");
     QueueSlot slot(state_->inFlight, limits_.queueLength);
     if (!slot.ok()) return queueFull();
-    Scene scene;
-    std::shared_ptr<const Model> model;
-    {
-        std::shared_lock<std::shared_mutex> lock(state_->mutex);
-        auto it = state_->scenes.find(id);
-        if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-        scene = it->second.scene;
-        model = state_->models.at(scene.model).model;
-    }
-    return state_->render(scene, model, p);
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    return state_->render(snap->scene, snap->model, p);
 }
 
 Result<EncodedImage> Service::heightmap(const std::string& id, const std::string& which,
@@ -955,15 +961,10 @@ Result<EncodedImage> Service::heightmap(const std::string& id, const std::string
         return bad("format", normal ? "must be png or exr" : "must be png16, exr or f32");
     QueueSlot slot(state_->inFlight, limits_.queueLength);
     if (!slot.ok()) return queueFull();
-    Scene scene;
-    std::shared_ptr<const Model> model;
-    {
-        std::shared_lock<std::shared_mutex> lock(state_->mutex);
-        auto it = state_->scenes.find(id);
-        if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-        scene = state_->resolved(it->second.scene);
-        model = state_->models.at(scene.model).model;
-    }
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    const Scene scene = state_->resolved(snap->scene);
+    const std::shared_ptr<const Model>& model = snap->model;
     Result<HeightMaps> maps = makeError(ErrorCode::Internal, "dermis::Service", "", "not baked");
     {
         std::shared_lock<std::shared_mutex> il(state_->imagesMutex);
