@@ -9,7 +9,7 @@
 //  * heightmap fetch: p50/p99 ms of the displacement map as raw float32 and the bump map as
 //    16-bit PNG.
 #include "http/api.hpp"
-#include "http/service.hpp"
+#include "service/service.hpp"
 
 #include <httplib.h>
 #include <nlohmann/json.hpp>

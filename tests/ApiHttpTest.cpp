@@ -23,7 +23,7 @@
 //   * a known path asked with another method answers 405 with Allow.
 #include "TestFiles.hpp"
 #include "http/api.hpp"
-#include "http/service.hpp"
+#include "service/service.hpp"
 #include "io/frame_io.hpp"
 
 #include <gtest/gtest.h>

@@ -10,7 +10,7 @@
 // and KayKit Barbarian are non-empty and change with time; MSAA, tessellation, displacement.
 #include "core/bake.hpp"
 #include "gl/renderer.hpp"
-#include "gl/scene_frame.hpp"
+#include "SceneFrame.hpp"
 #include "gl/uniform_blocks.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
@@ -191,9 +191,9 @@ MapComparison compareMaps(const HeightImage& gpu, const HeightImage& cpu,
 
 TEST_F(RendererGLTest, HeightPassEqualsTheCpuReference) {
     PatternImages images;
-    images["a"] = testPattern(64, 40, 1.5, 2.0); // non-square
-    images["b"] = testPattern(32, 32, 3.0, 1.0);
-    images["c"] = testPattern(50, 70, 0.7, 2.5);
+    images["a"] = makePatternImage(testPattern(64, 40, 1.5, 2.0)); // non-square
+    images["b"] = makePatternImage(testPattern(32, 32, 3.0, 1.0));
+    images["c"] = makePatternImage(testPattern(50, 70, 0.7, 2.5));
     HeightImage base = testPattern(97, 61, 4.0, 4.0); // a static map of another size
     for (float& v : base.data) v *= 0.1f;
 
@@ -204,7 +204,8 @@ TEST_F(RendererGLTest, HeightPassEqualsTheCpuReference) {
     for (DeformModel m : {DeformModel::Scale, DeformModel::Bias})
         for (Response r : {Response::Log2, Response::Ln, Response::Linear, Response::Smoothstep}) {
             BakePlacement p;
-            p.pattern = &images[keys[n % 3]];
+            p.pattern = &images[keys[n % 3]]->pixels;
+            p.patternId = images[keys[n % 3]]->contentId;
             // Overlapping footprints along a diagonal, non-square and rotated.
             p.footprint.center = {0.2 + 0.08 * n, 0.25 + 0.06 * n};
             p.footprint.scale = {0.22 + 0.02 * (n % 3), 0.13 + 0.03 * (n % 2)};
@@ -224,7 +225,6 @@ TEST_F(RendererGLTest, HeightPassEqualsTheCpuReference) {
 
     HeightPassInput in;
     in.placements = ps;
-    in.images = &images;
     in.base = &base;
     in.width = 320;
     in.height = 200; // non-square map
@@ -506,7 +506,8 @@ TEST_F(DefaultCharacterGLTest, FrameOptionsAreValidated) {
     rs.size = {0, 10};
     auto r = renderDefault(gl(), *loaded_, model_, pose("squat", 0.5), rs);
     ASSERT_FALSE(r);
-    EXPECT_EQ(r.error().field, "/render/size");
+    // One check for render settings everywhere (validateRenderSettings): it names the element.
+    EXPECT_EQ(r.error().field, "/render/size/0");
     rs = settings_;
     rs.msaa = 3;
     r = renderDefault(gl(), *loaded_, model_, pose("squat", 0.5), rs);

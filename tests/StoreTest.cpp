@@ -1,7 +1,7 @@
 // StoreTest — the server's data folder (server/http/store): blobs and folder blobs with their
 // metadata records, scene records, generated ids, unsafe names refused, unreadable records and
 // leftovers of interrupted writes skipped. Files only; no GL, no HTTP.
-#include "http/store.hpp"
+#include "service/store.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>

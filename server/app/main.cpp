@@ -7,12 +7,12 @@
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
 #include "core/normalmap.hpp"
 #include "gl/renderer.hpp"
-#include "gl/scene_frame.hpp"
+#include "core/frame_plan.hpp"
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
 #include "io/scene_files.hpp"
 #include "http/api.hpp"
-#include "http/service.hpp"
+#include "service/service.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -69,27 +69,21 @@ int runBake(const BakeArgs& a) {
     auto t0 = std::chrono::steady_clock::now();
     auto loaded = loadSceneFile(a.scene);
     if (!loaded) return fail(loaded.error());
-    const HeightImage* base = loaded->base ? &*loaded->base : nullptr;
-    std::optional<double> time;
-    if (a.hasTime) time = a.time;
+    FrameOverrides overrides;
+    if (a.hasTime) overrides.time = a.time;
+    auto plan = planFrame(loaded->scene, loaded->model, loaded->images, loaded->base, overrides);
+    if (!plan) return fail(plan.error());
     HeightMaps maps;
     std::string how = "CPU";
     if (a.gpu) {
         auto renderer = Renderer::create(backendOf(a.gl));
         if (!renderer) return fail(renderer.error());
-        auto model = std::make_shared<const Model>(std::move(loaded->model));
-        auto frame = makeSceneFrame(loaded->scene, model, loaded->images, base, {time});
-        if (!frame) return fail(frame.error());
-        auto gpuMaps = (*renderer)->bakeHeightMaps(*frame->request.heights);
+        auto gpuMaps = (*renderer)->bakeHeightMaps(plan->heights);
         if (!gpuMaps) return fail(gpuMaps.error());
         maps = std::move(*gpuMaps);
         how = "GPU (" + (*renderer)->info().backend + ", " + (*renderer)->info().renderer + ")";
     } else {
-        SceneBakeOptions opt;
-        opt.time = time;
-        opt.base = base;
-        opt.threads = a.threads;
-        auto cpuMaps = bakeScene(loaded->scene, loaded->model, loaded->images, opt);
+        auto cpuMaps = bakeHeightMaps(plan->heights, a.threads);
         if (!cpuMaps) return fail(cpuMaps.error());
         maps = std::move(*cpuMaps);
     }
@@ -108,7 +102,7 @@ int runBake(const BakeArgs& a) {
     }
     if (a.normals) {
         // A bump-map unit rises bump_strength % of the map's width (in texels).
-        const double strength = 0.01 * loaded->scene.render.bumpStrength * maps.bump.width;
+        const double strength = 0.01 * plan->render.bumpStrength * maps.bump.width;
         auto normal = normalMapFromBump(maps.bump, strength);
         if (!normal) return fail(normal.error());
         if (auto s = writeFrame(a.out + "/normal.png", encodeNormalMap8(*normal)); !s)
@@ -188,31 +182,43 @@ int runRender(const RenderArgs& a) {
             return fail(makeError(ErrorCode::InvalidArgument, where, "--out",
                                   "a frame range needs a %04d-style field in the file name"));
     }
-    auto loaded = loadSceneFile(a.scene);
-    if (!loaded) return fail(loaded.error());
+    FrameOverrides overrides;
     if (!a.size.empty()) {
         int w = 0, h = 0;
         char tail = 0;
-        if (std::sscanf(a.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 ||
-            w > kMaxRenderSize || h > kMaxRenderSize)
+        if (std::sscanf(a.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2)
             return fail(makeError(ErrorCode::InvalidArgument, where, "--size",
-                                  "expected WxH with each side in [1, " +
-                                      std::to_string(kMaxRenderSize) + "], got \"" + a.size + "\""));
-        loaded->scene.render.size = {w, h};
+                                  "expected WxH, got \"" + a.size + "\""));
+        overrides.width = w;
+        overrides.height = h;
     }
+    auto loaded = loadSceneFile(a.scene);
+    if (!loaded) return fail(loaded.error());
     if (!animation) times = {a.hasTime ? a.time : loaded->scene.pose.time};
+    // The one range check of render settings (size included) runs in planFrame; "--size" is named
+    // when the size it set is out of range.
+    auto checkSize = [&](Error e) {
+        if (!a.size.empty() && e.field.rfind("/render/size", 0) == 0) {
+            e.field = "--size";
+            e.message = std::string(where) + ": --size: " + e.message;
+        }
+        return e;
+    };
 
     auto renderer = Renderer::create(backendOf(a.gl));
     if (!renderer) return fail(renderer.error());
     auto model = std::make_shared<const Model>(std::move(loaded->model));
-    const HeightImage* base = loaded->base ? &*loaded->base : nullptr;
+    const RenderSettings* used = nullptr;
+    RenderSettings last;
     for (std::size_t k = 0; k < times.size(); ++k) {
-        SceneFrameOptions opt;
-        opt.time = times[k];
-        opt.readHeightMaps = a.heightmaps;
-        auto frame = makeSceneFrame(loaded->scene, model, loaded->images, base, opt);
-        if (!frame) return fail(frame.error());
-        auto result = (*renderer)->renderFrame(frame->request);
+        overrides.time = times[k];
+        auto plan = planFrame(loaded->scene, *model, loaded->images, loaded->base, overrides);
+        if (!plan) return fail(checkSize(plan.error()));
+        FrameRequest request = frameRequest(*plan, model);
+        request.readHeightMaps = a.heightmaps;
+        last = plan->render;
+        used = &last;
+        auto result = (*renderer)->renderFrame(request);
         if (!result) return fail(result.error());
         const std::string path = animation ? framePath(a.out, static_cast<int>(k)) : a.out;
         if (auto s = createFolderOf(path); !s) return fail(s.error());
@@ -226,7 +232,7 @@ int runRender(const RenderArgs& a) {
         }
     }
     std::cout << "rendered " << times.size() << (times.size() == 1 ? " frame" : " frames") << " of "
-              << loaded->scene.render.size[0] << "x" << loaded->scene.render.size[1] << " with "
+              << used->size[0] << "x" << used->size[1] << " with "
               << (*renderer)->info().backend << " (" << (*renderer)->info().renderer << ") to "
               << (animation ? framePath(a.out, 0) + " …" : a.out) << " ("
               << static_cast<int>(msSince(t0)) << " ms)\n";

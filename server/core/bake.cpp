@@ -1,6 +1,8 @@
 // Scene document + character → height maps (CPU reference path).
 #include "bake.hpp"
 
+#include "frame_plan.hpp"
+
 #include <cmath>
 
 namespace dermis {
@@ -87,7 +89,11 @@ Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const M
         auto theta = placementAngle(model, pose, p, i);
         if (!theta) return theta.error();
         BakePlacement b;
-        b.pattern = &it->second;
+        if (!it->second)
+            return makeError(ErrorCode::NotFound, where, ptr + "/pattern",
+                             "no image loaded for pattern '" + p.pattern + "'");
+        b.pattern = &it->second->pixels;
+        b.patternId = it->second->contentId;
         b.footprint.center = {p.center[0], p.center[1]};
         b.footprint.scale = {p.scale[0], p.scale[1]};
         b.footprint.rotationDeg = p.rotation;
@@ -103,16 +109,11 @@ Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const M
 
 Result<HeightMaps> bakeScene(const Scene& scene, const Model& model, const PatternImages& images,
                              const SceneBakeOptions& options) {
-    auto pose = evaluatePose(model, scene.pose, options.time);
-    if (!pose) return pose.error();
-    auto placements = resolvePlacements(scene, model, *pose, images);
-    if (!placements) return placements.error();
-    BakeSettings settings;
-    settings.width = scene.heightmapSize[0];
-    settings.height = scene.heightmapSize[1];
-    settings.base = options.base;
-    settings.threads = options.threads;
-    return bakeHeightMaps(*placements, settings);
+    FrameOverrides overrides;
+    overrides.time = options.time;
+    auto plan = planFrame(scene, model, images, options.base, overrides);
+    if (!plan) return plan.error();
+    return bakeHeightMaps(plan->heights, options.threads);
 }
 
 } // namespace dermis

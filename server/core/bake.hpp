@@ -11,6 +11,7 @@
 #include "scene.hpp"
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -28,10 +29,11 @@ Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
 Result<double> placementAngle(const Model& model, const LocalPose& pose, const Placement& p,
                               std::size_t index);
 
-/// Pattern images by the id used in placements (custom ids and built-in ids).
-using PatternImages = std::map<std::string, HeightImage>;
+/// Pattern images by the id used in placements (custom ids and built-in ids). Shared and
+/// immutable: a frame plan keeps the images it points to alive while the owner's map changes.
+using PatternImages = std::map<std::string, std::shared_ptr<const PatternImage>>;
 
-/// Resolves every placement to a BakePlacement (pointers into `images`). Fails when the model
+/// Resolves every placement to a BakePlacement (pointers into `images`, patternId set). Fails when the model
 /// has no TEXCOORD_0 ("/placements/<i>": why), a joint is unknown, or an image is missing.
 Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const Model& model,
                                                      const LocalPose& pose,
@@ -39,11 +41,11 @@ Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const M
 
 struct SceneBakeOptions {
     std::optional<double> time; ///< overrides pose.time
-    const HeightImage* base = nullptr;
+    std::shared_ptr<const PatternImage> base;
     int threads = 0;
 };
 
-/// evaluatePose → resolvePlacements → bakeHeightMaps at the scene's heightmap size.
+/// planFrame (core/frame_plan.hpp) → bakeHeightMaps at the scene's heightmap size.
 Result<HeightMaps> bakeScene(const Scene& scene, const Model& model, const PatternImages& images,
                              const SceneBakeOptions& options = {});
 

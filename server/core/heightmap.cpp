@@ -2,10 +2,20 @@
 #include "heightmap.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <thread>
 
 namespace dermis {
+
+std::shared_ptr<const PatternImage> makePatternImage(HeightImage pixels) {
+    static std::atomic<std::uint64_t> next{1};
+    auto out = std::make_shared<PatternImage>();
+    out->contentId = next.fetch_add(1);
+    out->pixels = std::move(pixels);
+    return out;
+}
+
 
 float sampleBilinear(const HeightImage& image, double su, double sv) {
     // Texel k has its centre at (k + 0.5)/N: continuous texel coordinate x = s·N − 0.5.

@@ -10,6 +10,8 @@
 
 #include <glm/glm.hpp>
 
+#include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace dermis {
@@ -28,6 +30,16 @@ struct HeightImage {
     float at(int i, int j) const { return data[static_cast<std::size_t>(j) * width + i]; }
     float& at(int i, int j) { return data[static_cast<std::size_t>(j) * width + i]; }
 };
+
+/// An immutable pattern (or base) image shared by its owner and the frames that use it, with a
+/// process-unique content id: ids come from a counter and are never reused, so a cache keyed by
+/// the id cannot mistake a new image for a deleted one that had the same address.
+struct PatternImage {
+    std::uint64_t contentId = 0; ///< > 0
+    HeightImage pixels;
+};
+/// Wraps `pixels` with a fresh content id. Thread-safe.
+std::shared_ptr<const PatternImage> makePatternImage(HeightImage pixels);
 
 /// Bilinear sample at normalised coordinates s ∈ [0,1]² (texel centres at (k+0.5)/N), clamped to
 /// the edge texels. Precondition: image non-empty.
@@ -55,6 +67,7 @@ TexelRect footprintTexels(const Footprint& f, int width, int height);
 /// A placement ready to bake: pattern image, footprint, model, and the current t and constant.
 struct BakePlacement {
     const HeightImage* pattern = nullptr; ///< not owned; must outlive the bake
+    std::uint64_t patternId = 0;          ///< PatternImage::contentId; 0 = unknown (GPU hashes the pixels)
     Footprint footprint;
     DeformModel model = DeformModel::Scale;
     Target target = Target::Bump;

@@ -6,6 +6,8 @@
 // Unknown fields are ignored (SPEC §2b: "more fields may be added").
 #include "scene.hpp"
 
+#include "render_settings.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -581,11 +583,14 @@ Result<std::optional<double>> autoOrNumber(const Reader& rd, const json& v, cons
     return std::optional<double>{*d};
 }
 
+/// Types only: ranges are checked once, by validateRenderSettings (core/render_settings.hpp).
 Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
+    constexpr int kAnyInt = std::numeric_limits<int>::max();
+    constexpr double kAny = -std::numeric_limits<double>::infinity();
     const std::string ptr = "/render";
     if (auto s = rd.object(v, ptr); !s) return s;
     if (const json* size = Reader::find(v, "size")) {
-        auto wh = rd.size(*size, ptr + "/size", 1, kMaxRenderSize);
+        auto wh = rd.size(*size, ptr + "/size", -kAnyInt, kAnyInt);
         if (!wh) return wh.error();
         render.size = *wh;
     }
@@ -598,30 +603,29 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
             render.camera.yaw = *d;
         }
         if (const json* pitch = Reader::find(*cam, "pitch")) {
-            auto d = rd.numberIn(*pitch, p + "/pitch", -90.0, 90.0);
+            auto d = rd.number(*pitch, p + "/pitch");
             if (!d) return d.error();
             render.camera.pitch = *d;
         }
         if (const json* dist = Reader::find(*cam, "distance")) {
-            auto d = autoOrNumber(rd, *dist, p + "/distance", 0.0, true);
+            auto d = autoOrNumber(rd, *dist, p + "/distance", kAny, false);
             if (!d) return d.error();
             render.camera.distance = *d;
         }
     }
     if (const json* ds = Reader::find(v, "displacement_scale")) {
-        auto d = autoOrNumber(rd, *ds, ptr + "/displacement_scale", 0.0, false);
+        auto d = autoOrNumber(rd, *ds, ptr + "/displacement_scale", kAny, false);
         if (!d) return d.error();
         render.displacementScale = *d;
     }
     if (const json* bs = Reader::find(v, "bump_strength")) {
-        auto d = rd.numberIn(*bs, ptr + "/bump_strength", 0.0);
+        auto d = rd.number(*bs, ptr + "/bump_strength");
         if (!d) return d.error();
         render.bumpStrength = *d;
     }
     if (const json* msaa = Reader::find(v, "msaa")) {
-        auto n = rd.integer(*msaa, ptr + "/msaa", 1, 4);
+        auto n = rd.integer(*msaa, ptr + "/msaa", -kAnyInt, kAnyInt);
         if (!n) return n.error();
-        if (*n == 3) return rd.bad(ptr + "/msaa", "must be 1, 2 or 4, got 3");
         render.msaa = *n;
     }
     if (const json* dm = Reader::find(v, "displacement")) {
@@ -630,7 +634,7 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
         if (!e) return e.error();
         render.displacement = *e;
     }
-    return Ok{};
+    return validateRenderSettings(render, {}, kSceneWhere);
 }
 
 // --- text → json with the pointer of an out-of-range number -------------------------------------

@@ -5,6 +5,8 @@
 #include "gl/programs.hpp"
 #include "gl/uniform_blocks.hpp"
 
+#include "core/render_settings.hpp"
+
 #include <glad/gl.h>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -122,17 +124,42 @@ struct GpuModel {
 /// pass is skipped (a camera move or a pose change that moves no driving joint).
 struct HeightKey {
     int width = 0, height = 0;
-    GLuint base = 0;
-    std::vector<GLuint> textures;
+    std::uint64_t base = 0;             ///< content id of the base map (0 = none)
+    std::vector<std::uint64_t> patterns; ///< content id per placement (0 = skipped)
     std::vector<double> params; ///< per placement: centre, scale, rotation, h, t, model, target, response
     bool operator==(const HeightKey&) const = default;
 };
 
 struct PatternTexture {
     GLuint tex = 0;
-    const HeightImage* source = nullptr;
-    int width = 0, height = 0;
+    std::uint64_t lastUse = 0; ///< frame counter, for evicting the least recently used
 };
+
+/// The content id of an image given without one: a hash of its size and pixels (FNV-1a over
+/// 64-bit words), with the top bit set so that it never equals a PatternImage counter id.
+std::uint64_t contentHash(const HeightImage& image) {
+    std::uint64_t h = 1469598103934665603ull;
+    auto mix = [&](std::uint64_t v) {
+        h ^= v;
+        h *= 1099511628211ull;
+    };
+    mix(static_cast<std::uint64_t>(image.width));
+    mix(static_cast<std::uint64_t>(image.height));
+    const std::size_t n = image.data.size();
+    const float* d = image.data.data();
+    std::size_t i = 0;
+    for (; i + 1 < n; i += 2) {
+        std::uint64_t v;
+        std::memcpy(&v, d + i, sizeof v);
+        mix(v);
+    }
+    if (i < n) {
+        std::uint32_t v;
+        std::memcpy(&v, d + i, sizeof v);
+        mix(v);
+    }
+    return h | (1ull << 63);
+}
 
 /// The height maps as one RG32F texture (red: bump, green: displacement) — one target for the
 /// height pass and one fetch for both maps in the skin pass — and its framebuffer.
@@ -223,19 +250,19 @@ struct Renderer::Impl {
     HeightTargets heights;
     FrameTargets frame;
     std::map<const Model*, GpuModel> models;
-    std::map<std::string, PatternTexture> patterns;
+    std::map<std::uint64_t, PatternTexture> patterns; ///< by content id
+    std::uint64_t useCounter = 0;
     GLuint baseTexture = 0;
+    std::uint64_t baseId = 0; ///< content id of what baseTexture holds
     std::optional<HeightKey> lastHeights; ///< what `heights` holds now, if from a height pass
     std::size_t heightPasses = 0, heightPassesSkipped = 0;
-    const HeightImage* baseSource = nullptr;
-    int baseWidth = 0, baseHeight = 0;
 
     Status init(GlBackend backend);
     void shutdown();
     Status checkGl(const char* what);
 
     Result<GpuModel*> modelFor(const std::shared_ptr<const Model>& model);
-    Result<GLuint> patternTexture(const std::string& key, const HeightImage& image);
+    Result<GLuint> patternTexture(std::uint64_t id, const HeightImage& image, const std::string& field);
     Status ensureHeightTargets(int w, int h);
     Status heightPass(const HeightPassInput& in);
     Status readHeightTargets(HeightMaps& maps);
@@ -474,26 +501,30 @@ void Renderer::Impl::uploadPalette(const Model& model, const GpuModel& gm,
 
 // --- height pass -----------------------------------------------------------------------------
 
-Result<GLuint> Renderer::Impl::patternTexture(const std::string& key, const HeightImage& image) {
-    auto it = patterns.find(key);
-    if (it != patterns.end()) {
-        if (it->second.source == &image && it->second.width == image.width &&
-            it->second.height == image.height)
-            return it->second.tex;
-        glDeleteTextures(1, &it->second.tex);
-        patterns.erase(it);
+Result<GLuint> Renderer::Impl::patternTexture(std::uint64_t id, const HeightImage& image,
+                                              const std::string& field) {
+    ++useCounter;
+    if (auto it = patterns.find(id); it != patterns.end()) {
+        it->second.lastUse = useCounter;
+        return it->second.tex;
     }
     if (image.width > info.maxTextureSize || image.height > info.maxTextureSize)
-        return makeError(ErrorCode::InvalidArgument, kWhere, "/patterns/" + key,
+        return makeError(ErrorCode::InvalidArgument, kWhere, field,
                          "pattern is larger than the GL's maximum texture size " +
                              std::to_string(info.maxTextureSize));
-    lastHeights.reset(); // a texture name may be reused for other content
+    // Bounded cache: drop the least recently used texture beyond kMaxPatternTextures.
+    constexpr std::size_t kMaxPatternTextures = 256;
+    if (patterns.size() >= kMaxPatternTextures) {
+        auto oldest = std::min_element(patterns.begin(), patterns.end(), [](const auto& a, const auto& b) {
+            return a.second.lastUse < b.second.lastUse;
+        });
+        glDeleteTextures(1, &oldest->second.tex);
+        patterns.erase(oldest);
+    }
     PatternTexture pt;
     pt.tex = makeFloatTexture(image.width, image.height, image.data.data(), GL_NEAREST);
-    pt.source = &image;
-    pt.width = image.width;
-    pt.height = image.height;
-    patterns[key] = pt;
+    pt.lastUse = useCounter;
+    patterns[id] = pt;
     return pt.tex;
 }
 
@@ -526,6 +557,7 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
                              std::to_string(std::min(kMaxHeightmapSize, info.maxTextureSize)) + "]");
     // Resolve each placement's texture first, so that a bad input changes nothing.
     std::vector<GLuint> textures(in.placements.size(), 0);
+    std::vector<std::uint64_t> ids(in.placements.size(), 0);
     for (std::size_t k = 0; k < in.placements.size(); ++k) {
         const BakePlacement& p = in.placements[k];
         const std::string field = "/placements/" + std::to_string(k);
@@ -536,29 +568,23 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
         if (!(p.footprint.scale.x > 0.0) || !(p.footprint.scale.y > 0.0))
             return makeError(ErrorCode::InvalidArgument, kWhere, field + "/scale", "must be > 0");
         if (p.t <= 0.0) continue; // contributes nothing (as on the CPU)
-        std::string key;
-        if (in.images)
-            for (const auto& [name, image] : *in.images)
-                if (&image == img) key = name;
-        if (key.empty()) // not from the map: cache by address
-            key = "@" + std::to_string(reinterpret_cast<std::uintptr_t>(img));
-        auto tex = patternTexture(key, *img);
+        ids[k] = p.patternId ? p.patternId : contentHash(*img);
+        auto tex = patternTexture(ids[k], *img, field + "/pattern");
         if (!tex) return tex.error();
         textures[k] = *tex;
     }
     const HeightImage* base = in.base;
+    std::uint64_t baseKey = 0;
     if (base) {
         if (base->width <= 0 || base->height <= 0 ||
             base->data.size() != static_cast<std::size_t>(base->width) * base->height ||
             base->width > info.maxTextureSize || base->height > info.maxTextureSize)
             return makeError(ErrorCode::InvalidArgument, kWhere, "/heightmap/base", "empty or oversized base map");
-        if (base != baseSource || base->width != baseWidth || base->height != baseHeight) {
+        baseKey = in.baseId ? in.baseId : contentHash(*base);
+        if (baseKey != baseId || !baseTexture) {
             glDeleteTextures(1, &baseTexture);
-            lastHeights.reset();
             baseTexture = makeFloatTexture(base->width, base->height, base->data.data(), GL_NEAREST);
-            baseSource = base;
-            baseWidth = base->width;
-            baseHeight = base->height;
+            baseId = baseKey;
         }
     }
     if (auto s = ensureHeightTargets(W, H); !s) return s;
@@ -566,8 +592,8 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
     HeightKey key;
     key.width = W;
     key.height = H;
-    key.base = base ? baseTexture : 0;
-    key.textures = textures;
+    key.base = baseKey;
+    key.patterns = ids;
     for (std::size_t k = 0; k < in.placements.size(); ++k) {
         if (!textures[k]) continue;
         const BakePlacement& p = in.placements[k];
@@ -744,16 +770,11 @@ Status Renderer::Impl::ensureFrameTargets(int w, int h, int samples) {
 Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     const RenderSettings& rs = req.render;
     const int W = rs.size[0], H = rs.size[1];
-    const GLint maxRb = maxRenderbufferSize;
-    if (W <= 0 || H <= 0 || W > kMaxRenderSize || H > kMaxRenderSize || W > maxRb || H > maxRb)
+    if (auto s = validateRenderSettings(rs, {}, kWhere); !s) return s.error();
+    if (W > maxRenderbufferSize || H > maxRenderbufferSize)
         return makeError(ErrorCode::InvalidArgument, kWhere, "/render/size",
-                         "each side must be in [1, " + std::to_string(std::min(kMaxRenderSize, maxRb)) + "]");
-    if (rs.msaa != 1 && rs.msaa != 2 && rs.msaa != 4)
-        return makeError(ErrorCode::InvalidArgument, kWhere, "/render/msaa", "must be 1, 2 or 4");
-    if (!std::isfinite(rs.bumpStrength) || rs.bumpStrength < 0.0)
-        return makeError(ErrorCode::InvalidArgument, kWhere, "/render/bump_strength", "must be >= 0");
-    if (rs.displacementScale && !(std::isfinite(*rs.displacementScale) && *rs.displacementScale >= 0.0))
-        return makeError(ErrorCode::InvalidArgument, kWhere, "/render/displacement_scale", "must be >= 0");
+                         "each side must be at most the GL's renderbuffer limit " +
+                             std::to_string(maxRenderbufferSize));
     if (!req.model) return makeError(ErrorCode::InvalidArgument, kWhere, "model", "no model");
     const Model& model = *req.model;
 
@@ -982,6 +1003,15 @@ Result<Renderer::BlockLayout> Renderer::Impl::blockLayout(const std::string& blo
     return layout;
 }
 
+FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> model) {
+    FrameRequest req;
+    req.model = std::move(model);
+    req.world = plan.world;
+    req.render = plan.render;
+    req.heights = plan.heights;
+    return req;
+}
+
 // --- public façade: every call runs on the render thread ----------------------------------------
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -1044,7 +1074,7 @@ void Renderer::forgetPatterns() {
         impl_->patterns.clear();
         glDeleteTextures(1, &impl_->baseTexture);
         impl_->baseTexture = 0;
-        impl_->baseSource = nullptr;
+        impl_->baseId = 0;
         impl_->lastHeights.reset();
         return 0;
     });

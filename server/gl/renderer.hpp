@@ -14,14 +14,15 @@
 // (the GL entry points are process-wide). This header includes no EGL/GL.
 //
 // Caches: a model's buffers and textures are uploaded once per Model object (kept while the
-// caller's shared_ptr lives); pattern textures are cached by key and re-uploaded only when the key
-// names an image at a different address or size — callers that change an image in place call
-// forgetPatterns(). Errors: Result<…> with ErrorCode::Unavailable when no backend starts (the
+// caller's shared_ptr lives); pattern and base textures are cached by content id (see
+// HeightPassInput), so a deleted image whose reused address holds a new one is never mistaken for
+// it. Errors: Result<…> with ErrorCode::Unavailable when no backend starts (the
 // message lists what was tried), InvalidArgument for bad inputs (field named), Internal for GL
 // failures (shader compile log, incomplete framebuffer).
 #pragma once
 
 #include "core/bake.hpp"
+#include "core/frame_plan.hpp"
 #include "core/heightmap.hpp"
 #include "core/model.hpp"
 #include "core/result.hpp"
@@ -53,13 +54,10 @@ struct RendererInfo {
     std::vector<std::string> tried; ///< one line per backend tried before this one, with why it failed
 };
 
-/// Input of the GPU height pass: the same placements as the CPU reference (bakeHeightMaps).
-struct HeightPassInput {
-    std::vector<BakePlacement> placements; ///< each `pattern` points into `images`
-    const PatternImages* images = nullptr; ///< key → image; textures are cached by key
-    const HeightImage* base = nullptr;     ///< optional static bump map
-    int width = 1024, height = 1024;
-};
+/// Input of the GPU height pass: the same as the CPU reference's (core/frame_plan.hpp). Pattern
+/// and base textures are cached by content id (BakePlacement::patternId, HeightMapInput::baseId),
+/// never by address; an image without an id (0) is cached by a hash of its pixels.
+using HeightPassInput = HeightMapInput;
 
 /// Wall-clock milliseconds of a frame's stages (with glFinish between them when profiling).
 struct FrameTimings {
@@ -86,23 +84,36 @@ struct FrameResult {
     glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< posed bounds used for framing
 };
 
-class Renderer {
+/// What a service needs of a renderer, so that it can be injected: Renderer is the GL one; tests
+/// use a CPU fake. Implementations may be called from any thread.
+class FrameRenderer {
+public:
+    virtual ~FrameRenderer() = default;
+    virtual const RendererInfo& info() const = 0;
+    /// Both height maps of `in`, row 0 first (SPEC conventions).
+    virtual Result<HeightMaps> bakeHeightMaps(const HeightPassInput& in) = 0;
+    /// One frame (and the maps it used when asked).
+    virtual Result<FrameResult> renderFrame(const FrameRequest& request) = 0;
+};
+
+class Renderer final : public FrameRenderer {
 public:
     /// Starts the render thread and a GL 4.3 core context on it. Fails (Unavailable) with every
     /// backend tried and why when none starts; never aborts the process.
     static Result<std::unique_ptr<Renderer>> create(GlBackend backend = GlBackend::Auto);
-    ~Renderer(); ///< finishes queued jobs, destroys GL objects and the context, joins the thread
+    ~Renderer() override; ///< finishes queued jobs, destroys GL objects and the context, joins the thread
     Renderer(const Renderer&) = delete;
     Renderer& operator=(const Renderer&) = delete;
 
-    const RendererInfo& info() const;
+    const RendererInfo& info() const override;
 
     /// Stage 1 alone: both maps at the input's size, read back (row 0 first, SPEC conventions).
     /// Matches the CPU reference within float rounding away from footprint edges.
-    Result<HeightMaps> bakeHeightMaps(const HeightPassInput& in);
+    Result<HeightMaps> bakeHeightMaps(const HeightPassInput& in) override;
 
     /// Stage 1 (optional) + stage 2 + readback of one frame.
-    Result<FrameResult> renderFrame(const FrameRequest& request);
+    /// Render settings are checked by validateRenderSettings, then against the GL's limits.
+    Result<FrameResult> renderFrame(const FrameRequest& request) override;
 
     /// Stage 2's skinning alone, captured with transform feedback: per part, the skinned
     /// positions and unit normals without displacement — the GPU twin of dermis::skin.
@@ -133,6 +144,10 @@ private:
     explicit Renderer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> impl_;
 };
+
+/// A frame request for `plan` (world matrices, render settings, GPU height pass on its heights).
+/// The request points into the plan's images: keep `plan` alive while the request is used.
+FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> model);
 
 /// The displacement scale "auto" resolves to: 1% of the largest extent of the rest-pose bounds
 /// (a bulge of L·h = 1 rises 1% of the character's height). Bump mapping uses 0.25 × this ×

@@ -9,7 +9,7 @@
 // TCP_NODELAY is on (keep-alive requests otherwise stall ~26 ms on the delayed ACK).
 #pragma once
 
-#include "http/service.hpp"
+#include "service/service.hpp"
 
 #include <memory>
 #include <string>

@@ -103,7 +103,7 @@ Result<LoadedScene> loadSceneFile(const std::string& path) {
             e.message = std::string(where) + ": " + e.field + ": " + e.message;
             return e;
         }
-        out.images.emplace(id, std::move(*img));
+        out.images.emplace(id, makePatternImage(std::move(*img)));
     }
     if (out.scene.heightmapBase) {
         auto img = readHeightImage(joinPath(out.baseDir, *out.scene.heightmapBase));
@@ -113,7 +113,7 @@ Result<LoadedScene> loadSceneFile(const std::string& path) {
             e.message = std::string(where) + ": /heightmap/base: " + e.message;
             return e;
         }
-        out.base = std::move(*img);
+        out.base = makePatternImage(std::move(*img));
     }
     return out;
 }

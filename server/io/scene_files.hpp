@@ -10,6 +10,7 @@
 #include "core/result.hpp"
 #include "core/scene.hpp"
 
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -32,7 +33,7 @@ struct LoadedScene {
     std::string baseDir;            ///< folder of the document
     Model model;
     PatternImages images;           ///< every pattern a placement uses, by id
-    std::optional<HeightImage> base; ///< heightmap.base, if any
+    std::shared_ptr<const PatternImage> base; ///< heightmap.base, if any
 };
 
 /// Reads and validates a scene file and everything it references.

@@ -1,8 +1,8 @@
-#include "http/service.hpp"
+#include "service/service.hpp"
 
 #include "core/bake.hpp"
 #include "core/normalmap.hpp"
-#include "gl/scene_frame.hpp"
+#include "core/frame_plan.hpp"
 #include "io/frame_io.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/image_io.hpp"
@@ -160,7 +160,7 @@ struct Service::State {
         std::shared_ptr<const Model> model;
     };
     Result<Snapshot> snapshot(const std::string& id) const;
-    const HeightImage* baseOf(const Scene& scene) const;
+    std::shared_ptr<const PatternImage> baseOf(const Scene& scene) const;
     void publish(const std::string& sceneId, const json& event);
     Result<json> commit(const std::string& id, const json& newDoc, const char* what, bool create);
     /// Locks, copies scene `id`'s document, lets `change` modify the copy, then commits it.
@@ -248,10 +248,10 @@ Scene Service::State::resolved(const Scene& scene) const {
     return s;
 }
 
-const HeightImage* Service::State::baseOf(const Scene& scene) const {
+std::shared_ptr<const PatternImage> Service::State::baseOf(const Scene& scene) const {
     if (!scene.heightmapBase) return nullptr;
     auto it = images.find(*scene.heightmapBase);
-    return it == images.end() ? nullptr : &it->second;
+    return it == images.end() ? nullptr : it->second;
 }
 
 void Service::State::publish(const std::string& sceneId, const json& event) {
@@ -292,20 +292,22 @@ Result<EncodedImage> Service::State::render(const Scene& sceneIn,
                                             const std::shared_ptr<const Model>& model,
                                             const FrameParams& p) {
     Scene scene = resolved(sceneIn);
-    if (p.width) scene.render.size[0] = *p.width;
-    if (p.height) scene.render.size[1] = *p.height;
-    if (p.msaa) scene.render.msaa = *p.msaa;
-    if (p.yaw) scene.render.camera.yaw = *p.yaw;
-    if (p.pitch) scene.render.camera.pitch = *p.pitch;
-    if (p.distance) scene.render.camera.distance = *p.distance;
+    FrameOverrides o;
+    o.width = p.width;
+    o.height = p.height;
+    o.msaa = p.msaa;
+    o.yaw = p.yaw;
+    o.pitch = p.pitch;
+    o.distance = p.distance;
+    o.time = p.time;
     Result<FrameResult> result = makeError(ErrorCode::Internal, "dermis::Service", "", "not rendered");
     {
         std::shared_lock<std::shared_mutex> il(imagesMutex);
-        SceneFrameOptions opt;
-        opt.time = p.time;
-        auto frame = makeSceneFrame(scene, model, images, baseOf(scene), opt);
-        if (!frame) return frame.error();
-        result = renderer->renderFrame(frame->request);
+        RenderLimits rl;
+        rl.maxSide = limits.maxRenderSide;
+        auto plan = planFrame(scene, *model, images, baseOf(scene), o, rl);
+        if (!plan) return plan.error();
+        result = renderer->renderFrame(frameRequest(*plan, model));
     }
     if (!result) return result.error();
     EncodedImage out;
@@ -337,7 +339,7 @@ Result<std::unique_ptr<Service>> Service::open(const std::string& dataDir, GlBac
     for (const PatternInfo& info : st.manifest.patterns) {
         auto img = readHeightImage(dermisDataDir() + "/patterns/" + info.file);
         if (!img) return img.error();
-        st.images[info.id] = std::move(*img);
+        st.images[info.id] = makePatternImage(std::move(*img));
         st.patterns[info.id] = PatternEntry{info.id, info.id, true, 0, &info};
     }
     auto defaultModel = loadGltfFile(resolveModelPath(kBuiltinDefault, ""));
@@ -384,7 +386,7 @@ Result<std::unique_ptr<Service>> Service::open(const std::string& dataDir, GlBac
             svc->warnings_.push_back(b.file + ": " + img.error().message);
             continue;
         }
-        st.images[b.id] = std::move(*img);
+        st.images[b.id] = makePatternImage(std::move(*img));
         st.patterns[b.id] = PatternEntry{b.id, b.meta.value("name", ""), false, bytes->size(), nullptr};
     }
     for (const Store::SceneRecord& r : st.store->listScenes(svc->warnings_)) {
@@ -671,7 +673,7 @@ json Service::listPatterns() const {
     json out = json::array();
     for (const auto& [id, e] : state_->patterns) {
         auto img = state_->images.find(id);
-        out.push_back(patternSummary(e, img == state_->images.end() ? nullptr : &img->second));
+        out.push_back(patternSummary(e, img == state_->images.end() ? nullptr : &img->second->pixels));
     }
     return {{"patterns", out}};
 }
@@ -695,8 +697,9 @@ Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const s
         !s)
         return s.error();
     std::unique_lock<std::shared_mutex> il(state_->imagesMutex);
-    HeightImage& stored = state_->images[e.id] = std::move(*img);
-    json summary = patternSummary(e, &stored);
+    auto stored = makePatternImage(std::move(*img));
+    state_->images[e.id] = stored;
+    json summary = patternSummary(e, &stored->pixels);
     state_->patterns[e.id] = std::move(e);
     return summary;
 }
@@ -707,7 +710,7 @@ Result<EncodedImage> Service::patternImage(const std::string& id, int size) cons
     std::shared_lock<std::shared_mutex> il(state_->imagesMutex);
     auto it = state_->images.find(id);
     if (it == state_->images.end() || !state_->patterns.count(id)) return notFound("id", "no pattern \"" + id + "\"");
-    const HeightImage& src = it->second;
+    const HeightImage& src = it->second->pixels;
     const int w = size, h = std::max(1, static_cast<int>(std::lround(double(size) * src.height / src.width)));
     Image8 img;
     img.width = w;
@@ -934,22 +937,41 @@ Error queueFull() {
 
 } // namespace
 
+namespace {
+
+/// A frame's query parameters name the render settings they override: an error in an overridden
+/// setting names the parameter ("width"), not the document field ("/render/size/0").
+Error asParamError(Error e, const FrameParams& p) {
+    const struct {
+        const char* field;
+        const char* param;
+        bool given;
+    } map[] = {{"/render/size/0", "width", p.width.has_value()},
+               {"/render/size/1", "height", p.height.has_value()},
+               {"/render/msaa", "msaa", p.msaa.has_value()},
+               {"/render/camera/yaw", "yaw", p.yaw.has_value()},
+               {"/render/camera/pitch", "pitch", p.pitch.has_value()},
+               {"/render/camera/distance", "distance", p.distance.has_value()},
+               {"/pose/time", "time", p.time.has_value()}};
+    for (const auto& m : map)
+        if (m.given && e.field == m.field) {
+            const std::string what = e.message.substr(e.message.rfind(": ") + 2);
+            return makeError(e.code, "dermis::Service::frame", m.param, what);
+        }
+    return e;
+}
+
+} // namespace
+
 Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p) {
     if (p.format != "png" && p.format != "jpeg") return bad("format", "must be png or jpeg");
-    for (auto [v, name] : {std::pair{p.width, "width"}, std::pair{p.height, "height"}})
-        if (v && (*v < 1 || *v > limits_.maxRenderSide))
-            return makeError(*v < 1 ? ErrorCode::InvalidArgument : ErrorCode::TooLarge, "dermis::Service",
-                             name, "must be in [1, " + std::to_string(limits_.maxRenderSide) + "]");
-    if (p.msaa && *p.msaa != 1 && *p.msaa != 2 && *p.msaa != 4) return bad("msaa", "must be 1, 2 or 4");
-    if (p.pitch && !(*p.pitch >= -90.0 && *p.pitch <= 90.0)) return bad("pitch", "must be in [-90, 90]");
-    if (p.yaw && !std::isfinite(*p.yaw)) return bad("yaw", "must be a finite number");
-    if (p.distance && !(*p.distance > 0.0 && std::isfinite(*p.distance))) return bad("distance", "must be > 0");
-    if (p.time && !(*p.time >= 0.0 && std::isfinite(*p.time))) return bad("time", "must be >= 0");
     QueueSlot slot(state_->inFlight, limits_.queueLength);
     if (!slot.ok()) return queueFull();
     auto snap = state_->snapshot(id);
     if (!snap) return snap.error();
-    return state_->render(snap->scene, snap->model, p);
+    auto img = state_->render(snap->scene, snap->model, p);
+    if (!img) return asParamError(img.error(), p);
+    return img;
 }
 
 Result<EncodedImage> Service::heightmap(const std::string& id, const std::string& which,
@@ -968,9 +990,9 @@ Result<EncodedImage> Service::heightmap(const std::string& id, const std::string
     Result<HeightMaps> maps = makeError(ErrorCode::Internal, "dermis::Service", "", "not baked");
     {
         std::shared_lock<std::shared_mutex> il(state_->imagesMutex);
-        auto frame = makeSceneFrame(scene, model, state_->images, state_->baseOf(scene));
-        if (!frame) return frame.error();
-        maps = state_->renderer->bakeHeightMaps(*frame->request.heights);
+        auto plan = planFrame(scene, *model, state_->images, state_->baseOf(scene));
+        if (!plan) return plan.error();
+        maps = state_->renderer->bakeHeightMaps(plan->heights);
     }
     if (!maps) return maps.error();
     const HeightImage& map = which == "displacement" ? maps->displacement : maps->bump;

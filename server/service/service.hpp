@@ -16,7 +16,7 @@
 #include "core/result.hpp"
 #include "core/scene.hpp"
 #include "gl/renderer.hpp"
-#include "http/store.hpp"
+#include "service/store.hpp"
 
 #include <nlohmann/json.hpp>
 

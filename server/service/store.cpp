@@ -1,4 +1,4 @@
-#include "http/store.hpp"
+#include "service/store.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>

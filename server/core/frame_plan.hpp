@@ -1,0 +1,65 @@
+// Dermis core — the one path from a scene to what a frame needs ("frame plan"): evaluate the pose
+// at a time, world matrices, each placement's joint angle and t, the height-map size and base,
+// and the render settings with a frame's overrides applied and checked. The CPU bake (bakeScene,
+// `bake`) and the GPU frame (renderer, `render`, the server) both start here.
+//
+// Pure: the caller loads the model and the images. A plan keeps the images it points to alive
+// (shared, immutable), so it can be used after the owner's lock is released. It does not render
+// and does not bake.
+#pragma once
+
+#include "bake.hpp"
+#include "heightmap.hpp"
+#include "model.hpp"
+#include "render_settings.hpp"
+#include "result.hpp"
+#include "rig.hpp"
+#include "scene.hpp"
+
+#include <glm/glm.hpp>
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace dermis {
+
+/// What both height-map stages take: the CPU reference (bakeHeightMaps below) and the GPU pass.
+struct HeightMapInput {
+    std::vector<BakePlacement> placements; ///< document order; `pattern` points into live images
+    const HeightImage* base = nullptr;     ///< optional static bump map
+    std::uint64_t baseId = 0;              ///< its PatternImage::contentId (0 = unknown)
+    int width = 1024, height = 1024;
+};
+
+/// A frame's overrides of the scene (query parameters, --time, --size). Absent = the scene's.
+struct FrameOverrides {
+    std::optional<double> time; ///< overrides pose.time
+    std::optional<int> width, height, msaa;
+    std::optional<double> yaw, pitch, distance;
+};
+
+struct FramePlan {
+    LocalPose pose;
+    std::vector<glm::mat4> world; ///< worldMatrices(model, pose): one per node
+    HeightMapInput heights;
+    RenderSettings render;        ///< the scene's, overrides applied, validated
+    /// Keep-alive of the images `heights` points to.
+    std::vector<std::shared_ptr<const PatternImage>> images;
+};
+
+/// Applies `overrides` to the scene's render settings and validates them once
+/// (validateRenderSettings with `limits`), then evaluates the pose and resolves the placements.
+/// Fails like validateRenderSettings (field "/render/…"), evaluatePose ("/pose/…") and
+/// resolvePlacements ("/placements/<i>…"); a time override must be finite and ≥ 0 ("/pose/time").
+/// A model without UVs but with placements fails at "/placements/0".
+Result<FramePlan> planFrame(const Scene& scene, const Model& model, const PatternImages& images,
+                            std::shared_ptr<const PatternImage> base,
+                            const FrameOverrides& overrides = {}, const RenderLimits& limits = {});
+
+/// CPU reference of the height-map stage on a plan's input (bakeHeightMaps with its size/base).
+Result<HeightMaps> bakeHeightMaps(const HeightMapInput& in, int threads = 0);
+/// Same, into caller-owned maps (storage reused; see bakeHeightMapsInto).
+Status bakeHeightMapsInto(const HeightMapInput& in, HeightMaps& maps, int threads = 0);
+
+} // namespace dermis

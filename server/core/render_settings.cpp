@@ -1,0 +1,48 @@
+#include "render_settings.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace dermis {
+namespace {
+
+std::string fmt(double d) {
+    std::ostringstream s;
+    s << d;
+    return s.str();
+}
+
+} // namespace
+
+Status validateRenderSettings(const RenderSettings& r, const RenderLimits& limits, const char* where) {
+    auto bad = [&](const std::string& field, const std::string& what) {
+        return makeError(ErrorCode::InvalidArgument, where, field, what);
+    };
+    for (std::size_t k = 0; k < 2; ++k) {
+        const std::string field = "/render/size/" + std::to_string(k);
+        const int side = r.size[k];
+        if (side < 1 || side > kMaxRenderSize)
+            return bad(field, "must be in [1, " + std::to_string(kMaxRenderSize) + "], got " +
+                                  std::to_string(side));
+        if (side > limits.maxSide)
+            return makeError(ErrorCode::TooLarge, where, field,
+                             std::to_string(side) + " exceeds the server's limit " +
+                                 std::to_string(limits.maxSide));
+    }
+    const Camera& c = r.camera;
+    if (!std::isfinite(c.yaw)) return bad("/render/camera/yaw", "must be a finite number");
+    if (!(c.pitch >= -90.0 && c.pitch <= 90.0))
+        return bad("/render/camera/pitch", "must be in [-90, 90], got " + fmt(c.pitch));
+    if (c.distance && !(std::isfinite(*c.distance) && *c.distance > 0.0))
+        return bad("/render/camera/distance", "must be > 0 (or \"auto\"), got " + fmt(*c.distance));
+    if (r.displacementScale && !(std::isfinite(*r.displacementScale) && *r.displacementScale >= 0.0))
+        return bad("/render/displacement_scale",
+                   "must be >= 0 (or \"auto\"), got " + fmt(*r.displacementScale));
+    if (!(std::isfinite(r.bumpStrength) && r.bumpStrength >= 0.0))
+        return bad("/render/bump_strength", "must be >= 0, got " + fmt(r.bumpStrength));
+    if (r.msaa != 1 && r.msaa != 2 && r.msaa != 4)
+        return bad("/render/msaa", "must be 1, 2 or 4, got " + std::to_string(r.msaa));
+    return Ok{};
+}
+
+} // namespace dermis
