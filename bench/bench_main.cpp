@@ -67,7 +67,7 @@ int benchFrames(GlBackend backend, int repeat, nlohmann::json& cases, nlohmann::
     }
     const RendererInfo& info = (*renderer)->info();
     gpuInfo = {{"backend", info.backend}, {"gl_renderer", info.renderer}, {"gl_version", info.version}};
-    auto loaded = loadSceneFile(dermisDataDir() + "/models/default.scene.json");
+    auto loaded = loadSceneFile(dermisContentDir() + "/models/default.scene.json");
     if (!loaded) {
         std::cerr << loaded.error().message << "\n";
         return 1;

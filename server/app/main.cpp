@@ -57,7 +57,7 @@ dermis::Status createFolderOf(const std::string& file) {
 // --- bake ------------------------------------------------------------------------------------
 
 struct BakeArgs {
-    std::string scene, out, gl = "auto";
+    std::string scene, out, gl = "auto", content;
     double time = -1.0;
     bool hasTime = false;
     int threads = 0;
@@ -67,7 +67,7 @@ struct BakeArgs {
 int runBake(const BakeArgs& a) {
     using namespace dermis;
     auto t0 = std::chrono::steady_clock::now();
-    auto loaded = loadSceneFile(a.scene);
+    auto loaded = loadSceneFile(a.scene, a.content.empty() ? dermisContentDir() : a.content);
     if (!loaded) return fail(loaded.error());
     FrameOverrides overrides;
     if (a.hasTime) overrides.time = a.time;
@@ -117,7 +117,7 @@ int runBake(const BakeArgs& a) {
 // --- render ----------------------------------------------------------------------------------
 
 struct RenderArgs {
-    std::string scene, out, gl = "auto", frames, size;
+    std::string scene, out, gl = "auto", frames, size, content;
     double time = 0.0;
     bool hasTime = false, heightmaps = false;
 };
@@ -192,7 +192,7 @@ int runRender(const RenderArgs& a) {
         overrides.width = w;
         overrides.height = h;
     }
-    auto loaded = loadSceneFile(a.scene);
+    auto loaded = loadSceneFile(a.scene, a.content.empty() ? dermisContentDir() : a.content);
     if (!loaded) return fail(loaded.error());
     if (!animation) times = {a.hasTime ? a.time : loaded->scene.pose.time};
     // The one range check of render settings (size included) runs in planFrame; "--size" is named
@@ -263,7 +263,7 @@ int runInfo(const std::string& gl) {
 // --- serve -----------------------------------------------------------------------------------
 
 struct ServeArgs {
-    std::string bind = "127.0.0.1", data = "dermis-data", token, gl = "auto", web;
+    std::string bind = "127.0.0.1", data = "dermis-data", content, token, gl = "auto", web;
     int port = 8080;
     dermis::ServerLimits limits;
     double maxUploadMb = 64;
@@ -282,7 +282,13 @@ int runServe(ServeArgs a) {
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
     std::signal(SIGPIPE, SIG_IGN);
 
-    auto service = Service::open(a.data, backendOf(a.gl), a.limits);
+    auto renderer = Renderer::create(backendOf(a.gl));
+    if (!renderer) return fail(renderer.error());
+    ServiceConfig config;
+    config.dataDir = a.data;
+    config.contentDir = a.content.empty() ? dermisContentDir() : a.content;
+    config.limits = a.limits;
+    auto service = Service::open(config, std::move(*renderer));
     if (!service) return fail(service.error());
     for (const std::string& w : (*service)->warnings())
         std::cerr << "dermis-server: warning: skipped " << w << "\n";
@@ -296,7 +302,7 @@ int runServe(ServeArgs a) {
     opt.bind = a.bind;
     opt.port = a.port;
     opt.token = a.token;
-    opt.webDir = a.web.empty() ? dermisDataDir() + "/web" : a.web;
+    opt.webDir = a.web.empty() ? config.contentDir + "/web" : a.web;
     Api api(**service, opt);
     auto port = api.bind();
     if (!port) return fail(port.error());
@@ -304,6 +310,7 @@ int runServe(ServeArgs a) {
     std::cout << "dermis-server: serving http://" << a.bind << ":" << *port << "/ (editor), API http://"
               << a.bind << ":" << *port << "/api/v1 — " << info["backend"].get<std::string>() << ", "
               << info["gl"]["renderer"].get<std::string>() << "; data in " << a.data
+              << ", content in " << config.contentDir
               << (a.token.empty() ? "" : "; bearer token required") << "\n"
               << "dermis-server: scene " << firstScene << ": http://" << a.bind << ":" << *port
               << "/api/v1/scenes/" << firstScene << "/frame" << std::endl;
@@ -323,9 +330,12 @@ int runServe(ServeArgs a) {
 void addServeOptions(CLI::App& app, ServeArgs& s) {
     app.add_option("--bind", s.bind, "Address to listen on (127.0.0.1 = this machine only)");
     app.add_option("--port", s.port, "TCP port (0 = any free port)")->check(CLI::Range(0, 65535));
-    app.add_option("--data", s.data, "Data directory (uploads and scenes, written atomically)");
+    app.add_option("--data", s.data, "Data directory: uploads and scenes, written durably");
+    app.add_option("--content", s.content,
+                   "Built-in content directory, read only: patterns/, models/, web/ "
+                   "(default $DERMIS_CONTENT_DIR or the source tree)");
     app.add_option("--token", s.token, "Bearer token every route but /health requires (or $DERMIS_TOKEN)");
-    app.add_option("--web", s.web, "Folder of the web editor served at / (default: the data folder's web/)");
+    app.add_option("--web", s.web, "Folder of the web editor served at / (default: the content folder's web/)");
     app.add_option("--max-upload-mb", s.maxUploadMb, "Largest request body / upload")->check(CLI::Range(0.001, 4096.0));
     app.add_option("--max-render-side", s.limits.maxRenderSide, "Largest frame side")->check(CLI::Range(16, 8192));
     app.add_option("--max-map-side", s.limits.maxMapSide, "Largest height-map side")->check(CLI::Range(16, 4096));
@@ -365,6 +375,7 @@ int main(int argc, char** argv) {
     bakeCmd->add_flag("--gpu", bake.gpu, "Bake with the GL height pass instead of the CPU");
     bakeCmd->add_flag("--normals", bake.normals,
                       "Also write normal.png, a UV-space normal map of the bump map");
+    bakeCmd->add_option("--content", bake.content, "Built-in content directory (builtin: names)");
     bakeCmd->add_option("--gl", bake.gl, "GL backend for --gpu")
         ->check(CLI::IsMember(kBackendNames));
 
@@ -385,6 +396,7 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--size", render.size, "Frame size WxH (overrides render.size)");
     renderCmd->add_flag("--heightmaps", render.heightmaps,
                         "Also write <frame>.bump.exr and <frame>.displacement.exr");
+    renderCmd->add_option("--content", render.content, "Built-in content directory (builtin: names)");
     renderCmd->add_option("--gl", render.gl, "GL backend")->check(CLI::IsMember(kBackendNames));
 
     std::string infoGl = "auto";

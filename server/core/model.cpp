@@ -31,6 +31,21 @@ int Model::findClip(const std::string& name) const {
     return -1;
 }
 
+int Model::parentJoint(int node) const {
+    if (node < 0 || static_cast<std::size_t>(node) >= nodes.size()) return -1;
+    int parent = nodes[static_cast<std::size_t>(node)].parent;
+    // Bounded walk: a malformed hierarchy with a cycle cannot loop forever.
+    for (std::size_t steps = 0; parent >= 0 && static_cast<std::size_t>(parent) < nodes.size() &&
+                                steps < nodes.size();
+         ++steps) {
+        if (parent == node) return -1; // a cycle back to the start
+        for (int j : joints)
+            if (j == parent) return parent;
+        parent = nodes[static_cast<std::size_t>(parent)].parent;
+    }
+    return -1;
+}
+
 std::vector<glm::vec3> computeNormals(const std::vector<glm::vec3>& positions,
                                       const std::vector<std::uint32_t>& indices) {
     // Each triangle adds its unnormalised face normal (length = 2·area) to its three corners, so

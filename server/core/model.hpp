@@ -91,6 +91,9 @@ struct Model {
     int findJoint(const std::string& name) const;
     /// Index into `clips` of the clip named `name`, −1 if none.
     int findClip(const std::string& name) const;
+    /// The nearest ancestor of node `node` that is a joint (skipping non-joint nodes between
+    /// them), −1 for none or an index out of range.
+    int parentJoint(int node) const;
 };
 
 /// Area-weighted vertex normals of a triangle list: each triangle adds its unnormalised face

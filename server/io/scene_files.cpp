@@ -35,14 +35,14 @@ std::string joinPath(const std::string& baseDir, const std::string& rel) {
 
 } // namespace
 
-std::string dermisDataDir() {
-    if (const char* env = std::getenv("DERMIS_DATA_DIR"); env && *env) return env;
+std::string dermisContentDir() {
+    if (const char* env = std::getenv("DERMIS_CONTENT_DIR"); env && *env) return env;
     return DERMIS_SOURCE_DIR;
 }
 
-Result<PatternManifest> loadBuiltinManifest() {
+Result<PatternManifest> loadBuiltinManifest(const std::string& contentDir) {
     const char* where = "dermis::loadBuiltinManifest";
-    const std::string path = dermisDataDir() + "/patterns/manifest.json";
+    const std::string path = contentDir + "/patterns/manifest.json";
     std::error_code ec;
     if (!fs::exists(path, ec)) return PatternManifest{};
     auto text = readText(path, where);
@@ -53,16 +53,17 @@ Result<PatternManifest> loadBuiltinManifest() {
     return parsePatternManifest(doc);
 }
 
-std::string resolveModelPath(const std::string& ref, const std::string& baseDir) {
+std::string resolveModelPath(const std::string& ref, const std::string& baseDir,
+                             const std::string& contentDir) {
     static const std::string kBuiltin = "builtin:";
     if (ref.rfind(kBuiltin, 0) == 0)
-        return dermisDataDir() + "/models/" + ref.substr(kBuiltin.size()) + ".glb";
+        return contentDir + "/models/" + ref.substr(kBuiltin.size()) + ".glb";
     return joinPath(baseDir, ref);
 }
 
-Result<LoadedScene> loadSceneFile(const std::string& path) {
+Result<LoadedScene> loadSceneFile(const std::string& path, const std::string& contentDir) {
     const char* where = "dermis::loadSceneFile";
-    auto manifest = loadBuiltinManifest();
+    auto manifest = loadBuiltinManifest(contentDir);
     if (!manifest) return manifest.error();
     auto text = readText(path, where);
     if (!text) return text.error();
@@ -73,7 +74,7 @@ Result<LoadedScene> loadSceneFile(const std::string& path) {
     out.scene = std::move(*scene);
     out.baseDir = fs::path(path).parent_path().string();
 
-    const std::string modelPath = resolveModelPath(out.scene.model, out.baseDir);
+    const std::string modelPath = resolveModelPath(out.scene.model, out.baseDir, contentDir);
     auto model = loadGltfFile(modelPath);
     if (!model) {
         Error e = model.error();
@@ -90,7 +91,7 @@ Result<LoadedScene> loadSceneFile(const std::string& path) {
         if (auto it = out.scene.patterns.find(id); it != out.scene.patterns.end()) {
             file = joinPath(out.baseDir, it->second);
         } else if (const PatternInfo* info = manifest->find(id)) {
-            file = dermisDataDir() + "/patterns/" + info->file;
+            file = contentDir + "/patterns/" + info->file;
         } else {
             return makeError(ErrorCode::NotFound, where,
                              "/placements/" + std::to_string(i) + "/pattern",

@@ -1,8 +1,9 @@
 // Dermis io shell — scene documents on disk: reads the JSON, resolves paths relative to the
 // document and `builtin:` names, loads the model, pattern images and static base map.
 //
-// Built-in content lives in the pattern library folder (patterns/manifest.json) and the built-in
-// model folder; both are found through dermisDataDir().
+// Built-in content (the pattern library, built-in characters, the editor) lives in one content
+// folder, dermisContentDir(): code and content are apart from the server's data folder (uploads
+// and scenes, `serve --data`), which this file knows nothing of.
 #pragma once
 
 #include "core/bake.hpp"
@@ -16,17 +17,19 @@
 
 namespace dermis {
 
-/// Folder holding `patterns/` (and built-in models): $DERMIS_DATA_DIR if set, else the source
-/// tree the binary was built from.
-std::string dermisDataDir();
+/// The built-in content folder: `patterns/` (library + manifest.json), `models/` (built-in
+/// characters, the default pattern set) and `web/` (the editor). $DERMIS_CONTENT_DIR if set, else
+/// the source tree the binary was built from. Never written to.
+std::string dermisContentDir();
 
-/// The built-in pattern manifest (patterns/manifest.json). A missing manifest yields an empty
-/// library (custom patterns still work); a corrupt one is an error.
-Result<PatternManifest> loadBuiltinManifest();
+/// The built-in pattern manifest (<content>/patterns/manifest.json). A missing manifest yields an
+/// empty library (custom patterns still work); a corrupt one is an error.
+Result<PatternManifest> loadBuiltinManifest(const std::string& contentDir = dermisContentDir());
 
-/// Resolves a model reference of a scene: "builtin:<name>" → <data>/patterns/../models/<name>.glb,
-/// otherwise a path relative to `baseDir`.
-std::string resolveModelPath(const std::string& ref, const std::string& baseDir);
+/// Resolves a model reference of a scene: "builtin:<name>" → <content>/models/<name>.glb,
+/// otherwise a path relative to `baseDir` (absolute paths stay as they are).
+std::string resolveModelPath(const std::string& ref, const std::string& baseDir,
+                             const std::string& contentDir = dermisContentDir());
 
 struct LoadedScene {
     Scene scene;
@@ -36,7 +39,9 @@ struct LoadedScene {
     std::shared_ptr<const PatternImage> base; ///< heightmap.base, if any
 };
 
-/// Reads and validates a scene file and everything it references.
-Result<LoadedScene> loadSceneFile(const std::string& path);
+/// Reads and validates a scene file and everything it references (built-in names from
+/// `contentDir`).
+Result<LoadedScene> loadSceneFile(const std::string& path,
+                                  const std::string& contentDir = dermisContentDir());
 
 } // namespace dermis

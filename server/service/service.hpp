@@ -1,13 +1,21 @@
-// Dermis HTTP shell — the server's state and operations, without HTTP: models, patterns and
-// scene documents (persisted through Store), edits, renders through the one Renderer, live
-// change events. The HTTP layer (api.cpp) maps requests to these calls and their errors to
-// statuses in one place.
+// Dermis service — the server's state and operations, without HTTP: models, patterns and scene
+// documents (persisted through Store), edits, renders through one injected FrameRenderer, live
+// change events. The HTTP layer (server/http/api.cpp) maps requests to these calls and their
+// errors to statuses in one place; tests drive it directly (ServiceTest, with a CPU fake
+// renderer).
 //
-// Threads: every method may be called from any HTTP thread. State is guarded by one
-// reader/writer lock; an edit validates the whole new document first, writes it durably, then
-// swaps it in, so a failed edit changes nothing and an acknowledged one survives a crash. GL
-// work goes to the renderer's thread; at most `limits.queueLength` renders wait for it, more are
-// refused with ErrorCode::Unavailable (503 + Retry-After).
+// Threads: every method may be called from any thread. Mutations (edits, uploads, deletes) are
+// serialised by one writer lock and hold it while they validate the whole new state, write it
+// durably and swap it in, so a failed edit changes nothing and an acknowledged one survives a
+// crash. Readers and renders take a shared lock only to copy what they need (documents, the
+// model, the pattern images they use: shared, immutable): no reader waits for a render or for
+// a disk write, and a render never blocks an upload. GL work goes to the renderer's thread; at
+// most `limits.queueLength` renders wait for it, more are refused with ErrorCode::Unavailable
+// (503 + Retry-After).
+//
+// Files: service.cpp (open, info), service_models.cpp, service_patterns.cpp,
+// service_scenes.cpp (documents and edits), service_renders.cpp (frames, maps, batch),
+// service_events.cpp; shared private state in service_state.hpp.
 //
 // Documents that arrive here name models and patterns only by generated ids ("m_…", "p_…") or
 // built-in names ("builtin:default", "crease"); never by path.
@@ -70,9 +78,15 @@ struct FrameParams {
     std::optional<double> yaw, pitch, distance, time;
 };
 
-/// A server-sent-events subscription to one scene: events queue up until taken.
+/// A server-sent-events subscription to one scene: events (whole SSE messages) queue up until
+/// taken. A reader that falls kMaxQueued events behind loses them: the queue is replaced by one
+/// `resync` event ({"type": "resync", "scene"}) telling it to read the scene again, and nothing
+/// more is queued until it has taken that event, so a stalled reader costs bounded memory.
 class Subscription {
 public:
+    static constexpr std::size_t kMaxQueued = 1000;
+
+    explicit Subscription(std::string sceneId = "");
     /// Waits up to `timeoutMs` for an event; nullopt on timeout or when closed.
     std::optional<std::string> next(int timeoutMs);
     void push(std::string event);
@@ -83,13 +97,28 @@ private:
     mutable std::mutex mutex_;
     std::condition_variable cv_;
     std::deque<std::string> events_;
+    std::string sceneId_;
     bool closed_ = false;
+    bool resyncQueued_ = false;
+};
+
+/// Where a service keeps things and how far it goes.
+struct ServiceConfig {
+    std::string dataDir;    ///< uploads and scenes, written durably (`serve --data`)
+    std::string contentDir; ///< built-in content, read only (`serve --content`; dermisContentDir())
+    ServerLimits limits;
 };
 
 class Service {
 public:
-    /// Opens the data directory (loading every stored model, pattern and scene; unreadable files
-    /// are skipped and listed in warnings()), loads the built-in content and starts the renderer.
+    /// Loads the built-in content (pattern library, default character, default pattern set),
+    /// then opens the data directory (every stored model, pattern and scene; unreadable ones are
+    /// skipped and listed in warnings()). Renders go to `renderer` (owned). Fails when the content
+    /// is missing or corrupt — including a default.scene.json that exists but cannot be read,
+    /// parsed or validated (named in the message) — or the data directory cannot be written.
+    static Result<std::unique_ptr<Service>> open(const ServiceConfig& config,
+                                                 std::unique_ptr<FrameRenderer> renderer);
+    /// Same with the GL renderer on `backend` and the content in dermisContentDir().
     static Result<std::unique_ptr<Service>> open(const std::string& dataDir, GlBackend backend,
                                                  const ServerLimits& limits);
     ~Service();
@@ -107,7 +136,8 @@ public:
                                          const std::string& gltfName, const std::string& name);
     Result<nlohmann::json> getModel(const std::string& id) const;
     Status deleteModel(const std::string& id);
-    /// The UV wireframe: {"width","height"? no: "edges": [u0,v0,u1,v1, …]} (json) or a PNG.
+    /// The UV wireframe (core uvEdges): {"id", "edge_count", "edges": [u0,v0,u1,v1, …],
+    /// "convention"} (json), or a size×size PNG (core rasterizeUvEdges).
     Result<nlohmann::json> uvLayout(const std::string& id) const;
     Result<EncodedImage> uvLayoutPng(const std::string& id, int size) const;
 

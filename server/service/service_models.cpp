@@ -1,0 +1,223 @@
+// Characters: upload (.glb, or .gltf with its files), list, describe, delete, UV layout.
+#include "service/service_state.hpp"
+
+#include "core/uv_layout.hpp"
+#include "io/frame_io.hpp"
+#include "io/gltf_loader.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <set>
+
+namespace dermis {
+
+using namespace detail;
+namespace fs = std::filesystem;
+
+namespace {
+
+Error bodyTooLarge(const ServerLimits& limits, const char* where) {
+    return makeError(ErrorCode::TooLarge, where, "body",
+                     "larger than " + std::to_string(limits.maxUploadBytes) + " bytes");
+}
+
+/// An uploaded model must have triangles and stay within the triangle and joint limits.
+Status checkModel(const Model& m, const ServerLimits& limits, const char* where) {
+    if (m.parts.empty()) return makeError(ErrorCode::InvalidArgument, where, "/meshes", "no triangle meshes");
+    if (m.triangleCount() > limits.maxTriangles)
+        return makeError(ErrorCode::TooLarge, where, "/meshes",
+                         std::to_string(m.triangleCount()) + " triangles, the limit is " +
+                             std::to_string(limits.maxTriangles));
+    if (m.joints.size() > limits.maxJoints)
+        return makeError(ErrorCode::TooLarge, where, "/skins",
+                         std::to_string(m.joints.size()) + " joints, the limit is " +
+                             std::to_string(limits.maxJoints));
+    return Ok{};
+}
+
+json modelSummary(const ModelEntry& e) {
+    return {{"id", e.id},
+            {"name", e.name},
+            {"builtin", e.builtin},
+            {"triangles", e.model->triangleCount()},
+            {"joints", e.model->joints.size()},
+            {"clips", e.model->clips.size()},
+            {"has_uvs", e.model->hasUVs()},
+            {"bytes", e.bytes}};
+}
+
+} // namespace
+
+json Service::listModels() const {
+    std::shared_lock<std::shared_mutex> lock(state_->mutex);
+    json out = json::array();
+    for (const auto& [id, e] : state_->models)
+        out.push_back(modelSummary(e));
+    return {{"models", out}};
+}
+
+Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::string& name) {
+    const char* where = "dermis::Service::addModel";
+    if (glb.size() > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
+    if (glb.size() < 12 || std::memcmp(glb.data(), "glTF", 4) != 0)
+        return makeError(ErrorCode::Unsupported, where, "body",
+                         "not a binary glTF (.glb); send a .gltf with its files as multipart/form-data");
+    auto parsed = parseGltf(glb, ""); // no base folder: no file of this machine is read
+    if (!parsed) return parsed.error();
+    if (auto s = loadGltfResources(*parsed); !s) return s.error();
+    Model& m = parsed->model;
+    if (auto st = checkModel(m, limits_, where); !st) return st.error();
+    ModelEntry e;
+    e.id = Store::newId("m");
+    e.name = sanitizeName(name);
+    e.bytes = glb.size();
+    e.model = std::make_shared<const Model>(std::move(m));
+    std::lock_guard<std::mutex> write(state_->writeMutex);
+    if (auto s = state_->store->putBlob("models", e.id, "glb", glb,
+                                        {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
+        !s)
+        return s.error();
+    json summary = modelSummary(e);
+    std::unique_lock<std::shared_mutex> lock(state_->mutex);
+    state_->models[e.id] = std::move(e);
+    return summary;
+}
+
+Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const std::string& gltfName,
+                                    const std::string& name) {
+    const char* where = "dermis::Service::addModelFiles";
+    std::size_t total = 0;
+    std::set<std::string> names;
+    for (const UploadFile& f : files) {
+        total += f.bytes.size();
+        if (!Store::isSafeFileName(f.name))
+            return makeError(ErrorCode::InvalidArgument, where, "files/" + f.name,
+                             "a file name must be plain ([A-Za-z0-9._ -], no folders)");
+        if (!names.insert(f.name).second)
+            return makeError(ErrorCode::InvalidArgument, where, "files/" + f.name, "given twice");
+    }
+    if (total > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
+    if (gltfName.empty() || !names.count(gltfName))
+        return makeError(ErrorCode::InvalidArgument, where, "gltf",
+                         "no .gltf part (name the part \"gltf\" or give it a .gltf file name)");
+    // Parse from a private scratch folder: the loader reads external URIs only inside it.
+    const fs::path scratch = fs::path(state_->store->dir()) / ("upload.tmp." + Store::newId("u"));
+    std::error_code ec;
+    fs::create_directories(scratch, ec);
+    if (ec) return makeError(ErrorCode::Io, where, "", "cannot create a scratch folder: " + ec.message());
+    struct Cleanup {
+        fs::path p;
+        ~Cleanup() {
+            std::error_code e;
+            fs::remove_all(p, e);
+        }
+    } cleanup{scratch};
+    for (const UploadFile& f : files)
+        if (auto s = Store::writeFileDurably((scratch / f.name).string(), f.bytes); !s) return s.error();
+    auto model = loadGltfFile((scratch / gltfName).string());
+    if (!model) return model.error();
+    if (auto st = checkModel(*model, limits_, where); !st) return st.error();
+    ModelEntry e;
+    e.id = Store::newId("m");
+    e.name = sanitizeName(name.empty() ? gltfName : name);
+    e.bytes = total;
+    e.model = std::make_shared<const Model>(std::move(*model));
+    std::vector<std::pair<std::string, std::vector<std::uint8_t>>> stored;
+    for (const UploadFile& f : files)
+        stored.emplace_back(f.name, f.bytes);
+    std::lock_guard<std::mutex> write(state_->writeMutex);
+    if (auto s = state_->store->putBlobFolder("models", e.id, stored, gltfName,
+                                              {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
+        !s)
+        return s.error();
+    json summary = modelSummary(e);
+    std::unique_lock<std::shared_mutex> lock(state_->mutex);
+    state_->models[e.id] = std::move(e);
+    return summary;
+}
+
+Result<json> Service::getModel(const std::string& id) const {
+    std::shared_lock<std::shared_mutex> lock(state_->mutex);
+    auto it = state_->models.find(id);
+    if (it == state_->models.end()) return notFound("id", "no model \"" + id + "\"");
+    const Model& m = *it->second.model;
+    json out = modelSummary(it->second);
+    json joints = json::array();
+    for (int n : m.joints) {
+        const Node& node = m.nodes[static_cast<std::size_t>(n)];
+        const int parent = m.parentJoint(n);
+        const glm::quat& q = node.rotation;
+        joints.push_back({{"name", node.name},
+                          {"parent", parent >= 0 ? json(m.nodes[static_cast<std::size_t>(parent)].name) : json()},
+                          {"rest_rotation", {q.x, q.y, q.z, q.w}}});
+    }
+    json clips = json::array();
+    for (const Clip& c : m.clips)
+        clips.push_back({{"name", c.name}, {"duration", c.duration}});
+    std::size_t vertices = 0;
+    for (const MeshPart& p : m.parts)
+        vertices += p.positions.size();
+    out["joints"] = std::move(joints);
+    out["joint_count"] = m.joints.size();
+    out["clips"] = std::move(clips);
+    out["vertices"] = vertices;
+    return out;
+}
+
+Status Service::deleteModel(const std::string& id) {
+    std::lock_guard<std::mutex> write(state_->writeMutex);
+    {
+        std::shared_lock<std::shared_mutex> lock(state_->mutex);
+        auto it = state_->models.find(id);
+        if (it == state_->models.end()) return notFound("id", "no model \"" + id + "\"");
+        if (it->second.builtin)
+            return makeError(ErrorCode::Conflict, "dermis::Service", "id", "built-in models cannot be deleted");
+        for (const auto& [sid, s] : state_->scenes)
+            if (s.scene.model == id)
+                return makeError(ErrorCode::Conflict, "dermis::Service", "id",
+                                 "model \"" + id + "\" is used by scene " + sid);
+    }
+    if (auto s = state_->store->removeBlob("models", id); !s) return s;
+    std::unique_lock<std::shared_mutex> lock(state_->mutex);
+    state_->models.erase(id); // renders that hold the model keep it alive until they finish
+    return Ok{};
+}
+
+namespace {
+
+/// The model behind `id` (kept alive by the caller's copy), under a shared lock.
+Result<std::shared_ptr<const Model>> findModel(const Service::State& st, const std::string& id) {
+    std::shared_lock<std::shared_mutex> lock(st.mutex);
+    auto it = st.models.find(id);
+    if (it == st.models.end()) return notFound("id", "no model \"" + id + "\"");
+    if (!it->second.model->hasUVs()) return bad("id", "model \"" + id + "\" has no TEXCOORD_0");
+    return it->second.model;
+}
+
+} // namespace
+
+Result<json> Service::uvLayout(const std::string& id) const {
+    auto model = findModel(*state_, id);
+    if (!model) return model.error();
+    const std::vector<UvEdge> edges = uvEdges(**model);
+    json flat = json::array();
+    auto r5 = [](float v) { return std::round(double(v) * 1e5) / 1e5; };
+    for (const UvEdge& e : edges)
+        for (float v : {e.a.x, e.a.y, e.b.x, e.b.y})
+            flat.push_back(r5(v));
+    return json{{"id", id}, {"edge_count", edges.size()}, {"edges", std::move(flat)},
+                {"convention", "u right, v down; each edge is u0, v0, u1, v1"}};
+}
+
+Result<EncodedImage> Service::uvLayoutPng(const std::string& id, int size) const {
+    if (size < 16 || size > limits_.maxRenderSide)
+        return bad("size", "must be in [16, " + std::to_string(limits_.maxRenderSide) + "]");
+    auto model = findModel(*state_, id);
+    if (!model) return model.error();
+    auto png = encodePng(rasterizeUvEdges(uvEdges(**model), size), true);
+    if (!png) return png.error();
+    return EncodedImage{std::move(*png), "image/png", ""};
+}
+
+} // namespace dermis

@@ -1,0 +1,128 @@
+// Pattern images: built-in library and uploads; list, preview, delete.
+#include "service/service_state.hpp"
+
+#include "core/preview.hpp"
+#include "io/frame_io.hpp"
+#include "io/image_io.hpp"
+
+#include <algorithm>
+
+namespace dermis {
+
+using namespace detail;
+
+namespace {
+
+json patternSummary(const PatternEntry& e, const HeightImage* img) {
+    json j = {{"id", e.id}, {"name", e.name}, {"builtin", e.builtin}};
+    if (img) {
+        j["width"] = img->width;
+        j["height"] = img->height;
+    }
+    if (e.info) {
+        j["kind"] = std::string(toString(e.info->kind));
+        j["model"] = std::string(toString(e.info->model));
+        j["target"] = std::string(toString(e.info->target));
+        j["joint"] = e.info->joint;
+        j["axis"] = e.info->axis;
+        j["theta_min"] = e.info->thetaMin;
+        j["theta_max"] = e.info->thetaMax;
+        j["description"] = e.info->description;
+    } else {
+        j["bytes"] = e.bytes;
+    }
+    return j;
+}
+
+std::string sniffExtension(const std::vector<std::uint8_t>& b) {
+    auto starts = [&](std::initializer_list<std::uint8_t> m) {
+        return b.size() >= m.size() && std::equal(m.begin(), m.end(), b.begin());
+    };
+    if (starts({0x89, 'P', 'N', 'G'})) return "png";
+    if (starts({0xFF, 0xD8, 0xFF})) return "jpg";
+    if (starts({'I', 'I', 42, 0}) || starts({'M', 'M', 0, 42})) return "tif";
+    if (starts({0x76, 0x2F, 0x31, 0x01})) return "exr";
+    if (starts({'8', 'B', 'P', 'S'})) return "psd";
+    return "img";
+}
+
+} // namespace
+
+json Service::listPatterns() const {
+    std::shared_lock<std::shared_mutex> lock(state_->mutex);
+    json out = json::array();
+    for (const auto& [id, e] : state_->patterns) {
+        auto img = state_->images.find(id);
+        out.push_back(patternSummary(e, img == state_->images.end() ? nullptr : &img->second->pixels));
+    }
+    return {{"patterns", out}};
+}
+
+Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+    const char* where = "dermis::Service::addPattern";
+    if (bytes.size() > limits_.maxUploadBytes)
+        return makeError(ErrorCode::TooLarge, where, "body",
+                         "larger than " + std::to_string(limits_.maxUploadBytes) + " bytes");
+    auto img = readHeightImageFromMemory(bytes);
+    if (!img) return img.error();
+    if (img->width > limits_.maxImageSide || img->height > limits_.maxImageSide)
+        return makeError(ErrorCode::TooLarge, where, "body",
+                         "image is " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+                             ", the limit is " + std::to_string(limits_.maxImageSide) + " per side");
+    PatternEntry e;
+    e.id = Store::newId("p");
+    e.name = sanitizeName(name);
+    e.bytes = bytes.size();
+    auto stored = makePatternImage(std::move(*img));
+    json summary = patternSummary(e, &stored->pixels);
+    std::lock_guard<std::mutex> write(state_->writeMutex);
+    if (auto s = state_->store->putBlob("patterns", e.id, sniffExtension(bytes), bytes,
+                                        {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
+        !s)
+        return s.error();
+    std::unique_lock<std::shared_mutex> lock(state_->mutex);
+    state_->images[e.id] = std::move(stored);
+    state_->patterns[e.id] = std::move(e);
+    return summary;
+}
+
+Result<EncodedImage> Service::patternImage(const std::string& id, int size) const {
+    if (size < 1 || size > 2048) return bad("size", "must be in [1, 2048]");
+    std::shared_ptr<const PatternImage> src;
+    {
+        std::shared_lock<std::shared_mutex> lock(state_->mutex);
+        auto it = state_->images.find(id);
+        if (it == state_->images.end() || !state_->patterns.count(id))
+            return notFound("id", "no pattern \"" + id + "\"");
+        src = it->second;
+    }
+    auto png = encodePng(heightPreview(src->pixels, size), false);
+    if (!png) return png.error();
+    return EncodedImage{std::move(*png), "image/png", ""};
+}
+
+Status Service::deletePattern(const std::string& id) {
+    std::lock_guard<std::mutex> write(state_->writeMutex);
+    {
+        std::shared_lock<std::shared_mutex> lock(state_->mutex);
+        auto it = state_->patterns.find(id);
+        if (it == state_->patterns.end()) return notFound("id", "no pattern \"" + id + "\"");
+        if (it->second.builtin)
+            return makeError(ErrorCode::Conflict, "dermis::Service", "id", "built-in patterns cannot be deleted");
+        for (const auto& [sid, s] : state_->scenes) {
+            bool used = s.scene.heightmapBase && *s.scene.heightmapBase == id;
+            for (const auto& [alias, target] : s.scene.patterns)
+                used = used || target == id;
+            if (used)
+                return makeError(ErrorCode::Conflict, "dermis::Service", "id",
+                                 "pattern \"" + id + "\" is used by scene " + sid);
+        }
+    }
+    if (auto s = state_->store->removeBlob("patterns", id); !s) return s;
+    std::unique_lock<std::shared_mutex> lock(state_->mutex);
+    state_->images.erase(id); // a render in flight keeps its copy alive
+    state_->patterns.erase(id);
+    return Ok{};
+}
+
+} // namespace dermis

@@ -1,0 +1,135 @@
+// Dermis service — private: the state every service_*.cpp file shares, its locks and the helpers
+// they have in common. Not installed, not included outside server/service/.
+//
+// Locks (order: writeMutex, then mutex):
+//   writeMutex  serialises mutations (edits, uploads, deletes). A mutation holds it for its whole
+//               run: validate against the current state, write durably, swap in, announce. So
+//               nothing changes between its check and its swap, and its events go out in order.
+//   mutex       guards the maps below. Mutations take it exclusively only to swap (no I/O and no
+//               parsing under it); readers and renders take it shared to copy what they need.
+// Pattern images are shared and immutable (core PatternImage): a render keeps the ones it uses
+// alive after the lock is released, so deleting a pattern never waits for a render.
+#pragma once
+
+#include "service/service.hpp"
+
+#include "core/frame_plan.hpp"
+
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <shared_mutex>
+#include <string>
+
+namespace dermis {
+
+using json = nlohmann::json;
+
+namespace detail {
+
+inline constexpr const char* kBuiltinDefault = "builtin:default";
+
+struct ModelEntry {
+    std::string id, name;
+    std::shared_ptr<const Model> model;
+    std::size_t bytes = 0;
+    bool builtin = false;
+};
+
+struct PatternEntry {
+    std::string id, name;
+    bool builtin = false;
+    std::size_t bytes = 0;
+    const PatternInfo* info = nullptr; ///< manifest entry of a built-in pattern
+};
+
+struct SceneEntry {
+    json doc; ///< canonical document (toJson of scene)
+    Scene scene;
+    std::uint64_t revision = 1;
+};
+
+Error bad(const std::string& field, const std::string& what);
+Error notFound(const std::string& field, const std::string& what);
+Error queueFull();
+double nowSeconds();
+/// [A-Za-z0-9_. -] only, at most 64 characters.
+std::string sanitizeName(const std::string& name);
+
+/// Counts renders waiting for or using the renderer; refuses beyond the queue length.
+class QueueSlot {
+public:
+    QueueSlot(std::atomic<int>& n, int limit) : n_(n) { ok_ = n_.fetch_add(1) < limit; }
+    ~QueueSlot() { n_.fetch_sub(1); }
+    QueueSlot(const QueueSlot&) = delete;
+    QueueSlot& operator=(const QueueSlot&) = delete;
+    bool ok() const { return ok_; }
+
+private:
+    std::atomic<int>& n_;
+    bool ok_ = false;
+};
+
+} // namespace detail
+
+struct Service::State {
+    std::optional<Store> store;
+    std::unique_ptr<FrameRenderer> renderer;
+    std::string contentDir;
+    PatternManifest manifest;
+    json defaultSceneDoc; ///< the default pattern set (null when not installed)
+    ServerLimits limits;
+
+    std::mutex writeMutex;
+    mutable std::shared_mutex mutex;
+    std::map<std::string, detail::ModelEntry> models;
+    std::map<std::string, detail::PatternEntry> patterns;
+    PatternImages images; ///< by pattern id, built-in and uploaded
+    std::map<std::string, detail::SceneEntry> scenes;
+
+    std::mutex subsMutex;
+    std::multimap<std::string, std::shared_ptr<Subscription>> subs;
+
+    std::atomic<int> inFlight{0};
+
+    /// The scene a document describes, validated against this server's models and patterns.
+    struct Prepared {
+        Scene scene;
+        json canonical;
+        std::shared_ptr<const Model> model;
+    };
+    /// Caller holds `mutex` (shared is enough). Without `withLimits` only the document and its
+    /// references are checked, not this server's configured limits (the default pattern set).
+    Result<Prepared> prepare(const json& doc, bool withLimits = true) const;
+    /// Placement patterns with their aliases replaced by pattern ids.
+    Scene resolved(const Scene& scene) const;
+
+    /// What a render needs, copied under a shared lock so that it runs unlocked.
+    struct Snapshot {
+        Scene scene; ///< resolved
+        std::shared_ptr<const Model> model;
+        PatternImages images; ///< the ones the scene uses
+        std::shared_ptr<const PatternImage> base;
+    };
+    Result<Snapshot> snapshot(const std::string& id) const;
+    /// Same for a document that is not stored (batch); caller holds `mutex` shared.
+    Snapshot snapshotOf(const Scene& scene, std::shared_ptr<const Model> model) const;
+
+    /// Validates `newDoc`, writes it durably, swaps it in and announces it. Caller holds
+    /// `writeMutex` (and not `mutex`).
+    Result<json> commit(const std::string& id, const json& newDoc, const char* what, bool create);
+    /// Takes `writeMutex`, copies scene `id`'s document, lets `change` modify the copy, commits.
+    Result<json> edit(const std::string& id, const char* what, const std::function<Status(json&)>& change);
+    void publish(const std::string& sceneId, const json& event);
+
+    /// Plans and renders one frame of `snap` with `p`'s overrides; encodes it.
+    Result<EncodedImage> render(const Snapshot& snap, const FrameParams& p);
+
+    /// Loading at open: built-in content, then stored uploads and scenes (warnings collected).
+    Status loadContent();
+    void loadStored(std::vector<std::string>& warnings);
+};
+
+} // namespace dermis
