@@ -354,15 +354,12 @@ Status parsePatterns(const Reader& rd, const json& v, const PatternManifest& man
     return Ok{};
 }
 
-/// One placement. `reservedIds` holds every explicit id of the document (so generated ids avoid
-/// them); `seenIds` the ids of the placements before this one.
-Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const Scene& scene,
-                      const PatternManifest& manifest, const std::set<std::string>& reservedIds,
-                      std::set<std::string>& seenIds, Placement& out) {
-    const std::string ptr = member("/placements", index);
-    if (auto s = rd.object(v, ptr); !s) return s;
-
-    // id: explicit (validated, unique) or generated "p<index>" (suffixed if that is taken).
+/// A placement's id: explicit (validated, unique) or generated "p<index>" (suffixed if that is
+/// taken). `reservedIds` holds every explicit id of the document (so generated ids avoid them);
+/// `seenIds` the ids of the placements before this one.
+Status parsePlacementId(const Reader& rd, const json& v, const std::string& ptr, std::size_t index,
+                        const std::set<std::string>& reservedIds, std::set<std::string>& seenIds,
+                        Placement& out) {
     if (const json* id = Reader::find(v, "id")) {
         auto s = rd.string(*id, ptr + "/id");
         if (!s) return s.error();
@@ -379,8 +376,13 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
         out.id = generated;
     }
     seenIds.insert(out.id);
+    return Ok{};
+}
 
-    // pattern (required): a custom pattern of this scene or a built-in one. Its defaults follow.
+/// The pattern (required): a custom pattern of this scene or a built-in one, whose manifest entry
+/// supplies the defaults that the placement's own fields may then override.
+Status parsePlacementPattern(const Reader& rd, const json& v, const std::string& ptr,
+                             const Scene& scene, const PatternManifest& manifest, Placement& out) {
     const json* pattern = Reader::find(v, "pattern");
     if (!pattern) return rd.bad(ptr + "/pattern", "is required");
     auto patternId = rd.string(*pattern, ptr + "/pattern");
@@ -406,7 +408,11 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
                           "': neither a key of \"patterns\" nor a built-in pattern id",
                       ErrorCode::NotFound);
     }
+    return Ok{};
+}
 
+/// Where the footprint sits in texture space: center, scale, rotation.
+Status parsePlacementFootprint(const Reader& rd, const json& v, const std::string& ptr, Placement& out) {
     if (const json* c = Reader::find(v, "center")) {
         auto uv = rd.numbers<2>(*c, ptr + "/center");
         if (!uv) return uv.error();
@@ -427,7 +433,11 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
         if (!d) return d.error();
         out.rotation = *d;
     }
+    return Ok{};
+}
 
+/// What drives it (paper eq. 1–2 inputs): joint (required), axis, theta range, h.
+Status parsePlacementDriver(const Reader& rd, const json& v, const std::string& ptr, Placement& out) {
     const json* joint = Reader::find(v, "joint");
     if (!joint) return rd.bad(ptr + "/joint", "is required");
     auto jointName = rd.string(*joint, ptr + "/joint");
@@ -470,7 +480,11 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
         if (!d) return d.error();
         out.h = *d;
     }
+    return Ok{};
+}
 
+/// How it deforms: model, target map, response curve.
+Status parsePlacementModel(const Reader& rd, const json& v, const std::string& ptr, Placement& out) {
     if (const json* m = Reader::find(v, "model")) {
         auto e = rd.enumeration(*m, ptr + "/model", deformModelFromString, "\"scale\" or \"bias\"");
         if (!e) return e.error();
@@ -489,6 +503,19 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
         out.response = *e;
     }
     return Ok{};
+}
+
+/// One placement, field groups in document order of precedence (the pattern's defaults first).
+Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const Scene& scene,
+                      const PatternManifest& manifest, const std::set<std::string>& reservedIds,
+                      std::set<std::string>& seenIds, Placement& out) {
+    const std::string ptr = member("/placements", index);
+    if (auto s = rd.object(v, ptr); !s) return s;
+    if (auto s = parsePlacementId(rd, v, ptr, index, reservedIds, seenIds, out); !s) return s;
+    if (auto s = parsePlacementPattern(rd, v, ptr, scene, manifest, out); !s) return s;
+    if (auto s = parsePlacementFootprint(rd, v, ptr, out); !s) return s;
+    if (auto s = parsePlacementDriver(rd, v, ptr, out); !s) return s;
+    return parsePlacementModel(rd, v, ptr, out);
 }
 
 Status parsePlacements(const Reader& rd, const json& v, const PatternManifest& manifest,
