@@ -26,23 +26,6 @@
 
 namespace dermis {
 
-std::string_view toString(GlBackend b) {
-    switch (b) {
-    case GlBackend::Auto: return "auto";
-    case GlBackend::EglDevice: return "egl-device";
-    case GlBackend::EglSurfaceless: return "egl-surfaceless";
-    case GlBackend::OsMesa: return "osmesa";
-    }
-    return "auto";
-}
-
-std::optional<GlBackend> glBackendFromString(std::string_view s) {
-    for (GlBackend b : {GlBackend::Auto, GlBackend::EglDevice, GlBackend::EglSurfaceless,
-                        GlBackend::OsMesa})
-        if (toString(b) == s) return b;
-    return std::nullopt;
-}
-
 namespace {
 
 std::pair<glm::vec3, glm::vec3> boundsOf(const std::vector<SkinnedPart>& parts) {

@@ -28,22 +28,16 @@
 #include "core/result.hpp"
 #include "core/rig.hpp"
 #include "core/scene.hpp"
+#include "gl/gl_backend.hpp"
 
 #include <glm/glm.hpp>
 
 #include <memory>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 namespace dermis {
-
-/// Where the GL context comes from. Auto tries EglDevice (a hardware EGL device, NVIDIA first),
-/// then EglSurfaceless (Mesa's surfaceless platform: llvmpipe without a GPU), then OsMesa.
-enum class GlBackend { Auto, EglDevice, EglSurfaceless, OsMesa };
-std::string_view toString(GlBackend b); ///< "auto", "egl-device", "egl-surfaceless", "osmesa"
-std::optional<GlBackend> glBackendFromString(std::string_view s);
 
 struct RendererInfo {
     std::string backend;    ///< the backend that started: "egl-device", "egl-surfaceless", "osmesa"
