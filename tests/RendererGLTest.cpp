@@ -5,9 +5,11 @@
 //
 // Checks: uniform-block mirrors; GPU height maps equal the CPU reference within 2e-3 away from
 // footprint edges (rotated, non-square, overlapping placements, every model and response, base
-// map; and the default scene); GPU skinning equals CPU skinning within 1e-4 (CesiumMan, default
-// character); reference images of the default character in three poses; frames of CesiumMan
-// and KayKit Barbarian are non-empty and change with time; MSAA, tessellation, displacement.
+// map; and the default scene); pattern and base textures follow their content (ids, or the
+// pixels' hash when an image has none, so in-place edits are seen); GPU skinning equals CPU
+// skinning within 1e-4 (CesiumMan, default character); reference images of the default
+// character in three poses; frames of CesiumMan and KayKit Barbarian are non-empty and change
+// with time; MSAA, tessellation, displacement.
 #include "core/bake.hpp"
 #include "gl/renderer.hpp"
 #include "SceneFrame.hpp"
@@ -297,6 +299,128 @@ TEST_F(RendererGLTest, HeightPassRejectsBadInput) {
     auto ok = gl().bakeHeightMaps(in);
     ASSERT_TRUE(ok) << ok.error().message;
     EXPECT_EQ(ok->bump.data, std::vector<float>(64 * 64, 0.0f));
+}
+
+// --- stage 1: texture caches keyed by content id ----------------------------------------------
+
+/// GPU and CPU maps of `in` agree within 2e-3 away from footprint edges (see compareMaps).
+void expectMatchesCpu(const HeightMaps& gpu, const HeightPassInput& in) {
+    auto cpu = bakeHeightMaps(in);
+    ASSERT_TRUE(cpu) << cpu.error().message;
+    for (auto [g, c] : {std::pair{&gpu.bump, &cpu->bump},
+                        std::pair{&gpu.displacement, &cpu->displacement}}) {
+        const MapComparison r = compareMaps(*g, *c, in.placements);
+        EXPECT_LE(r.maxDiff, 2e-3f);
+        EXPECT_GT(r.compared, 0u);
+    }
+}
+
+TEST_F(RendererGLTest, BaseMapWithoutAnIdIsUploadedAgainWhenItsPixelsChangeInPlace) {
+    // The cache used to be keyed by the image's address: the same object with new pixels (same
+    // address, same size) would have kept the old texture, and the height pass would be skipped.
+    HeightImage base = testPattern(40, 30, 2.0, 1.0);
+    HeightPassInput in;
+    in.base = &base; // baseId 0: the renderer hashes the pixels
+    in.width = 80;
+    in.height = 60;
+    auto first = gl().bakeHeightMaps(in);
+    ASSERT_TRUE(first) << first.error().message;
+    expectMatchesCpu(*first, in);
+
+    const float* address = base.data.data();
+    for (float& v : base.data) v = 0.5f - 0.75f * v;
+    ASSERT_EQ(base.data.data(), address);
+    const auto before = gl().stats();
+    auto second = gl().bakeHeightMaps(in);
+    ASSERT_TRUE(second) << second.error().message;
+    EXPECT_EQ(gl().stats().heightPasses, before.heightPasses + 1) << "the pass must run again";
+    EXPECT_NE(second->bump.data, first->bump.data);
+    expectMatchesCpu(*second, in);
+}
+
+TEST_F(RendererGLTest, PatternWithoutAnIdIsUploadedAgainWhenItsPixelsChangeInPlace) {
+    HeightImage pattern = testPattern(48, 32, 1.0, 1.5);
+    BakePlacement p;
+    p.pattern = &pattern; // patternId 0: the renderer hashes the pixels
+    p.footprint.center = {0.5, 0.45};
+    p.footprint.scale = {0.6, 0.5};
+    p.footprint.rotationDeg = 20.0;
+    p.target = Target::Displacement;
+    p.t = 0.6;
+    HeightPassInput in;
+    in.placements = {p};
+    in.width = 96;
+    in.height = 96;
+    auto first = gl().bakeHeightMaps(in);
+    ASSERT_TRUE(first) << first.error().message;
+    expectMatchesCpu(*first, in);
+
+    const float* address = pattern.data.data();
+    for (float& v : pattern.data) v = -v;
+    ASSERT_EQ(pattern.data.data(), address);
+    const auto before = gl().stats();
+    auto second = gl().bakeHeightMaps(in);
+    ASSERT_TRUE(second) << second.error().message;
+    EXPECT_EQ(gl().stats().heightPasses, before.heightPasses + 1) << "the pass must run again";
+    EXPECT_NE(second->displacement.data, first->displacement.data);
+    expectMatchesCpu(*second, in);
+}
+
+TEST_F(RendererGLTest, PatternTexturesAreCachedByContentId) {
+    const auto a = makePatternImage(testPattern(32, 32, 1.0, 2.0));
+    const auto b = makePatternImage(testPattern(32, 32, 2.5, 0.5));
+    ASSERT_NE(a->contentId, b->contentId);
+    auto inputFor = [](const PatternImage& image) {
+        BakePlacement p;
+        p.pattern = &image.pixels;
+        p.patternId = image.contentId;
+        p.footprint.center = {0.5, 0.5};
+        p.footprint.scale = {0.5, 0.5};
+        p.t = 0.7;
+        HeightPassInput in;
+        in.placements = {p};
+        in.width = 64;
+        in.height = 64;
+        return in;
+    };
+    auto mapA = gl().bakeHeightMaps(inputFor(*a));
+    auto mapB = gl().bakeHeightMaps(inputFor(*b));
+    ASSERT_TRUE(mapA && mapB);
+    // Different ids with different pixels: different maps, each the CPU reference's.
+    EXPECT_NE(mapA->bump.data, mapB->bump.data);
+    expectMatchesCpu(*mapA, inputFor(*a));
+    expectMatchesCpu(*mapB, inputFor(*b));
+
+    // The same inputs again: the height pass is skipped and the maps are the same.
+    auto before = gl().stats();
+    auto again = gl().bakeHeightMaps(inputFor(*b));
+    ASSERT_TRUE(again);
+    EXPECT_EQ(gl().stats().heightPassesSkipped, before.heightPassesSkipped + 1);
+    EXPECT_EQ(again->bump.data, mapB->bump.data);
+
+    // Back to a's id: its cached texture is used, bit for bit the first map.
+    before = gl().stats();
+    auto backToA = gl().bakeHeightMaps(inputFor(*a));
+    ASSERT_TRUE(backToA);
+    EXPECT_EQ(gl().stats().heightPasses, before.heightPasses + 1);
+    EXPECT_EQ(backToA->bump.data, mapA->bump.data);
+
+    // An id names its content: a placement that gives a's id is drawn with a's cached texture,
+    // whatever pixels it points to (PatternImage ids are never reused for other pixels).
+    HeightPassInput mislabelled = inputFor(*b);
+    mislabelled.placements[0].patternId = a->contentId;
+    mislabelled.placements[0].h = 1.0 + 1e-9; // not the key of the maps the targets hold
+    before = gl().stats();
+    auto byId = gl().bakeHeightMaps(mislabelled);
+    ASSERT_TRUE(byId);
+    EXPECT_EQ(gl().stats().heightPasses, before.heightPasses + 1);
+    EXPECT_EQ(byId->bump.data, mapA->bump.data);
+
+    // After forgetPatterns the textures are uploaded again from the pixels given.
+    gl().forgetPatterns();
+    auto reloaded = gl().bakeHeightMaps(inputFor(*a));
+    ASSERT_TRUE(reloaded);
+    EXPECT_EQ(reloaded->bump.data, mapA->bump.data);
 }
 
 // --- stage 2: skinning --------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 //   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B] [limits]
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
 #include "core/normalmap.hpp"
+#include "gl/gl_backend.hpp"
 #include "gl/renderer.hpp"
 #include "core/frame_plan.hpp"
 #include "io/frame_io.hpp"

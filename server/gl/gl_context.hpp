@@ -6,7 +6,8 @@
 // library is opened with dlopen only when that backend is tried. No EGL/GL types in this header.
 #pragma once
 
-#include "gl/renderer.hpp"
+#include "core/result.hpp"
+#include "gl/gl_backend.hpp"
 
 #include <memory>
 #include <string>

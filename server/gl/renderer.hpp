@@ -6,7 +6,11 @@
 //            skipped when a frame's inputs equal those of the maps already rendered;
 //   stage 2: the character — linear blend skinning in the vertex shader, displacement along the
 //            skinned normal (per vertex, or per tessellated vertex), bump mapping, base colour,
-//            simple lighting, MSAA, sRGB output, an orbit camera framed on the posed bounds.
+//            simple lighting, MSAA, sRGB output, an orbit camera framed on the posed bounds
+//            (core/camera.hpp: the same matrices a pick uses to cast rays from pixels).
+//
+// Files: this façade and the render thread in renderer.cpp; Renderer::Impl in renderer_impl.hpp;
+// model uploads in gpu_model.cpp; stage 1 in height_pass.cpp; stage 2 in frame_pass.cpp.
 //
 // Ownership and threads: a Renderer owns one GL context and one render thread that is the only
 // thread ever touching GL. Every public method may be called from any thread: it queues a job to
@@ -28,22 +32,16 @@
 #include "core/result.hpp"
 #include "core/rig.hpp"
 #include "core/scene.hpp"
+#include "gl/gl_backend.hpp"
 
 #include <glm/glm.hpp>
 
 #include <memory>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 namespace dermis {
-
-/// Where the GL context comes from. Auto tries EglDevice (a hardware EGL device, NVIDIA first),
-/// then EglSurfaceless (Mesa's surfaceless platform: llvmpipe without a GPU), then OsMesa.
-enum class GlBackend { Auto, EglDevice, EglSurfaceless, OsMesa };
-std::string_view toString(GlBackend b); ///< "auto", "egl-device", "egl-surfaceless", "osmesa"
-std::optional<GlBackend> glBackendFromString(std::string_view s);
 
 struct RendererInfo {
     std::string backend;    ///< the backend that started: "egl-device", "egl-surfaceless", "osmesa"
@@ -127,7 +125,9 @@ public:
     };
     Stats stats();
 
-    /// Drops cached pattern textures (next use re-uploads) and models whose owner is gone.
+    /// Drops the cached pattern and base textures (next use re-uploads them) and forgets what the
+    /// height targets hold, so the next height pass runs. Models are not touched here: a model
+    /// whose owner is gone is dropped at the next frame or skinning job.
     void forgetPatterns();
 
     /// Introspection for UniformBlockGLTest: the GL's size of a uniform block and the offsets of

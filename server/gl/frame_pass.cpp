@@ -1,0 +1,303 @@
+// Stage 2 of the renderer: frame targets, the skin pass (skinning, displacement, bump mapping,
+// shading under the camera of core/camera.hpp), readback, and transform-feedback skinning
+// (see renderer_impl.hpp).
+#include "gl/renderer_impl.hpp"
+
+#include "gl/uniform_blocks.hpp"
+
+#include "core/camera.hpp"
+#include "core/render_settings.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace dermis {
+
+using namespace gl;
+
+namespace {
+
+/// Colour or depth storage of a frame target, multisampled when samples > 1.
+void renderbufferStorage(GLuint rb, int samples, GLenum format, int w, int h) {
+    glBindRenderbuffer(GL_RENDERBUFFER, rb);
+    if (samples > 1)
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
+    else
+        glRenderbufferStorage(GL_RENDERBUFFER, format, w, h);
+}
+
+} // namespace
+
+void FrameTargets::destroy() {
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteFramebuffers(1, &resolveFbo);
+    glDeleteRenderbuffers(1, &color);
+    glDeleteRenderbuffers(1, &depth);
+    glDeleteRenderbuffers(1, &resolveColor);
+    glDeleteBuffers(1, &pbo);
+    *this = FrameTargets{};
+}
+
+Status Renderer::Impl::ensureFrameTargets(int w, int h, int samples) {
+    if (frame.fbo && frame.width == w && frame.height == h && frame.samples == samples) return Ok{};
+    frame.destroy();
+    frame.width = w;
+    frame.height = h;
+    frame.samples = samples;
+    glGenFramebuffers(1, &frame.fbo);
+    glGenRenderbuffers(1, &frame.color);
+    glGenRenderbuffers(1, &frame.depth);
+    renderbufferStorage(frame.color, samples, GL_SRGB8_ALPHA8, w, h);
+    renderbufferStorage(frame.depth, samples, GL_DEPTH_COMPONENT24, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, frame.color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, frame.depth);
+    bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    if (samples > 1) {
+        glGenFramebuffers(1, &frame.resolveFbo);
+        glGenRenderbuffers(1, &frame.resolveColor);
+        renderbufferStorage(frame.resolveColor, 1, GL_SRGB8_ALPHA8, w, h);
+        glBindFramebuffer(GL_FRAMEBUFFER, frame.resolveFbo);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                  frame.resolveColor);
+        complete = complete && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    }
+    glGenBuffers(1, &frame.pbo);
+    frame.pboSize = static_cast<std::size_t>(w) * h * 4;
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, frame.pbo);
+    glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(frame.pboSize), nullptr, GL_STREAM_READ);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    if (!complete) {
+        frame.destroy();
+        return makeError(ErrorCode::Internal, kWhere, "/render/size",
+                         "the GL cannot create a " + std::to_string(w) + "x" + std::to_string(h) +
+                             " frame with " + std::to_string(samples) + " samples");
+    }
+    return checkGl("creating the frame targets");
+}
+
+// --- one frame ----------------------------------------------------------------------------------
+
+/// Render settings by the core's one check (validateRenderSettings), then the GL's renderbuffer
+/// limit; a model must be given.
+Status Renderer::Impl::checkFrameRequest(const FrameRequest& req) const {
+    const RenderSettings& rs = req.render;
+    if (auto s = validateRenderSettings(rs, {}, kWhere); !s) return s;
+    if (rs.size[0] > maxRenderbufferSize || rs.size[1] > maxRenderbufferSize)
+        return makeError(ErrorCode::InvalidArgument, kWhere, "/render/size",
+                         "each side must be at most the GL's renderbuffer limit " +
+                             std::to_string(maxRenderbufferSize));
+    if (!req.model) return makeError(ErrorCode::InvalidArgument, kWhere, "model", "no model");
+    return Ok{};
+}
+
+Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
+    if (auto s = checkFrameRequest(req); !s) return s.error();
+    const RenderSettings& rs = req.render;
+    const int W = rs.size[0], H = rs.size[1];
+    const Model& model = *req.model;
+
+    FrameResult out;
+    auto gm = modelFor(req.model);
+    if (!gm) return gm.error();
+
+    // Stage 1: the height maps this frame samples.
+    auto t0 = std::chrono::steady_clock::now();
+    auto heightSource = heightStage(req, out);
+    if (!heightSource) return heightSource.error();
+    if (req.profile) glFinish();
+    out.timings.heightMs = msSince(t0);
+
+    // Stage 2: skin, displace, shade.
+    t0 = std::chrono::steady_clock::now();
+    const int samples = std::min(rs.msaa, std::max(1, info.maxSamples));
+    if (auto s = ensureFrameTargets(W, H, samples); !s) return s.error();
+    uploadPalette(model, **gm, req.world);
+    const double dispScale = rs.displacementScale ? *rs.displacementScale : (*gm)->autoDisplacement;
+    const double bumpScale = 0.25 * (*gm)->autoDisplacement * rs.bumpStrength;
+    // Framed on the posed bounds (CPU skinning of the same pose: cheap at these sizes).
+    const Bounds bounds = framingBounds(skin(model, req.world));
+    out.boundsMin = bounds.min;
+    out.boundsMax = bounds.max;
+    const FrameCamera camera = frameCamera(bounds.min, bounds.max, dispScale, rs.camera, W, H);
+    uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
+    const std::size_t partStride = uploadPartBlocks(model, **gm);
+    const GLuint readFbo = drawSkinPass(model, **gm, rs, heightSource->texture, partStride, samples);
+    if (auto s = checkGl("skin pass"); !s) return s.error();
+    if (req.profile) glFinish();
+    out.timings.skinMs = msSince(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    if (auto s = readFrame(readFbo, out.image); !s) return s.error();
+    out.timings.readbackMs = msSince(t0);
+    if (auto s = checkGl("frame readback"); !s) return s.error();
+    return out;
+}
+
+/// The GPU height pass on req.heights (and its maps into `out` when asked), else the CPU maps
+/// uploaded, else the flat 1×1 texture.
+Result<HeightSource> Renderer::Impl::heightStage(const FrameRequest& req, FrameResult& out) {
+    HeightSource src{flatTexture, glm::vec2(1.0f)};
+    if (req.heights) {
+        if (auto s = heightPass(*req.heights); !s) return s.error();
+        src = {heights.maps, glm::vec2(heights.width, heights.height)};
+        if (req.readHeightMaps) {
+            HeightMaps maps;
+            if (auto s = readHeightTargets(maps); !s) return s.error();
+            out.maps = std::move(maps);
+        }
+    } else if (req.cpuMaps) {
+        if (auto s = uploadHeightMaps(*req.cpuMaps); !s) return s.error();
+        src = {heights.maps, glm::vec2(heights.width, heights.height)};
+    }
+    return src;
+}
+
+void Renderer::Impl::uploadFrameBlock(const FrameCamera& camera, double dispScale,
+                                      double bumpScale, glm::vec2 heightmapSize) {
+    FrameBlock fb{};
+    fb.viewProj = camera.viewProj;
+    fb.cameraPos = glm::vec4(camera.eye, 0.0f);
+    fb.lightDir = glm::vec4(camera.lightDir, 0.3f); // w: ambient level
+    fb.heights = glm::vec4(static_cast<float>(dispScale), static_cast<float>(bumpScale), 0.0f, 0.0f);
+    fb.heightmapSize = glm::vec4(heightmapSize, 1.0f / heightmapSize.x, 1.0f / heightmapSize.y);
+    // Tessellation: about one vertex every 6 pixels, at most level 16.
+    fb.viewport = glm::vec4(static_cast<float>(camera.width), static_cast<float>(camera.height),
+                            6.0f, 16.0f);
+    glBindBuffer(GL_UNIFORM_BUFFER, frameUbo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof fb, &fb);
+    glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBinding, frameUbo);
+}
+
+/// One PartBlock per part in partUbo (bound by range per draw); returns the stride.
+std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm) {
+    const std::size_t stride = uboStride(sizeof(PartBlock));
+    std::vector<std::uint8_t> partBlocks(stride * std::max<std::size_t>(1, gm.parts.size()), 0);
+    for (std::size_t pi = 0; pi < gm.parts.size(); ++pi) {
+        const GpuModel::Part& gp = gm.parts[pi];
+        PartBlock pb{};
+        pb.baseColor = glm::vec4(0.80f, 0.62f, 0.54f, 1.0f); // skin tone when there is no material
+        if (gp.material >= 0 && static_cast<std::size_t>(gp.material) < model.materials.size())
+            pb.baseColor = model.materials[static_cast<std::size_t>(gp.material)].baseColorFactor;
+        const bool textured = gm.baseColorTexture(model, gp) != 0;
+        pb.part = glm::ivec4(gp.paletteOffset, textured ? 1 : 0, gp.hasUVs ? 1 : 0, 0);
+        std::memcpy(partBlocks.data() + stride * pi, &pb, sizeof pb);
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, partUbo);
+    glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(partBlocks.size()), partBlocks.data(),
+                 GL_STREAM_DRAW);
+    return stride;
+}
+
+/// Draws every part into the frame targets and resolves MSAA; returns the framebuffer to read.
+GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
+                                    const RenderSettings& rs, GLuint heightTexture,
+                                    std::size_t partStride, int samples) {
+    const int W = frame.width, H = frame.height;
+    glBindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
+    glViewport(0, 0, W, H);
+    glEnable(GL_FRAMEBUFFER_SRGB);
+    if (samples > 1) glEnable(GL_MULTISAMPLE);
+    else glDisable(GL_MULTISAMPLE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    const float background[4] = {0.046f, 0.054f, 0.066f, 1.0f}; // linear; a dark blue-grey
+    const float one = 1.0f;
+    glClearBufferfv(GL_COLOR, 0, background);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    const bool tess = rs.displacement == DisplacementMode::Tessellated;
+    glUseProgram(tess ? skinTessProgram : skinProgram);
+    if (tess) glPatchParameteri(GL_PATCH_VERTICES, 3);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, heightTexture);
+    for (std::size_t pi = 0; pi < gm.parts.size(); ++pi) {
+        const GpuModel::Part& gp = gm.parts[pi];
+        if (gp.indexCount == 0) continue;
+        glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
+                          static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));
+        glActiveTexture(GL_TEXTURE2);
+        const GLuint colorTex = gm.baseColorTexture(model, gp);
+        glBindTexture(GL_TEXTURE_2D, colorTex ? colorTex : whiteTexture);
+        glBindVertexArray(gp.vao);
+        glDrawElements(tess ? GL_PATCHES : GL_TRIANGLES, gp.indexCount, GL_UNSIGNED_INT, nullptr);
+    }
+    glBindVertexArray(0);
+    GLuint readFbo = frame.fbo;
+    if (samples > 1) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, frame.fbo);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, frame.resolveFbo);
+        glBlitFramebuffer(0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        readFbo = frame.resolveFbo;
+    }
+    glDisable(GL_FRAMEBUFFER_SRGB);
+    return readFbo;
+}
+
+/// Reads the frame (RGBA8, GL row 0 first = the picture's top) through the pixel-pack buffer.
+Status Renderer::Impl::readFrame(GLuint readFbo, Image8& image) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, readFbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, frame.pbo);
+    glReadPixels(0, 0, frame.width, frame.height, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    image.width = frame.width;
+    image.height = frame.height;
+    image.rgba.resize(frame.pboSize);
+    const void* mapped = glMapBufferRange(GL_PIXEL_PACK_BUFFER, 0,
+                                          static_cast<GLsizeiptr>(frame.pboSize), GL_MAP_READ_BIT);
+    if (!mapped) {
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+        return makeError(ErrorCode::Internal, kWhere, "", "cannot map the pixel-pack buffer");
+    }
+    std::memcpy(image.rgba.data(), mapped, frame.pboSize);
+    glUnmapBuffer(GL_PIXEL_PACK_BUFFER);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    return Ok{};
+}
+
+// --- transform-feedback skinning ------------------------------------------------------------------
+
+Result<std::vector<SkinnedPart>> Renderer::Impl::skinOnGpu(const std::shared_ptr<const Model>& model,
+                                                           const std::vector<glm::mat4>& world) {
+    auto gm = modelFor(model);
+    if (!gm) return gm.error();
+    uploadPalette(*model, **gm, world);
+    glUseProgram(captureProgram);
+    glEnable(GL_RASTERIZER_DISCARD);
+    std::vector<SkinnedPart> out((*gm)->parts.size());
+    PartBlock pb{};
+    glBindBuffer(GL_UNIFORM_BUFFER, partUbo);
+    for (std::size_t pi = 0; pi < (*gm)->parts.size(); ++pi) {
+        const GpuModel::Part& gp = (*gm)->parts[pi];
+        const std::size_t nv = static_cast<std::size_t>(gp.vertexCount);
+        if (nv == 0) continue;
+        pb.part = glm::ivec4(gp.paletteOffset, 0, 0, 0);
+        glBindBuffer(GL_UNIFORM_BUFFER, partUbo);
+        glBufferData(GL_UNIFORM_BUFFER, sizeof pb, &pb, GL_STREAM_DRAW);
+        glBindBufferBase(GL_UNIFORM_BUFFER, kPartBinding, partUbo);
+        const std::size_t bytes = nv * 6 * sizeof(float);
+        glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, feedbackBuffer);
+        glBufferData(GL_TRANSFORM_FEEDBACK_BUFFER, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_READ);
+        glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, feedbackBuffer);
+        glBindVertexArray(gp.vao);
+        glBeginTransformFeedback(GL_POINTS);
+        glDrawArrays(GL_POINTS, 0, gp.vertexCount);
+        glEndTransformFeedback();
+        glBindVertexArray(0);
+        std::vector<float> data(nv * 6);
+        glGetBufferSubData(GL_TRANSFORM_FEEDBACK_BUFFER, 0, static_cast<GLsizeiptr>(bytes), data.data());
+        out[pi].positions.resize(nv);
+        out[pi].normals.resize(nv);
+        for (std::size_t v = 0; v < nv; ++v) {
+            out[pi].positions[v] = glm::vec3(data[v * 6], data[v * 6 + 1], data[v * 6 + 2]);
+            out[pi].normals[v] = glm::vec3(data[v * 6 + 3], data[v * 6 + 4], data[v * 6 + 5]);
+        }
+    }
+    glDisable(GL_RASTERIZER_DISCARD);
+    if (auto s = checkGl("transform feedback skinning"); !s) return s.error();
+    return out;
+}
+
+} // namespace dermis

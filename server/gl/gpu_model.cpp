@@ -1,0 +1,202 @@
+// The renderer's model uploads: buffers and textures once per Model object, the joint palette
+// per job (see renderer_impl.hpp).
+#include "gl/renderer_impl.hpp"
+
+#include "gl/uniform_blocks.hpp"
+
+#include "core/camera.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dermis {
+
+using namespace gl;
+
+double autoDisplacementScale(const Model& model) {
+    const Bounds b = framingBounds(skin(model, worldMatrices(model, restPose(model))));
+    const glm::vec3 ext = b.max - b.min;
+    const double m = std::max({ext.x, ext.y, ext.z});
+    return m > 0.0 && std::isfinite(m) ? 0.01 * m : 0.01;
+}
+
+GLuint GpuModel::baseColorTexture(const Model& model, const Part& part) const {
+    if (part.material < 0 || static_cast<std::size_t>(part.material) >= model.materials.size())
+        return 0;
+    const int ti = model.materials[static_cast<std::size_t>(part.material)].baseColorTexture;
+    return ti >= 0 && static_cast<std::size_t>(ti) < textures.size()
+               ? textures[static_cast<std::size_t>(ti)]
+               : 0;
+}
+
+void GpuModel::destroy() {
+    for (Part& p : parts) {
+        glDeleteVertexArrays(1, &p.vao);
+        glDeleteBuffers(6, p.buffers);
+    }
+    if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+    parts.clear();
+    textures.clear();
+}
+
+namespace {
+
+/// An sRGB texture of `img` with mipmaps; a 1×1 white one when `img` is empty or malformed.
+GLuint uploadImage(const Image8& img) {
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    if (img.width > 0 && img.height > 0 &&
+        img.rgba.size() == static_cast<std::size_t>(img.width) * img.height * 4) {
+        const int levels =
+            1 + static_cast<int>(std::floor(std::log2(std::max(img.width, img.height))));
+        glTexStorage2D(GL_TEXTURE_2D, levels, GL_SRGB8_ALPHA8, img.width, img.height);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, img.width, img.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                        img.rgba.data());
+        glGenerateMipmap(GL_TEXTURE_2D);
+        // Bilinear within the nearest mip level: half the fetches of trilinear.
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+    } else {
+        const std::uint8_t white[4] = {255, 255, 255, 255};
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_SRGB8_ALPHA8, 1, 1);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    }
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    return tex;
+}
+
+/// A part's vertex attributes as the CPU skinning reads them: missing normals are computed,
+/// missing UVs are zero, a vertex without joint data follows influence 0, out-of-range joints
+/// weigh 0; triangles with an out-of-range index are dropped.
+struct PartAttributes {
+    std::vector<glm::vec3> normals;
+    std::vector<glm::vec2> uvs;
+    std::vector<glm::u16vec4> joints;
+    std::vector<glm::vec4> weights;
+    std::vector<std::uint32_t> indices;
+};
+
+PartAttributes partAttributes(const MeshPart& part, bool hasUVs) {
+    const std::size_t nv = part.positions.size();
+    PartAttributes a;
+    a.normals = part.normals.size() == nv ? part.normals : computeNormals(part.positions, part.indices);
+    a.uvs = hasUVs ? part.uvs : std::vector<glm::vec2>(nv, glm::vec2(0.0f));
+    a.joints.assign(nv, glm::u16vec4(0));
+    a.weights.assign(nv, glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
+    if (part.joints.size() == nv && part.weights.size() == nv) {
+        const std::size_t ni = part.influences.size();
+        for (std::size_t v = 0; v < nv; ++v)
+            for (int c = 0; c < 4; ++c) {
+                const bool ok = part.joints[v][c] < ni;
+                a.joints[v][c] = ok ? part.joints[v][c] : 0;
+                a.weights[v][c] = ok ? part.weights[v][c] : 0.0f;
+            }
+    }
+    a.indices.reserve(part.indices.size());
+    for (std::size_t i = 0; i + 2 < part.indices.size(); i += 3)
+        if (part.indices[i] < nv && part.indices[i + 1] < nv && part.indices[i + 2] < nv)
+            a.indices.insert(a.indices.end(), part.indices.begin() + static_cast<long>(i),
+                             part.indices.begin() + static_cast<long>(i) + 3);
+    return a;
+}
+
+/// The vertex array and buffers of one part (attribute slots 0–4 as in shaders/skin.vert).
+void uploadPart(const MeshPart& part, GpuModel::Part& gp) {
+    const std::size_t nv = part.positions.size();
+    const PartAttributes a = partAttributes(part, gp.hasUVs);
+    gp.indexCount = static_cast<GLsizei>(a.indices.size());
+    glGenVertexArrays(1, &gp.vao);
+    glBindVertexArray(gp.vao);
+    glGenBuffers(6, gp.buffers);
+    auto attrib = [&](int slot, const void* data, std::size_t bytes, GLint comps, GLenum type,
+                      bool integer) {
+        glBindBuffer(GL_ARRAY_BUFFER, gp.buffers[slot]);
+        glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), bytes ? data : nullptr,
+                     GL_STATIC_DRAW);
+        glEnableVertexAttribArray(static_cast<GLuint>(slot));
+        if (integer)
+            glVertexAttribIPointer(static_cast<GLuint>(slot), comps, type, 0, nullptr);
+        else
+            glVertexAttribPointer(static_cast<GLuint>(slot), comps, type, GL_FALSE, 0, nullptr);
+    };
+    attrib(0, part.positions.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
+    attrib(1, a.normals.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
+    attrib(2, a.uvs.data(), nv * sizeof(glm::vec2), 2, GL_FLOAT, false);
+    attrib(3, a.joints.data(), nv * sizeof(glm::u16vec4), 4, GL_UNSIGNED_SHORT, true);
+    attrib(4, a.weights.data(), nv * sizeof(glm::vec4), 4, GL_FLOAT, false);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gp.buffers[5]);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(a.indices.size() * sizeof(std::uint32_t)),
+                 a.indices.empty() ? nullptr : a.indices.data(), GL_STATIC_DRAW);
+    glBindVertexArray(0);
+}
+
+} // namespace
+
+void Renderer::Impl::dropOrphanedModels() {
+    // Their address may be reused by a new model.
+    for (auto it = models.begin(); it != models.end();) {
+        if (it->second.owner.expired()) {
+            it->second.destroy();
+            it = models.erase(it);
+        } else {
+            ++it;
+        }
+    }
+}
+
+Result<GpuModel*> Renderer::Impl::modelFor(const std::shared_ptr<const Model>& model) {
+    if (!model) return makeError(ErrorCode::InvalidArgument, kWhere, "model", "no model");
+    dropOrphanedModels();
+    auto found = models.find(model.get());
+    if (found != models.end()) return &found->second;
+
+    const Model& m = *model;
+    GpuModel gm;
+    gm.owner = model;
+    gm.autoDisplacement = autoDisplacementScale(m);
+    for (const Image8& img : m.images)
+        gm.textures.push_back(uploadImage(img));
+    for (const MeshPart& part : m.parts) {
+        GpuModel::Part gp;
+        const std::size_t nv = part.positions.size();
+        gp.vertexCount = static_cast<GLsizei>(nv);
+        gp.paletteOffset = gm.paletteSize;
+        gm.paletteSize += std::max<int>(1, static_cast<int>(part.influences.size()));
+        gp.material = part.material;
+        gp.hasUVs = part.uvs.size() == nv && nv > 0;
+        uploadPart(part, gp);
+        gm.parts.push_back(gp);
+    }
+    if (auto s = checkGl("uploading a model"); !s) {
+        gm.destroy();
+        return s.error();
+    }
+    auto [it, inserted] = models.emplace(model.get(), std::move(gm));
+    return &it->second;
+}
+
+void Renderer::Impl::uploadPalette(const Model& model, const GpuModel& gm,
+                                   const std::vector<glm::mat4>& world) {
+    std::vector<glm::mat4> palette(static_cast<std::size_t>(std::max(gm.paletteSize, 1)),
+                                   glm::mat4(1.0f));
+    for (std::size_t pi = 0; pi < model.parts.size() && pi < gm.parts.size(); ++pi) {
+        const MeshPart& part = model.parts[pi];
+        const std::size_t base = static_cast<std::size_t>(gm.parts[pi].paletteOffset);
+        for (std::size_t k = 0; k < part.influences.size(); ++k) {
+            const Influence& inf = part.influences[k];
+            const bool valid = inf.node >= 0 && static_cast<std::size_t>(inf.node) < world.size();
+            palette[base + k] =
+                (valid ? world[static_cast<std::size_t>(inf.node)] : glm::mat4(1.0f)) * inf.inverseBind;
+        }
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, paletteSsbo);
+    glBufferData(GL_SHADER_STORAGE_BUFFER,
+                 static_cast<GLsizeiptr>(palette.size() * sizeof(glm::mat4)), palette.data(),
+                 GL_STREAM_DRAW);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPaletteBinding, paletteSsbo);
+}
+
+} // namespace dermis

@@ -1,0 +1,222 @@
+// Dermis GL shell (internal) — Renderer::Impl, the render thread's side of the renderer, and the
+// GL objects it owns. Included only by the renderer's own files; it includes GL (glad).
+//
+//   renderer.cpp    job queue, init/shutdown, introspection, the public façade;
+//   gpu_model.cpp   a model's buffers and textures (uploaded once per Model), the joint palette;
+//   height_pass.cpp stage 1: pattern/base texture caches by content id, the height targets, the
+//                   height pass, readback and upload of maps;
+//   frame_pass.cpp  stage 2: frame targets, the skin pass (camera from core/camera.hpp),
+//                   readback, transform-feedback skinning.
+//
+// Threads: everything below except `run` (and the queue members it uses) belongs to the render
+// thread, which owns the GL context. Ownership: Impl owns every GL object named here and deletes
+// them in shutdown(); the structs' destroy() delete their own objects and need the context.
+// Errors: Status/Result with kWhere as the function name, ErrorCode::Internal for GL failures.
+#pragma once
+
+#include "core/camera.hpp"
+#include "gl/gl_context.hpp"
+#include "gl/renderer.hpp"
+
+#include <glad/gl.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <future>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace dermis::gl {
+
+inline constexpr const char* kWhere = "dermis::Renderer";
+
+inline double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// A float texture: one channel (R32F) or two (RG32F, `data` interleaved), clamped to the edge,
+/// with `filter` for both minification and magnification. `data` may be null (storage only).
+/// The caller owns the texture. Leaves it bound to GL_TEXTURE_2D of the active unit.
+GLuint makeFloatTexture(int w, int h, const float* data, GLint filter, int channels = 1);
+
+/// A model's GL objects (gpu_model.cpp).
+struct GpuModel {
+    std::weak_ptr<const Model> owner;
+    struct Part {
+        GLuint vao = 0;
+        GLuint buffers[6] = {}; ///< position, normal, uv, joints, weights, indices
+        GLsizei indexCount = 0, vertexCount = 0;
+        int paletteOffset = 0;
+        int material = -1;
+        bool hasUVs = false;
+    };
+    std::vector<Part> parts;
+    std::vector<GLuint> textures; ///< one per Model::images entry, sRGB
+    int paletteSize = 0;
+    double autoDisplacement = 0.01;
+
+    /// The base-colour texture of `part` (of `model`, the Model this was uploaded from), or 0
+    /// when its material has none or names no uploaded image.
+    GLuint baseColorTexture(const Model& model, const Part& part) const;
+    void destroy();
+};
+
+/// What the height targets were last rendered from: when a frame asks for the same, the height
+/// pass is skipped (a camera move or a pose change that moves no driving joint).
+struct HeightKey {
+    int width = 0, height = 0;
+    std::uint64_t base = 0;              ///< content id of the base map (0 = none)
+    std::vector<std::uint64_t> patterns; ///< content id per placement (0 = skipped)
+    std::vector<double> params; ///< per placement: centre, scale, rotation, h, t, model, target, response
+    bool operator==(const HeightKey&) const = default;
+};
+
+struct PatternTexture {
+    GLuint tex = 0;
+    std::uint64_t lastUse = 0; ///< frame counter, for evicting the least recently used
+};
+
+/// The content id of an image given without one: a hash of its size and pixels (FNV-1a over
+/// 64-bit words), with the top bit set so that it never equals a PatternImage counter id.
+std::uint64_t contentHash(const HeightImage& image);
+
+/// The height maps as one RG32F texture (red: bump, green: displacement) — one target for the
+/// height pass and one fetch for both maps in the skin pass — and its framebuffer.
+struct HeightTargets {
+    GLuint fbo = 0, maps = 0;
+    int width = 0, height = 0;
+    std::vector<float> staging; ///< interleaving buffer for CPU maps
+
+    void destroy();
+};
+
+/// Each placement's pattern texture and content id (0 for placements that contribute nothing).
+struct ResolvedPatterns {
+    std::vector<GLuint> textures;
+    std::vector<std::uint64_t> ids;
+};
+
+/// Multisampled colour + depth, the single-sampled resolve target, and the pixel-pack buffer.
+struct FrameTargets {
+    GLuint fbo = 0, color = 0, depth = 0, resolveFbo = 0, resolveColor = 0, pbo = 0;
+    int width = 0, height = 0, samples = 0;
+    std::size_t pboSize = 0;
+
+    void destroy();
+};
+
+/// The height maps a frame samples: a texture (RG32F) and its size.
+struct HeightSource {
+    GLuint texture = 0;
+    glm::vec2 size{1.0f};
+};
+
+} // namespace dermis::gl
+
+namespace dermis {
+
+struct Renderer::Impl {
+    // --- job queue (any thread) ----------------------------------------------------------------
+    std::thread thread;
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::deque<std::function<void()>> jobs;
+    bool stopping = false;
+
+    /// Queues `f` for the render thread and waits for its result.
+    template <class F>
+    auto run(F&& f) -> decltype(f()) {
+        using R = decltype(f());
+        auto task = std::make_shared<std::packaged_task<R()>>(std::forward<F>(f));
+        std::future<R> fut = task->get_future();
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            jobs.push_back([task] { (*task)(); });
+        }
+        cv.notify_one();
+        return fut.get();
+    }
+
+    /// The render thread's loop: runs jobs in order until stopping and drained.
+    void loop();
+
+    // --- render-thread state ----------------------------------------------------------------------
+    std::unique_ptr<gl::GlContext> context;
+    RendererInfo info;
+    GLuint heightProgram = 0, heightBaseProgram = 0, skinProgram = 0, skinTessProgram = 0,
+           captureProgram = 0;
+    GLuint emptyVao = 0, heightUbo = 0, frameUbo = 0, partUbo = 0, paletteSsbo = 0,
+           feedbackBuffer = 0;
+    GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
+    GLuint whiteTexture = 0; ///< 1×1 white, for parts without a base-colour texture
+    GLint uboAlignment = 256;
+    GLint maxRenderbufferSize = 0;
+
+    gl::HeightTargets heights;
+    gl::FrameTargets frame;
+    std::map<const Model*, gl::GpuModel> models;
+    std::map<std::uint64_t, gl::PatternTexture> patterns; ///< by content id
+    std::uint64_t useCounter = 0;
+    GLuint baseTexture = 0;
+    std::uint64_t baseId = 0; ///< content id of what baseTexture holds
+    std::optional<gl::HeightKey> lastHeights; ///< what `heights` holds now, if from a height pass
+    std::size_t heightPasses = 0, heightPassesSkipped = 0;
+
+    /// Bytes between consecutive blocks of `size` in one uniform buffer bound by range.
+    std::size_t uboStride(std::size_t size) const {
+        const auto a = static_cast<std::size_t>(uboAlignment);
+        return (size + a - 1) / a * a;
+    }
+
+    // renderer.cpp: life cycle and introspection.
+    Status init(GlBackend backend);
+    void readDriverInfo();
+    Status buildPrograms();
+    void createSharedObjects();
+    void shutdown();
+    void dropPatternTextures(); ///< pattern and base textures, and what the targets were from
+    Status checkGl(const char* what);
+    Result<Renderer::BlockLayout> blockLayout(const std::string& block);
+
+    // gpu_model.cpp
+    Result<gl::GpuModel*> modelFor(const std::shared_ptr<const Model>& model);
+    void dropOrphanedModels();
+    void uploadPalette(const Model& model, const gl::GpuModel& gm, const std::vector<glm::mat4>& world);
+
+    // height_pass.cpp: stage 1.
+    Status bakeHeightMaps(const HeightPassInput& in, HeightMaps& maps); ///< pass + readback
+    Status heightPass(const HeightPassInput& in);
+    Result<gl::ResolvedPatterns> resolvePatterns(const HeightPassInput& in);
+    Result<GLuint> patternTexture(std::uint64_t id, const HeightImage& image, const std::string& field);
+    Result<std::uint64_t> resolveBase(const HeightPassInput& in);
+    std::size_t uploadHeightBlocks(const HeightPassInput& in);
+    void drawHeightPass(const HeightPassInput& in, const std::vector<GLuint>& textures,
+                        std::size_t stride);
+    Status ensureHeightTargets(int w, int h);
+    Status readHeightTargets(HeightMaps& maps);
+    Status uploadHeightMaps(const HeightMaps& maps);
+
+    // frame_pass.cpp: stage 2.
+    Result<FrameResult> renderFrame(const FrameRequest& req);
+    Status checkFrameRequest(const FrameRequest& req) const;
+    Result<gl::HeightSource> heightStage(const FrameRequest& req, FrameResult& out);
+    Status ensureFrameTargets(int w, int h, int samples);
+    void uploadFrameBlock(const FrameCamera& camera, double dispScale, double bumpScale,
+                          glm::vec2 heightmapSize);
+    std::size_t uploadPartBlocks(const Model& model, const gl::GpuModel& gm);
+    GLuint drawSkinPass(const Model& model, const gl::GpuModel& gm, const RenderSettings& rs,
+                        GLuint heightTexture, std::size_t partStride, int samples);
+    Status readFrame(GLuint readFbo, Image8& image);
+    Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
+                                               const std::vector<glm::mat4>& world);
+};
+
+} // namespace dermis
