@@ -2,8 +2,10 @@
 // 127.0.0.1 (any free port) from a thread of this process, with a GL context on the backend named
 // by $DERMIS_TEST_GL, and real cpp-httplib clients over loopback. It checks:
 //   * health, info (backend, GL renderer, the configured limits) and the served OpenAPI file;
-//   * OpenAPI coverage: the path+method pairs of the served YAML equal Api::routes(), and every
-//     route is routed (none answers httplib's generic "no such route");
+//   * OpenAPI coverage: the path+method pairs of the served YAML equal Api::routes() (generated
+//     from the table the routes are registered from), the open ones (`security: []`) are exactly
+//     the routes served without credentials, and every route is routed (none answers httplib's
+//     generic "no such route");
 //   * models: built-in details, .glb uploads of the shared models (CesiumMan, KayKit Barbarian,
 //     RiggedFigure without UVs), UV layouts as JSON and PNG, deletion;
 //   * patterns: the built-in manifest and previews, a custom PNG upload used by id and through a
@@ -13,7 +15,7 @@
 //     changing with the pose), height maps (png16/exr/f32, normal), delete;
 //   * server-sent events: hello, then one change event per edit with increasing revisions;
 //   * the stateless batch: multipart/mixed with one decodable image part per frame;
-//   * bearer-token authentication on every route but /health (a second server);
+//   * bearer-token authentication on every route but the open ones (a second server);
 //   * a table of bad inputs (malformed JSON, wrong types, non-finite numbers, unknown ids, path
 //     tricks, bad sizes and formats, corrupt and oversized uploads, wrong content types, conflicts,
 //     limits): each answers {"error": {"code", "message", "field"}} with the right status and
@@ -352,6 +354,36 @@ std::set<std::pair<std::string, std::string>> openapiRoutes(const std::string& y
     return out;
 }
 
+/// (METHOD, path) pairs of an OpenAPI YAML whose operation says `security: []` (no credentials).
+std::set<std::pair<std::string, std::string>> openapiOpenRoutes(const std::string& yaml) {
+    std::set<std::pair<std::string, std::string>> out;
+    std::istringstream in(yaml);
+    std::string line, path, method;
+    bool inPaths = false;
+    const std::regex pathLine("^  (/[^ :]*):\\s*$");
+    const std::regex methodLine("^    (get|put|post|patch|delete|head|options):\\s*$");
+    const std::regex openLine("^      security: \\[\\]\\s*$");
+    std::smatch m;
+    while (std::getline(in, line)) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (!line.empty() && line[0] != ' ' && line[0] != '#') {
+            inPaths = line.rfind("paths:", 0) == 0;
+            continue;
+        }
+        if (!inPaths) continue;
+        if (std::regex_match(line, m, pathLine)) {
+            path = m[1];
+            method.clear();
+        } else if (std::regex_match(line, m, methodLine)) {
+            method = m[1];
+            std::transform(method.begin(), method.end(), method.begin(), ::toupper);
+        } else if (std::regex_match(line, openLine) && !path.empty() && !method.empty()) {
+            out.insert({method, path});
+        }
+    }
+    return out;
+}
+
 /// A route template with made-up ids filled in.
 std::string fillRoute(std::string path) {
     for (auto [key, value] : {std::pair<std::string, std::string>{"{id}", "x_0000000000000000"},
@@ -454,6 +486,14 @@ TEST_F(ApiHttpTest, OpenapiListsExactlyTheServedRoutes) {
     for (const auto& [m, p] : documented)
         EXPECT_TRUE(served.count({m, p})) << m << " " << p << " is in openapi.yaml but not served";
     EXPECT_GE(served.size(), 27u);
+
+    // The routes served without credentials are the ones the document marks `security: []`.
+    std::set<std::pair<std::string, std::string>> open;
+    for (const Route& r : Api::routes())
+        if (r.open) open.insert({r.method, r.path});
+    EXPECT_EQ(open, openapiOpenRoutes(yaml.body));
+    const std::set<std::pair<std::string, std::string>> expectedOpen = {{"GET", "/health"}};
+    EXPECT_EQ(open, expectedOpen);
 }
 
 TEST_F(ApiHttpTest, EveryRouteIsRouted) {
@@ -1427,7 +1467,7 @@ class ApiHttpAuthTest : public ::testing::Test {
     static inline std::string error_;
 };
 
-TEST_F(ApiHttpAuthTest, EveryRouteButHealthNeedsTheBearerToken) {
+TEST_F(ApiHttpAuthTest, EveryRouteButTheOpenOnesNeedsTheBearerToken) {
     Http anon(server_->port());
     Http authed(server_->port(), kToken);
     EXPECT_EQ(anon.get("/health").status, 200);
@@ -1444,7 +1484,7 @@ TEST_F(ApiHttpAuthTest, EveryRouteButHealthNeedsTheBearerToken) {
         {"token without scheme", {{"Authorization", kToken}}},
     };
     for (const Route& route : Api::routes()) {
-        if (route.path == "/health") continue;
+        if (route.open) continue;
         const std::string path = fillRoute(route.path);
         const bool hasBody =
             route.method == "POST" || route.method == "PUT" || route.method == "PATCH";

@@ -7,6 +7,9 @@
 // content type or file type, 422 invalid values, 503 full render queue (with Retry-After).
 // HTTP threads never touch GL: renders go through the Service to the renderer's thread.
 // TCP_NODELAY is on (keep-alive requests otherwise stall ~26 ms on the delayed ACK).
+//
+// Layout: api.cpp holds the shared plumbing (errors, body parsing, the route table, auth,
+// registration); each route family lives in its own api_<family>.cpp (see api_internal.hpp).
 #pragma once
 
 #include "service/service.hpp"
@@ -19,15 +22,17 @@ namespace dermis {
 
 struct ApiOptions {
     std::string bind = "127.0.0.1";
-    int port = 8080;        ///< 0 = any free port
-    std::string token;      ///< bearer token every route but /health requires; empty = none
-    std::string webDir;     ///< static files served at / (the editor); empty = none
-    int threads = 32;       ///< HTTP worker threads (event streams hold one each)
+    int port = 8080;       ///< 0 = any free port
+    std::string token;     ///< bearer token every route but the open ones needs; empty = none
+    std::string webDir;    ///< static files served at / (the editor); empty = none
+    int threads = 32;      ///< HTTP worker threads (event streams hold one each)
 };
 
-/// A route of the API: method and OpenAPI path template ("/scenes/{id}").
+/// A route of the API: method and OpenAPI path template ("/scenes/{id}"); `open` routes need no
+/// credentials (OpenAPI `security: []`).
 struct Route {
     std::string method, path;
+    bool open = false;
 };
 
 class Api {
@@ -41,7 +46,8 @@ public:
     /// Stops serving (from any thread) and closes event streams.
     void stop();
 
-    /// Every route served under /api/v1, for the OpenAPI coverage test.
+    /// Every route served under /api/v1 (generated from the table the routes are registered
+    /// from), for the OpenAPI coverage test.
     static const std::vector<Route>& routes();
 
     struct Impl;

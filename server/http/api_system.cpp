@@ -1,0 +1,19 @@
+// Dermis HTTP shell — system routes: liveness (open), server info with the configured limits,
+// and the OpenAPI document.
+#include "http/api_internal.hpp"
+
+namespace dermis::api_detail {
+
+void installSystemRoutes(RouteTable& t) {
+    t.addOpen("GET", "/health", [](Api::Impl&, const Req&, Res& res) {
+        sendJson(res, 200, {{"status", "ok"}});
+    });
+    t.add("GET", "/info", [](Api::Impl& a, const Req&, Res& res) {
+        sendJson(res, 200, a.svc.info());
+    });
+    t.add("GET", "/openapi.yaml", [](Api::Impl&, const Req&, Res& res) {
+        res.set_content(std::string(openapiYaml()), "application/yaml");
+    });
+}
+
+} // namespace dermis::api_detail
