@@ -304,7 +304,7 @@ int runServe(ServeArgs a) {
     std::cout << "dermis-server: serving http://" << a.bind << ":" << *port << "/ (editor), API http://"
               << a.bind << ":" << *port << "/api/v1 — " << info["backend"].get<std::string>() << ", "
               << info["gl"]["renderer"].get<std::string>() << "; data in " << a.data
-              << (a.token.empty() ? "" : "; bearer token required") << "\n"
+              << (a.token.empty() ? "" : "; token required (bearer, or the page's sign-in)") << "\n"
               << "dermis-server: scene " << firstScene << ": http://" << a.bind << ":" << *port
               << "/api/v1/scenes/" << firstScene << "/frame" << std::endl;
     std::thread waiter([&api, signals] {
@@ -324,7 +324,9 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
     app.add_option("--bind", s.bind, "Address to listen on (127.0.0.1 = this machine only)");
     app.add_option("--port", s.port, "TCP port (0 = any free port)")->check(CLI::Range(0, 65535));
     app.add_option("--data", s.data, "Data directory (uploads and scenes, written atomically)");
-    app.add_option("--token", s.token, "Bearer token every route but /health requires (or $DERMIS_TOKEN)");
+    app.add_option("--token", s.token,
+                   "Token every API route but /health and /session requires, as a bearer token or "
+                   "through a page's sign-in (POST /api/v1/session) (or $DERMIS_TOKEN)");
     app.add_option("--web", s.web, "Folder of the web editor served at / (default: the data folder's web/)");
     app.add_option("--max-upload-mb", s.maxUploadMb, "Largest request body / upload")->check(CLI::Range(0.001, 4096.0));
     app.add_option("--max-render-side", s.limits.maxRenderSide, "Largest frame side")->check(CLI::Range(16, 8192));

@@ -1,5 +1,5 @@
 // Dermis HTTP shell — the plumbing every route family shares: the error mapping, body and query
-// parsing, the route table, authentication (bearer token), registration with
+// parsing, the route table, authentication (bearer token or session cookie), registration with
 // httplib and Api's own methods. The routes themselves live in api_<family>.cpp.
 #include "http/api_internal.hpp"
 
@@ -199,6 +199,7 @@ const RouteTable& routeTable() {
     static const RouteTable table = [] {
         RouteTable t;
         installSystemRoutes(t);
+        installSessionRoutes(t);
         installModelRoutes(t);
         installPatternRoutes(t);
         installSceneRoutes(t);
@@ -240,7 +241,10 @@ const std::vector<Route>& Api::routes() {
 
 // --- Api::Impl -----------------------------------------------------------------------------------
 
-Api::Impl::Impl(Service& s, ApiOptions o) : svc(s), opt(std::move(o)) {}
+Api::Impl::Impl(Service& s, ApiOptions o)
+    : svc(s), opt(std::move(o)),
+      sessions(static_cast<std::size_t>(std::max(1, opt.maxSessions)),
+               std::chrono::seconds(std::max(1, opt.sessionMaxAgeSeconds))) {}
 
 std::string Api::Impl::allowedMethods(const std::string& path) const {
     std::string allow;
@@ -264,6 +268,8 @@ bool Api::Impl::isOpen(const std::string& method, const std::string& path) const
 bool Api::Impl::authorized(const Req& req) const {
     const std::string auth = req.get_header_value("Authorization");
     if (auth.rfind("Bearer ", 0) == 0 && constantTimeEquals(auth.substr(7), opt.token)) return true;
+    for (const std::string& id : cookieValues(req, kSessionCookie))
+        if (sessions.valid(id)) return true;
     return false;
 }
 
@@ -279,8 +285,8 @@ void Api::Impl::install() {
     s.set_write_timeout(svc.limits().requestTimeoutSeconds, 0);
     s.set_keep_alive_max_count(1000);
 
-    // Authentication: with a token set, every route but the open ones needs the bearer token.
-    // Unknown paths under the prefix need it too (no probing).
+    // Authentication: with a token set, every route but the open ones needs the bearer token or
+    // a live session's cookie. Unknown paths under the prefix need them too (no probing).
     s.set_pre_routing_handler([this](const Req& req, Res& res) {
         if (opt.token.empty() || req.path.rfind(kPrefix, 0) != 0)
             return httplib::Server::HandlerResponse::Unhandled;
@@ -288,7 +294,8 @@ void Api::Impl::install() {
             return httplib::Server::HandlerResponse::Unhandled;
         res.set_header("WWW-Authenticate", "Bearer");
         sendError(res, 401, "unauthorized",
-                  "dermis-server: a valid bearer token is required",
+                  "dermis-server: a valid bearer token (or a session cookie from POST " + kPrefix +
+                      "/session) is required",
                   "Authorization");
         return httplib::Server::HandlerResponse::Handled;
     });

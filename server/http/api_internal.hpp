@@ -4,6 +4,7 @@
 // authentication, registration with httplib, Api's methods); each route family adds its routes
 // to the one RouteTable from its own file:
 //   api_system.cpp   /health, /info, /openapi.yaml
+//   api_session.cpp  /session (browser sign-in) and the SessionStore
 //   api_models.cpp   /models…            api_patterns.cpp  /patterns…
 //   api_scenes.cpp   /scenes, placements, pose
 //   api_renders.cpp  frames, height maps, the stateless batch (/render)
@@ -22,9 +23,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <initializer_list>
+#include <mutex>
 #include <optional>
 #include <regex>
 #include <string>
@@ -77,7 +81,7 @@ bool constantTimeEquals(const std::string& a, const std::string& b);
 using Handler = std::function<void(Api::Impl& api, const Req& req, Res& res)>;
 
 enum class Access {
-    Credentials, ///< the bearer token, when the server has one
+    Credentials, ///< the bearer token or a session cookie, when the server has a token
     Open,        ///< anyone (OpenAPI `security: []`)
 };
 
@@ -116,11 +120,49 @@ std::string pathRegex(const std::string& pathTemplate);
 
 // One install function per route family: each adds its routes to the table.
 void installSystemRoutes(RouteTable& table);
+void installSessionRoutes(RouteTable& table);
 void installModelRoutes(RouteTable& table);
 void installPatternRoutes(RouteTable& table);
 void installSceneRoutes(RouteTable& table);
 void installRenderRoutes(RouteTable& table);
 void installEventRoutes(RouteTable& table);
+
+// --- browser sessions (api_session.cpp) ----------------------------------------------------------
+
+/// The cookie that carries a session id.
+inline const std::string kSessionCookie = "dermis_session";
+
+/// Browser sessions opened by POST /session: random 128-bit ids (32 lower-case hex digits, from
+/// getrandom(2)), each valid until it expires, is removed or is evicted — at most `capacity` at
+/// once, the oldest forgotten first. In memory only (a restart signs everyone out).
+/// Thread-safe (one mutex). Lookups compare against every live id without an early exit, so the
+/// time taken does not tell how much of a guess was right.
+class SessionStore {
+public:
+    SessionStore(std::size_t capacity, std::chrono::seconds maxAge);
+    /// Opens a session; its id. Fails (Internal) only when the system has no randomness to give.
+    Result<std::string> create();
+    /// True for the id of a live (not expired, not removed, not evicted) session.
+    bool valid(const std::string& id) const;
+    /// Forgets the session (nothing when there is none).
+    void remove(const std::string& id);
+    std::size_t size() const;
+
+private:
+    struct Entry {
+        std::string id;
+        std::chrono::steady_clock::time_point expires;
+    };
+    void pruneExpired(std::chrono::steady_clock::time_point now); ///< caller holds mutex_
+    const std::size_t capacity_;
+    const std::chrono::seconds maxAge_;
+    mutable std::mutex mutex_;
+    std::deque<Entry> entries_; ///< oldest first
+};
+
+/// The values of cookie `name` in the request's Cookie headers (all of them: a browser may send
+/// more than one), at most 16.
+std::vector<std::string> cookieValues(const Req& req, const std::string& name);
 
 } // namespace api_detail
 
@@ -134,6 +176,7 @@ struct Api::Impl {
     /// half the workers may stream; more are refused with 503 (otherwise a few dozen open editor
     /// tabs, or one client, would leave no thread to answer anything else: a hang).
     std::atomic<int> streams{0};
+    api_detail::SessionStore sessions;
 
     Impl(Service& s, ApiOptions o);
     int maxStreams() const { return std::max(1, opt.threads / 2); }
@@ -144,7 +187,7 @@ struct Api::Impl {
     /// True when `path` (under the prefix) needs no credentials: an open route of `method`, or a
     /// path all of whose routes are open (so that a wrong method there answers 405, not 401).
     bool isOpen(const std::string& method, const std::string& path) const;
-    /// True when the request carries the bearer token.
+    /// True when the request carries the bearer token or the cookie of a live session.
     bool authorized(const api_detail::Req& req) const;
 
 private:

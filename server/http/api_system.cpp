@@ -1,5 +1,5 @@
-// Dermis HTTP shell — system routes: liveness (open), server info with the configured limits,
-// and the OpenAPI document.
+// Dermis HTTP shell — system routes: liveness (open), server info with the configured limits
+// (the Service's, plus the HTTP layer's own session limits), and the OpenAPI document.
 #include "http/api_internal.hpp"
 
 namespace dermis::api_detail {
@@ -9,7 +9,10 @@ void installSystemRoutes(RouteTable& t) {
         sendJson(res, 200, {{"status", "ok"}});
     });
     t.add("GET", "/info", [](Api::Impl& a, const Req&, Res& res) {
-        sendJson(res, 200, a.svc.info());
+        json info = a.svc.info();
+        info["limits"]["max_sessions"] = std::max(1, a.opt.maxSessions);
+        info["limits"]["session_max_age_seconds"] = std::max(1, a.opt.sessionMaxAgeSeconds);
+        sendJson(res, 200, info);
     });
     t.add("GET", "/openapi.yaml", [](Api::Impl&, const Req&, Res& res) {
         res.set_content(std::string(openapiYaml()), "application/yaml");
