@@ -2,8 +2,10 @@
 // 127.0.0.1 (any free port) from a thread of this process, with a GL context on the backend named
 // by $DERMIS_TEST_GL, and real cpp-httplib clients over loopback. It checks:
 //   * health, info (backend, GL renderer, the configured limits) and the served OpenAPI file;
-//   * OpenAPI coverage: the path+method pairs of the served YAML equal Api::routes(), and every
-//     route is routed (none answers httplib's generic "no such route");
+//   * OpenAPI coverage: the path+method pairs of the served YAML equal Api::routes() (generated
+//     from the table the routes are registered from), the open ones (`security: []`) are exactly
+//     the routes served without credentials, and every route is routed (none answers httplib's
+//     generic "no such route");
 //   * models: built-in details, .glb uploads of the shared models (CesiumMan, KayKit Barbarian,
 //     RiggedFigure without UVs), UV layouts as JSON and PNG, deletion;
 //   * patterns: the built-in manifest and previews, a custom PNG upload used by id and through a
@@ -13,7 +15,10 @@
 //     changing with the pose), height maps (png16/exr/f32, normal), delete;
 //   * server-sent events: hello, then one change event per edit with increasing revisions;
 //   * the stateless batch: multipart/mixed with one decodable image part per frame;
-//   * bearer-token authentication on every route but /health (a second server);
+//   * bearer-token authentication on every route but the open ones (a second server);
+//   * browser sessions: POST /session trades the token for an HttpOnly, SameSite=Strict cookie
+//     that authorises the API and the event stream; wrong tokens and forged cookies are 401;
+//     DELETE /session ends it; sessions are bounded (oldest evicted) and expire (a third server);
 //   * a table of bad inputs (malformed JSON, wrong types, non-finite numbers, unknown ids, path
 //     tricks, bad sizes and formats, corrupt and oversized uploads, wrong content types, conflicts,
 //     limits): each answers {"error": {"code", "message", "field"}} with the right status and
@@ -83,8 +88,9 @@ std::string fileText(const std::string& path) {
 class LiveServer {
   public:
     /// Starts a server; nullptr and `error` set when anything fails (the tests then fail).
+    /// `base` supplies the options the tests do not set themselves (session limits).
     static std::unique_ptr<LiveServer> start(const ServerLimits& limits, const std::string& token,
-                                             std::string& error) {
+                                             std::string& error, ApiOptions base = {}) {
         auto s = std::unique_ptr<LiveServer>(new LiveServer());
         auto svc = Service::open(s->dir_.str(), testBackend(), limits);
         if (!svc) {
@@ -92,7 +98,7 @@ class LiveServer {
             return nullptr;
         }
         s->service_ = std::move(*svc);
-        ApiOptions opt;
+        ApiOptions opt = std::move(base);
         opt.bind = "127.0.0.1";
         opt.port = 0;
         opt.token = token;
@@ -352,6 +358,36 @@ std::set<std::pair<std::string, std::string>> openapiRoutes(const std::string& y
     return out;
 }
 
+/// (METHOD, path) pairs of an OpenAPI YAML whose operation says `security: []` (no credentials).
+std::set<std::pair<std::string, std::string>> openapiOpenRoutes(const std::string& yaml) {
+    std::set<std::pair<std::string, std::string>> out;
+    std::istringstream in(yaml);
+    std::string line, path, method;
+    bool inPaths = false;
+    const std::regex pathLine("^  (/[^ :]*):\\s*$");
+    const std::regex methodLine("^    (get|put|post|patch|delete|head|options):\\s*$");
+    const std::regex openLine("^      security: \\[\\]\\s*$");
+    std::smatch m;
+    while (std::getline(in, line)) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (!line.empty() && line[0] != ' ' && line[0] != '#') {
+            inPaths = line.rfind("paths:", 0) == 0;
+            continue;
+        }
+        if (!inPaths) continue;
+        if (std::regex_match(line, m, pathLine)) {
+            path = m[1];
+            method.clear();
+        } else if (std::regex_match(line, m, methodLine)) {
+            method = m[1];
+            std::transform(method.begin(), method.end(), method.begin(), ::toupper);
+        } else if (std::regex_match(line, openLine) && !path.empty() && !method.empty()) {
+            out.insert({method, path});
+        }
+    }
+    return out;
+}
+
 /// A route template with made-up ids filled in.
 std::string fillRoute(std::string path) {
     for (auto [key, value] : {std::pair<std::string, std::string>{"{id}", "x_0000000000000000"},
@@ -360,6 +396,81 @@ std::string fillRoute(std::string path) {
         for (std::size_t p; (p = path.find(key)) != std::string::npos;)
             path.replace(p, key.size(), value);
     return path;
+}
+
+/// A scene's event stream read on its own thread with the given request headers, until the
+/// object is destroyed (the next ping, ≤ 1 s, then ends it).
+class EventStream {
+  public:
+    EventStream(int port, const std::string& sceneId, httplib::Headers headers) {
+        thread_ = std::thread([this, port, sceneId, headers] {
+            httplib::Client cli("127.0.0.1", port);
+            cli.set_read_timeout(30, 0);
+            auto res = cli.Get(
+                kApi + "/scenes/" + sceneId + "/events", headers,
+                [this](const httplib::Response& r) {
+                    {
+                        std::lock_guard<std::mutex> lock(mutex_);
+                        status_ = r.status;
+                    }
+                    cv_.notify_all();
+                    return r.status == 200;
+                },
+                [this](const char* data, std::size_t n) {
+                    {
+                        std::lock_guard<std::mutex> lock(mutex_);
+                        text_.append(data, n);
+                    }
+                    cv_.notify_all();
+                    return !stop_.load();
+                });
+            (void)res;
+            {
+                std::lock_guard<std::mutex> lock(mutex_);
+                if (status_ == 0) status_ = -1;
+            }
+            cv_.notify_all();
+        });
+    }
+    ~EventStream() {
+        stop_ = true;
+        thread_.join();
+    }
+    /// The response status once known (waits up to 10 s; 0 when none came, -1 on no answer).
+    int status() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait_for(lock, std::chrono::seconds(10), [&] { return status_ != 0; });
+        return status_;
+    }
+    /// Waits up to 10 s for `what` to appear in the stream.
+    bool waitFor(const std::string& what) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        return cv_.wait_for(lock, std::chrono::seconds(10),
+                            [&] { return text_.find(what) != std::string::npos; });
+    }
+    std::string text() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        return text_;
+    }
+
+  private:
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    std::string text_;
+    int status_ = 0;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;
+};
+
+/// The session id a Set-Cookie header sets ("" when it sets none).
+std::string sessionIdOf(const Reply& r) {
+    std::smatch m;
+    const std::string c = r.header("Set-Cookie");
+    return std::regex_search(c, m, std::regex("^dermis_session=([^;]*)")) ? std::string(m[1]) : "";
+}
+
+httplib::Headers cookieHeader(const std::string& id) {
+    return {{"Cookie", "dermis_session=" + id}};
 }
 
 ServerLimits mainLimits() {
@@ -453,7 +564,16 @@ TEST_F(ApiHttpTest, OpenapiListsExactlyTheServedRoutes) {
             << m << " " << p << " is served but not in openapi.yaml";
     for (const auto& [m, p] : documented)
         EXPECT_TRUE(served.count({m, p})) << m << " " << p << " is in openapi.yaml but not served";
-    EXPECT_GE(served.size(), 27u);
+    EXPECT_GE(served.size(), 29u);
+
+    // The routes served without credentials are the ones the document marks `security: []`.
+    std::set<std::pair<std::string, std::string>> open;
+    for (const Route& r : Api::routes())
+        if (r.open) open.insert({r.method, r.path});
+    EXPECT_EQ(open, openapiOpenRoutes(yaml.body));
+    const std::set<std::pair<std::string, std::string>> expectedOpen = {
+        {"GET", "/health"}, {"POST", "/session"}, {"DELETE", "/session"}};
+    EXPECT_EQ(open, expectedOpen);
 }
 
 TEST_F(ApiHttpTest, EveryRouteIsRouted) {
@@ -489,6 +609,21 @@ TEST_F(ApiHttpTest, AKnownPathWithAnotherMethodIs405) {
     EXPECT_NE(r.header("Allow").find("PUT"), std::string::npos) << r.header("Allow");
     expectError(h.call("DELETE", "/models"), 405);
     expectError(h.call("POST", "/health", "{}", "application/json"), 405);
+}
+
+TEST_F(ApiHttpTest, SessionWithoutAServerTokenSetsNoCookie) {
+    // Every route is open: signing in is answered, but there is nothing to carry.
+    Http h = http();
+    Reply r = h.post("/session", {{"token", "anything"}});
+    EXPECT_EQ(r.status, 204) << r;
+    EXPECT_FALSE(r.hasHeader("Set-Cookie")) << r.header("Set-Cookie");
+    Reply out = h.del("/session");
+    EXPECT_EQ(out.status, 204) << out;
+    EXPECT_NE(out.header("Set-Cookie").find("Max-Age=0"), std::string::npos);
+    Reply info = h.get("/info");
+    ASSERT_EQ(info.status, 200);
+    EXPECT_EQ(info.js()["limits"]["max_sessions"], 256);
+    EXPECT_EQ(info.js()["limits"]["session_max_age_seconds"], 12 * 3600);
 }
 
 // ================================================================================================
@@ -1306,6 +1441,18 @@ TEST_F(ApiHttpTest, BadInputGetsAJsonErrorWithTheRightStatus) {
         {"reorder unknown id", "PUT", scene + "/placements", J, R"(["elbow", "nope"])", {404}, "/1"},
         {"reorder not an array", "PUT", scene + "/placements", J, R"({"order": ["elbow", "knee"]})", {422}, ""},
         {"reorder non-string id", "PUT", scene + "/placements", J, R"(["elbow", 7])", {422}, "/1"},
+        // --- sign-in
+        {"session with no body", "POST", "/session", J, "", {400}, "body"},
+        {"session with no body or type", "POST", "/session", "", "", {415}, "body"},
+        {"session non-JSON", "POST", "/session", J, "token=abc", {400}, "body"},
+        {"session as a form", "POST", "/session", "application/x-www-form-urlencoded", "token=abc", {415}, "body"},
+        {"session token not a string", "POST", "/session", J, R"({"token": 12345})", {422}, "/token"},
+        {"session token null", "POST", "/session", J, R"({"token": null})", {422}, "/token"},
+        {"session token an array", "POST", "/session", J, R"({"token": ["s3cret"]})", {422}, "/token"},
+        {"session without token", "POST", "/session", J, R"({"password": "s3cret"})", {422}, "/token"},
+        {"session body an array", "POST", "/session", J, R"(["s3cret"])", {422}, ""},
+        {"session body a string", "POST", "/session", J, R"("s3cret")", {422}, ""},
+        {"session nested deep", "POST", "/session", J, nested(100000, true), {400}, "body"},
         // --- frame and map parameters
         {"width=100000", "GET", scene + "/frame?width=100000", "", "", {413, 422}, "width"},
         {"width=99999999999", "GET", scene + "/frame?width=99999999999", "", "", {413, 422}, "width"},
@@ -1427,7 +1574,7 @@ class ApiHttpAuthTest : public ::testing::Test {
     static inline std::string error_;
 };
 
-TEST_F(ApiHttpAuthTest, EveryRouteButHealthNeedsTheBearerToken) {
+TEST_F(ApiHttpAuthTest, EveryRouteButTheOpenOnesNeedsTheBearerToken) {
     Http anon(server_->port());
     Http authed(server_->port(), kToken);
     EXPECT_EQ(anon.get("/health").status, 200);
@@ -1444,7 +1591,7 @@ TEST_F(ApiHttpAuthTest, EveryRouteButHealthNeedsTheBearerToken) {
         {"token without scheme", {{"Authorization", kToken}}},
     };
     for (const Route& route : Api::routes()) {
-        if (route.path == "/health") continue;
+        if (route.open) continue;
         const std::string path = fillRoute(route.path);
         const bool hasBody =
             route.method == "POST" || route.method == "PUT" || route.method == "PATCH";
@@ -1479,8 +1626,173 @@ TEST_F(ApiHttpAuthTest, EveryRouteButHealthNeedsTheBearerToken) {
     EXPECT_EQ(authed.del("/scenes/" + id).status, 204);
 }
 
+TEST_F(ApiHttpAuthTest, SessionCookieAuthorisesTheApiAndTheEventStream) {
+    Http anon(server_->port());
+    Http authed(server_->port(), kToken);
+
+    // The right token: 204 and a session cookie the page's scripts cannot read or send away.
+    Reply in = anon.post("/session", {{"token", kToken}});
+    ASSERT_EQ(in.status, 204) << in;
+    const std::string cookie = in.header("Set-Cookie");
+    const std::string id = sessionIdOf(in);
+    EXPECT_TRUE(std::regex_match(id, std::regex("[0-9a-f]{32}"))) << cookie;
+    EXPECT_NE(cookie.find("; HttpOnly"), std::string::npos) << cookie;
+    EXPECT_NE(cookie.find("; SameSite=Strict"), std::string::npos) << cookie;
+    EXPECT_NE(cookie.find("; Path=/api/v1"), std::string::npos) << cookie;
+    EXPECT_NE(cookie.find("; Max-Age=43200"), std::string::npos) << cookie;
+    EXPECT_EQ(in.header("Cache-Control"), "no-store");
+    // Every sign-in is a new session.
+    Reply again = anon.post("/session", {{"token", kToken}});
+    ASSERT_EQ(again.status, 204) << again;
+    const std::string other = sessionIdOf(again);
+    EXPECT_NE(other, id);
+
+    // The cookie authorises the API, alone or among other cookies.
+    Reply scenes = anon.call("GET", "/scenes", "", "", cookieHeader(id));
+    EXPECT_EQ(scenes.status, 200) << scenes;
+    EXPECT_EQ(anon.call("GET", "/info", "", "", {{"Cookie", "theme=dark; dermis_session=" + id + "; x=1"}})
+                  .status,
+              200);
+    Reply created = anon.call("POST", "/scenes", smallScene().dump(), "application/json", cookieHeader(id));
+    ASSERT_EQ(created.status, 201) << created;
+    const std::string scene = created.js()["id"];
+    Reply frame = anon.call("GET", "/scenes/" + scene + "/frame?width=64&height=64", "", "", cookieHeader(id));
+    EXPECT_EQ(frame.status, 200) << frame;
+
+    // And the event stream: an edit made with the bearer token reaches the cookie's stream.
+    {
+        EventStream stream(server_->port(), scene, cookieHeader(id));
+        ASSERT_EQ(stream.status(), 200);
+        ASSERT_TRUE(stream.waitFor("event: hello")) << stream.text();
+        ASSERT_EQ(authed.patch("/scenes/" + scene + "/pose", {{"time", 0.25}}).status, 200);
+        EXPECT_TRUE(stream.waitFor("event: change")) << stream.text();
+        EXPECT_NE(stream.text().find("\"revision\":2"), std::string::npos) << stream.text();
+    }
+    {
+        EventStream refused(server_->port(), scene, {});
+        EXPECT_EQ(refused.status(), 401);
+    }
+
+    // Sign-out forgets that session (and clears the cookie); the other one still works.
+    Reply out = anon.call("DELETE", "/session", "", "", cookieHeader(id));
+    EXPECT_EQ(out.status, 204) << out;
+    const std::string cleared = out.header("Set-Cookie");
+    EXPECT_EQ(sessionIdOf(out), "") << cleared;
+    EXPECT_NE(cleared.find("Max-Age=0"), std::string::npos) << cleared;
+    EXPECT_NE(cleared.find("Path=/api/v1"), std::string::npos) << cleared;
+    Reply after = anon.call("GET", "/scenes", "", "", cookieHeader(id));
+    expectError(after, 401, "Authorization");
+    {
+        EventStream ended(server_->port(), scene, cookieHeader(id));
+        EXPECT_EQ(ended.status(), 401);
+    }
+    EXPECT_EQ(anon.call("GET", "/scenes", "", "", cookieHeader(other)).status, 200);
+    EXPECT_EQ(anon.call("DELETE", "/session", "", "", cookieHeader(other)).status, 204);
+    expectError(anon.call("GET", "/scenes", "", "", cookieHeader(other)), 401);
+    EXPECT_EQ(authed.del("/scenes/" + scene).status, 204);
+}
+
+TEST_F(ApiHttpAuthTest, WrongTokensAndForgedCookiesAre401) {
+    Http anon(server_->port());
+    for (const json& token : {json("wrong"), json(""), json(std::string(kToken) + "x"),
+                              json(std::string(kToken).substr(1)), json("Bearer " + std::string(kToken))}) {
+        SCOPED_TRACE(token.dump());
+        Reply r = anon.post("/session", {{"token", token}});
+        expectError(r, 401, "/token");
+        EXPECT_EQ(r.js()["error"]["code"], "unauthorized");
+        EXPECT_FALSE(r.hasHeader("Set-Cookie")) << r.header("Set-Cookie");
+    }
+    // A real session, to make sure none of the forgeries below is mistaken for it.
+    Reply in = anon.post("/session", {{"token", kToken}});
+    ASSERT_EQ(in.status, 204);
+    const std::string id = sessionIdOf(in);
+    std::string flipped = id;
+    flipped[0] = flipped[0] == '0' ? '1' : '0';
+    std::string upper = id;
+    std::transform(upper.begin(), upper.end(), upper.begin(), ::toupper);
+    const std::vector<std::pair<std::string, httplib::Headers>> forged = {
+        {"unknown id", cookieHeader("0123456789abcdef0123456789abcdef")},
+        {"one digit changed", cookieHeader(flipped)},
+        {"prefix", cookieHeader(id.substr(0, 31))},
+        {"suffix", cookieHeader(id + "0")},
+        {"upper case", upper == id ? cookieHeader("x") : cookieHeader(upper)},
+        {"empty", cookieHeader("")},
+        {"the token as the cookie", cookieHeader(kToken)},
+        {"another cookie's name", {{"Cookie", "session=" + id}}},
+        {"name prefix", {{"Cookie", "xdermis_session=" + id}}},
+        {"id as a header", {{"X-Dermis-Session", id}}},
+        {"id as a bearer token", {{"Authorization", "Bearer " + id}}},
+    };
+    for (const auto& [what, headers] : forged) {
+        SCOPED_TRACE(what);
+        for (const std::string path : {"/scenes", "/info", "/scenes/s_0000000000000000/events"}) {
+            Reply r = anon.call("GET", path, "", "", headers);
+            expectError(r, 401, "Authorization");
+            EXPECT_EQ(r.header("WWW-Authenticate"), "Bearer");
+        }
+    }
+    // A wrong bearer token next to a good cookie, and a forged cookie next to a good one: either
+    // credential is enough.
+    httplib::Headers both = cookieHeader(id);
+    both.emplace("Authorization", "Bearer wrong");
+    EXPECT_EQ(anon.call("GET", "/scenes", "", "", both).status, 200);
+    EXPECT_EQ(anon.call("GET", "/scenes", "", "", {{"Cookie", "dermis_session=forged; dermis_session=" + id}})
+                  .status,
+              200);
+    // Sign-out with a forged cookie ends nothing.
+    EXPECT_EQ(anon.call("DELETE", "/session", "", "", cookieHeader(flipped)).status, 204);
+    EXPECT_EQ(anon.call("GET", "/scenes", "", "", cookieHeader(id)).status, 200);
+    EXPECT_EQ(anon.call("DELETE", "/session", "", "", cookieHeader(id)).status, 204);
+    // /health stays open; /session asked with another method is 405, not 401.
+    EXPECT_EQ(anon.get("/health").status, 200);
+    Reply get = anon.get("/session");
+    expectError(get, 405);
+    EXPECT_NE(get.header("Allow").find("POST"), std::string::npos);
+}
+
 // ================================================================================================
-// Back-pressure (a third server, with a render queue of 1)
+// Session limits (a third server: two sessions at most, each for 3 s)
+// ================================================================================================
+
+class ApiHttpSessionLimitTest : public ::testing::Test {
+  protected:
+    static constexpr const char* kToken = "limit-t0ken";
+    static void SetUpTestSuite() {
+        ApiOptions opt;
+        opt.maxSessions = 2;
+        opt.sessionMaxAgeSeconds = 3;
+        server_ = LiveServer::start(mainLimits(), kToken, error_, opt);
+    }
+    static void TearDownTestSuite() { server_.reset(); }
+    void SetUp() override {
+        ASSERT_TRUE(server_ && error_.empty()) << "the server did not start: " << error_;
+    }
+    static inline std::unique_ptr<LiveServer> server_;
+    static inline std::string error_;
+};
+
+TEST_F(ApiHttpSessionLimitTest, TheOldestSessionIsEvictedAndSessionsExpire) {
+    Http anon(server_->port());
+    std::vector<std::string> ids;
+    for (int i = 0; i < 3; ++i) {
+        Reply r = anon.post("/session", {{"token", kToken}});
+        ASSERT_EQ(r.status, 204) << r;
+        EXPECT_NE(r.header("Set-Cookie").find("Max-Age=3"), std::string::npos);
+        ids.push_back(sessionIdOf(r));
+    }
+    expectError(anon.call("GET", "/scenes", "", "", cookieHeader(ids[0])), 401); // evicted
+    EXPECT_EQ(anon.call("GET", "/scenes", "", "", cookieHeader(ids[1])).status, 200);
+    Reply info = anon.call("GET", "/info", "", "", cookieHeader(ids[2]));
+    ASSERT_EQ(info.status, 200);
+    EXPECT_EQ(info.js()["limits"]["max_sessions"], 2);
+    EXPECT_EQ(info.js()["limits"]["session_max_age_seconds"], 3);
+    std::this_thread::sleep_for(std::chrono::milliseconds(3500));
+    for (const std::string& id : ids)
+        expectError(anon.call("GET", "/scenes", "", "", cookieHeader(id)), 401); // expired
+}
+
+// ================================================================================================
+// Back-pressure (a fourth server, with a render queue of 1)
 // ================================================================================================
 
 class ApiHttpQueueTest : public ::testing::Test {

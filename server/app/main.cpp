@@ -312,7 +312,7 @@ int runServe(ServeArgs a) {
               << a.bind << ":" << *port << "/api/v1 — " << info["backend"].get<std::string>() << ", "
               << info["gl"]["renderer"].get<std::string>() << "; data in " << a.data
               << ", content in " << config.contentDir
-              << (a.token.empty() ? "" : "; bearer token required") << "\n"
+              << (a.token.empty() ? "" : "; token required (bearer, or the page's sign-in)") << "\n"
               << "dermis-server: scene " << firstScene << ": http://" << a.bind << ":" << *port
               << "/api/v1/scenes/" << firstScene << "/frame" << std::endl;
     std::thread waiter([&api, signals] {
@@ -335,7 +335,9 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
     app.add_option("--content", s.content,
                    "Built-in content directory, read only: patterns/, models/, web/ "
                    "(default $DERMIS_CONTENT_DIR or the source tree)");
-    app.add_option("--token", s.token, "Bearer token every route but /health requires (or $DERMIS_TOKEN)");
+    app.add_option("--token", s.token,
+                   "Token every API route but /health and /session requires, as a bearer token or "
+                   "through a page's sign-in (POST /api/v1/session) (or $DERMIS_TOKEN)");
     app.add_option("--web", s.web, "Folder of the web editor served at / (default: the content folder's web/)");
     app.add_option("--max-upload-mb", s.maxUploadMb, "Largest request body / upload")->check(CLI::Range(0.001, 4096.0));
     app.add_option("--max-render-side", s.limits.maxRenderSide, "Largest frame side")->check(CLI::Range(16, 8192));

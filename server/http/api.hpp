@@ -2,11 +2,17 @@
 //
 // One error policy: every failure answers {"error": {"code", "message", "field"}} with the status
 // of its ErrorCode (mapped in one place, api.cpp statusOf): 400 malformed JSON or undecodable
-// bytes or JSON nested deeper than 64 levels, 401 missing/wrong token, 404 unknown ids or
+// bytes or JSON nested deeper than 64 levels, 401 missing/wrong credentials, 404 unknown ids or
 // routes, 405 known path with another method, 409 conflicts, 413 over a limit, 415 wrong
 // content type or file type, 422 invalid values, 503 full render queue (with Retry-After).
 // HTTP threads never touch GL: renders go through the Service to the renderer's thread.
 // TCP_NODELAY is on (keep-alive requests otherwise stall ~26 ms on the delayed ACK).
+//
+// Credentials (when ApiOptions::token is set): every route but the open ones (/health and
+// POST/DELETE /session) needs the bearer token, or the cookie of a browser session that
+// POST /session opened with that token (sessions live in the Api, in memory: a restart forgets
+// them). Layout: api.cpp holds the shared plumbing (errors, body parsing, the route table, auth,
+// registration); each route family lives in its own api_<family>.cpp (see api_internal.hpp).
 #pragma once
 
 #include "service/service.hpp"
@@ -19,15 +25,19 @@ namespace dermis {
 
 struct ApiOptions {
     std::string bind = "127.0.0.1";
-    int port = 8080;        ///< 0 = any free port
-    std::string token;      ///< bearer token every route but /health requires; empty = none
-    std::string webDir;     ///< static files served at / (the editor); empty = none
-    int threads = 32;       ///< HTTP worker threads (event streams hold one each)
+    int port = 8080;       ///< 0 = any free port
+    std::string token;     ///< every route but the open ones needs it (or a session); empty = none
+    std::string webDir;    ///< static files served at / (the editor); empty = none
+    int threads = 32;      ///< HTTP worker threads (event streams hold one each)
+    int maxSessions = 256; ///< browser sessions kept at once; the oldest is forgotten beyond
+    int sessionMaxAgeSeconds = 12 * 3600; ///< a session's lifetime (and its cookie's Max-Age)
 };
 
-/// A route of the API: method and OpenAPI path template ("/scenes/{id}").
+/// A route of the API: method and OpenAPI path template ("/scenes/{id}"); `open` routes need no
+/// credentials (OpenAPI `security: []`).
 struct Route {
     std::string method, path;
+    bool open = false;
 };
 
 class Api {
@@ -41,7 +51,8 @@ public:
     /// Stops serving (from any thread) and closes event streams.
     void stop();
 
-    /// Every route served under /api/v1, for the OpenAPI coverage test.
+    /// Every route served under /api/v1 (generated from the table the routes are registered
+    /// from), for the OpenAPI coverage test.
     static const std::vector<Route>& routes();
 
     struct Impl;

@@ -1,0 +1,201 @@
+// Dermis HTTP shell — private to server/http: what the route families share.
+//
+// Layout: api.cpp holds the plumbing (the error mapping, body and query parsing, the route table,
+// authentication, registration with httplib, Api's methods); each route family adds its routes
+// to the one RouteTable from its own file:
+//   api_system.cpp   /health, /info, /openapi.yaml
+//   api_session.cpp  /session (browser sign-in) and the SessionStore
+//   api_models.cpp   /models…            api_patterns.cpp  /patterns…
+//   api_scenes.cpp   /scenes, placements, pose
+//   api_renders.cpp  frames, height maps, the stateless batch (/render)
+//   api_events.cpp   /scenes/{id}/events (server-sent events)
+// Registration with httplib, Api::routes() (checked against openapi.yaml by ApiHttpTest), the
+// 405 Allow lists and the open-route check of authentication all read that table, so a route
+// exists in all of them or in none.
+//
+// Not a public header: it includes httplib, which only server/http links.
+#pragma once
+
+#include "http/api.hpp"
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <initializer_list>
+#include <mutex>
+#include <optional>
+#include <regex>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+namespace api_detail {
+
+using json = nlohmann::json;
+using Req = httplib::Request;
+using Res = httplib::Response;
+
+/// Every route lives under this prefix.
+inline const std::string kPrefix = "/api/v1";
+
+// --- answers (api.cpp) ---------------------------------------------------------------------------
+
+/// The one mapping from error codes to HTTP statuses.
+int statusOf(ErrorCode code);
+void sendJson(Res& res, int status, const json& body);
+/// {"error": {"code", "message", "field"}} with `status` (503 also gets Retry-After: 1).
+void sendError(Res& res, int status, const std::string& code, const std::string& message,
+               const std::string& field);
+void sendError(Res& res, const Error& e);
+/// Scene documents: an unsupported "format" version is an invalid value (422), not a media type.
+void sendDocError(Res& res, const Error& e);
+/// A 200 answer with the image's bytes, Content-Type and X-Dermis-Backend.
+void sendImage(Res& res, EncodedImage&& img);
+
+// --- requests (api.cpp) --------------------------------------------------------------------------
+
+/// True when the Content-Type (parameters ignored, case-insensitive) is one of `types`; "image/*"
+/// matches by prefix.
+bool hasContentType(const Req& req, std::initializer_list<const char*> types);
+/// Parses a JSON body; false (and the answer sent: 415 wrong type, 400 malformed or nested deeper
+/// than 64 levels) when it cannot.
+bool jsonBody(const Req& req, Res& res, json& out);
+std::vector<std::uint8_t> bytesOf(const std::string& s);
+/// Query parameters: true when absent (out untouched) or well-formed; false (and a 422 sent) when
+/// present but malformed.
+bool intParam(const Req& req, Res& res, const char* name, std::optional<int>& out);
+bool numberParam(const Req& req, Res& res, const char* name, std::optional<double>& out);
+/// Compares without an early exit (the time depends only on the lengths).
+bool constantTimeEquals(const std::string& a, const std::string& b);
+
+// --- the route table (api.cpp) -------------------------------------------------------------------
+
+/// A route's handler. Path parameters are req.matches[1], [2]… in template order.
+using Handler = std::function<void(Api::Impl& api, const Req& req, Res& res)>;
+
+enum class Access {
+    Credentials, ///< the bearer token or a session cookie, when the server has a token
+    Open,        ///< anyone (OpenAPI `security: []`)
+};
+
+struct RouteDef {
+    Route route; ///< method, OpenAPI path template, open
+    Handler handler;
+};
+
+/// Routes in the order their families add them. Not thread-safe while being built; routeTable()
+/// builds the one table once and only reads it afterwards.
+class RouteTable {
+public:
+    /// Adds a route that needs credentials. `method` is GET, POST, PUT, PATCH or DELETE; `path` an
+    /// OpenAPI template under the prefix ("/scenes/{id}"). Throws std::logic_error on another
+    /// method or a duplicate (a programming error, found by every test).
+    void add(const std::string& method, const std::string& path, Handler handler) {
+        add(method, path, std::move(handler), Access::Credentials);
+    }
+    /// Adds a route anyone may call (OpenAPI `security: []`).
+    void addOpen(const std::string& method, const std::string& path, Handler handler) {
+        add(method, path, std::move(handler), Access::Open);
+    }
+    const std::vector<RouteDef>& defs() const { return defs_; }
+
+private:
+    void add(const std::string& method, const std::string& path, Handler handler, Access access);
+    std::vector<RouteDef> defs_;
+};
+
+/// The table of every route (built on first use from the install functions below).
+const RouteTable& routeTable();
+
+/// The regular expression of a path template: each "{name}" becomes one capture group of
+/// [A-Za-z0-9_:.-]+ (no '/', so never a path trick), '.' is literal. Without the prefix.
+std::string pathRegex(const std::string& pathTemplate);
+
+// One install function per route family: each adds its routes to the table.
+void installSystemRoutes(RouteTable& table);
+void installSessionRoutes(RouteTable& table);
+void installModelRoutes(RouteTable& table);
+void installPatternRoutes(RouteTable& table);
+void installSceneRoutes(RouteTable& table);
+void installRenderRoutes(RouteTable& table);
+void installEventRoutes(RouteTable& table);
+
+// --- browser sessions (api_session.cpp) ----------------------------------------------------------
+
+/// The cookie that carries a session id.
+inline const std::string kSessionCookie = "dermis_session";
+
+/// Browser sessions opened by POST /session: random 128-bit ids (32 lower-case hex digits, from
+/// getrandom(2)), each valid until it expires, is removed or is evicted — at most `capacity` at
+/// once, the oldest forgotten first. In memory only (a restart signs everyone out).
+/// Thread-safe (one mutex). Lookups compare against every live id without an early exit, so the
+/// time taken does not tell how much of a guess was right.
+class SessionStore {
+public:
+    SessionStore(std::size_t capacity, std::chrono::seconds maxAge);
+    /// Opens a session; its id. Fails (Internal) only when the system has no randomness to give.
+    Result<std::string> create();
+    /// True for the id of a live (not expired, not removed, not evicted) session.
+    bool valid(const std::string& id) const;
+    /// Forgets the session (nothing when there is none).
+    void remove(const std::string& id);
+    std::size_t size() const;
+
+private:
+    struct Entry {
+        std::string id;
+        std::chrono::steady_clock::time_point expires;
+    };
+    void pruneExpired(std::chrono::steady_clock::time_point now); ///< caller holds mutex_
+    const std::size_t capacity_;
+    const std::chrono::seconds maxAge_;
+    mutable std::mutex mutex_;
+    std::deque<Entry> entries_; ///< oldest first
+};
+
+/// The values of cookie `name` in the request's Cookie headers (all of them: a browser may send
+/// more than one), at most 16.
+std::vector<std::string> cookieValues(const Req& req, const std::string& name);
+
+} // namespace api_detail
+
+/// The server: options, the httplib server, state shared by the handlers.
+struct Api::Impl {
+    Service& svc;
+    ApiOptions opt;
+    httplib::Server server;
+    std::atomic<bool> stopping{false};
+    /// Open event streams. Each holds an HTTP worker thread for as long as it is open, so at most
+    /// half the workers may stream; more are refused with 503 (otherwise a few dozen open editor
+    /// tabs, or one client, would leave no thread to answer anything else: a hang).
+    std::atomic<int> streams{0};
+    api_detail::SessionStore sessions;
+
+    Impl(Service& s, ApiOptions o);
+    int maxStreams() const { return std::max(1, opt.threads / 2); }
+    /// Configures the server and registers every route of the table.
+    void install();
+    /// The methods served for `path` (under the prefix), comma-separated; "" when no route.
+    std::string allowedMethods(const std::string& path) const;
+    /// True when `path` (under the prefix) needs no credentials: an open route of `method`, or a
+    /// path all of whose routes are open (so that a wrong method there answers 405, not 401).
+    bool isOpen(const std::string& method, const std::string& path) const;
+    /// True when the request carries the bearer token or the cookie of a live session.
+    bool authorized(const api_detail::Req& req) const;
+
+private:
+    struct Matcher {
+        std::regex re; ///< pathRegex of the route's template
+        const api_detail::RouteDef* def;
+    };
+    std::vector<Matcher> matchers_; ///< one per route of the table
+};
+
+} // namespace dermis

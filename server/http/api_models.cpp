@@ -1,0 +1,69 @@
+// Dermis HTTP shell — model routes: list, upload (.glb body, or a .gltf with its external files
+// as multipart parts), details, delete, UV layout (JSON or PNG).
+#include "http/api_internal.hpp"
+
+namespace dermis::api_detail {
+
+void installModelRoutes(RouteTable& t) {
+    t.add("GET", "/models",
+          [](Api::Impl& a, const Req&, Res& res) { sendJson(res, 200, a.svc.listModels()); });
+    t.add("POST", "/models", [](Api::Impl& a, const Req& req, Res& res) {
+        if (req.is_multipart_form_data()) {
+            // A .gltf and its external files: part "gltf" (or the part whose file name ends in
+            // .gltf) and one part per buffer/image, named by its file name (the URI in the .gltf).
+            std::vector<UploadFile> files;
+            std::string gltfName;
+            for (const auto& [field, part] : req.files) {
+                const std::string name = part.filename.empty() ? field : part.filename;
+                files.push_back({name, bytesOf(part.content)});
+                const bool isGltf =
+                    name.size() > 5 && name.compare(name.size() - 5, 5, ".gltf") == 0;
+                if (field == "gltf" || (gltfName.empty() && isGltf)) gltfName = name;
+            }
+            auto r = a.svc.addModelFiles(files, gltfName, req.get_param_value("name"));
+            if (!r) return sendError(res, r.error());
+            return sendJson(res, 201, *r);
+        }
+        if (!hasContentType(req, {"model/gltf-binary", "application/octet-stream"}))
+            return sendError(res, 415, "unsupported",
+                             "dermis-server: body: expected Content-Type model/gltf-binary, or "
+                             "multipart/form-data with a .gltf and its files",
+                             "body");
+        auto r = a.svc.addModel(bytesOf(req.body), req.get_param_value("name"));
+        if (!r) {
+            Error e = r.error();
+            if (e.field.empty() && e.code == ErrorCode::Parse)
+                e.field = "body"; // undecodable bytes
+            return sendError(res, e);
+        }
+        sendJson(res, 201, *r);
+    });
+    t.add("GET", "/models/{id}", [](Api::Impl& a, const Req& req, Res& res) {
+        auto r = a.svc.getModel(req.matches[1]);
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
+    t.add("DELETE", "/models/{id}", [](Api::Impl& a, const Req& req, Res& res) {
+        auto r = a.svc.deleteModel(req.matches[1]);
+        if (!r) return sendError(res, r.error());
+        res.status = 204;
+    });
+    t.add("GET", "/models/{id}/uv-layout", [](Api::Impl& a, const Req& req, Res& res) {
+        const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+        if (format == "json") {
+            auto r = a.svc.uvLayout(req.matches[1]);
+            if (!r) return sendError(res, r.error());
+            return sendJson(res, 200, *r);
+        }
+        if (format != "png")
+            return sendError(res, 422, "invalid_argument",
+                             "dermis-server: format: must be png or json", "format");
+        std::optional<int> size;
+        if (!intParam(req, res, "size", size)) return;
+        auto r = a.svc.uvLayoutPng(req.matches[1], size.value_or(1024));
+        if (!r) return sendError(res, r.error());
+        sendImage(res, std::move(*r));
+    });
+}
+
+} // namespace dermis::api_detail

@@ -1,0 +1,78 @@
+// Dermis HTTP shell — render routes: a scene's frame, its height maps, and the stateless batch
+// (POST /render), whose frames stream as multipart/mixed parts as they finish. Renders go through
+// the Service to the renderer's thread (a full queue answers 503 + Retry-After).
+#include "http/api_internal.hpp"
+
+#include <memory>
+
+namespace dermis::api_detail {
+
+void installRenderRoutes(RouteTable& t) {
+    t.add("GET", "/scenes/{id}/frame", [](Api::Impl& a, const Req& req, Res& res) {
+        FrameParams p;
+        if (req.has_param("format")) p.format = req.get_param_value("format");
+        if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
+            !intParam(req, res, "msaa", p.msaa) || !numberParam(req, res, "yaw", p.yaw) ||
+            !numberParam(req, res, "pitch", p.pitch) ||
+            !numberParam(req, res, "distance", p.distance) ||
+            !numberParam(req, res, "time", p.time))
+            return;
+        auto r = a.svc.frame(req.matches[1], p);
+        if (!r) return sendError(res, r.error());
+        sendImage(res, std::move(*r));
+    });
+    t.add("GET", "/scenes/{id}/heightmaps/{map}", [](Api::Impl& a, const Req& req, Res& res) {
+        const std::string map = req.matches[2];
+        const std::string format = req.has_param("format") ? req.get_param_value("format")
+                                                           : (map == "normal" ? "png" : "png16");
+        auto r = a.svc.heightmap(req.matches[1], map, format);
+        if (!r) return sendError(res, r.error());
+        sendImage(res, std::move(*r));
+    });
+
+    // --- stateless batch: frames streamed as multipart/mixed parts as they finish
+    t.add("POST", "/render", [](Api::Impl& a, const Req& req, Res& res) {
+        json body;
+        if (!jsonBody(req, res, body)) return;
+        auto job = a.svc.batch(body);
+        if (!job) return sendDocError(res, job.error());
+        auto shared = std::make_shared<Service::BatchJob>(std::move(*job));
+        const std::string boundary = "dermis-frame-boundary";
+        res.set_header("X-Dermis-Frames", std::to_string(shared->frames));
+        res.set_chunked_content_provider(
+            "multipart/mixed; boundary=" + boundary,
+            [shared, boundary, next = std::make_shared<std::size_t>(0)](std::size_t,
+                                                                        httplib::DataSink& sink) {
+                const std::size_t k = (*next)++;
+                if (k >= shared->frames) {
+                    const std::string end = "--" + boundary + "--\r\n";
+                    sink.write(end.data(), end.size());
+                    sink.done();
+                    return true;
+                }
+                auto img = shared->render(k);
+                std::string part = "--" + boundary + "\r\n";
+                if (!img) {
+                    const json err = {{"error",
+                                       {{"code", errorCodeName(img.error().code)},
+                                        {"message", img.error().message},
+                                        {"field", img.error().field}}}};
+                    part +=
+                        "Content-Type: application/json\r\nX-Dermis-Frame: " + std::to_string(k) +
+                        "\r\n\r\n" + err.dump() + "\r\n--" + boundary + "--\r\n";
+                    sink.write(part.data(), part.size());
+                    sink.done();
+                    return true;
+                }
+                part += "Content-Type: " + img->contentType +
+                        "\r\nX-Dermis-Frame: " + std::to_string(k) +
+                        "\r\nX-Dermis-Backend: " + img->backend +
+                        "\r\nContent-Length: " + std::to_string(img->bytes.size()) + "\r\n\r\n";
+                part.append(img->bytes.begin(), img->bytes.end());
+                part += "\r\n";
+                return sink.write(part.data(), part.size());
+            });
+    });
+}
+
+} // namespace dermis::api_detail
