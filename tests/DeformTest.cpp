@@ -1,4 +1,5 @@
 // DeformTest — the deformation model of SPEC §2 / paper eq. 1 and 2. Pure.
+#include "DeformTestHelpers.hpp"
 #include "core/deform.hpp"
 
 #include <gtest/gtest.h>
@@ -129,23 +130,6 @@ TEST(DeformTest, BiasRevealsMoreAreaAsTGrows) {
         EXPECT_GT(count, prevCount);
         prevCount = count;
     }
-}
-
-TEST(DeformTest, ValidateDriveRejectsBadParameters) {
-    EXPECT_TRUE(validateDrive(drive(0, 90, 1, DeformModel::Scale, Response::Log2)).ok());
-    EXPECT_TRUE(validateDrive(drive(90, 0, 0, DeformModel::Bias, Response::Ln)).ok());
-    auto fieldOf = [](const Drive& d) { return validateDrive(d, "/placements/3").error().field; };
-    EXPECT_EQ(fieldOf(drive(45, 45, 1, DeformModel::Scale, Response::Log2)),
-              "/placements/3/theta_max");
-    EXPECT_EQ(fieldOf(drive(0, 90, -0.1, DeformModel::Scale, Response::Log2)), "/placements/3/h");
-    EXPECT_EQ(fieldOf(drive(NAN, 90, 1, DeformModel::Scale, Response::Log2)),
-              "/placements/3/theta_min");
-    EXPECT_EQ(fieldOf(drive(0, INFINITY, 1, DeformModel::Scale, Response::Log2)),
-              "/placements/3/theta_max");
-    EXPECT_EQ(fieldOf(drive(0, 90, NAN, DeformModel::Scale, Response::Log2)), "/placements/3/h");
-    const Error e = validateDrive(drive(45, 45, 1, DeformModel::Scale, Response::Log2)).error();
-    EXPECT_NE(e.message.find("dermis::validateDrive"), std::string::npos);
-    EXPECT_NE(e.message.find("theta_min"), std::string::npos);
 }
 
 TEST(DeformTest, NamesRoundTrip) {

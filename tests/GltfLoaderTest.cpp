@@ -695,6 +695,46 @@ TEST(GltfLoaderTest, ExternalFilesOnlyFromTheModelsFolder) {
     EXPECT_EQ(missing.error().code, ErrorCode::NotFound);
 }
 
+TEST(GltfLoaderTest, FilesInMemoryResolveOnlyToEachOther) {
+    TempDir dir;
+    SkinnedTriangle t;
+    const std::vector<std::uint8_t> px = {255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255};
+    writeImage(dir / "tex.png", 2, 2, 3, px, OIIO::TypeDesc::UINT8);
+    writeBytes(dir / "secret.bin", t.b.bin); // on disk beside the process: must never be read
+    auto gltf = [&](const std::string& bufferUri, const std::string& imageUri) {
+        json d = t.b.doc;
+        d["buffers"] = json::array({{{"byteLength", t.b.bin.size()}, {"uri", bufferUri}}});
+        d["images"] = json::array({{{"uri", imageUri}}});
+        d["textures"] = json::array({{{"source", 0}}});
+        d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+        const std::string text = d.dump(1);
+        return std::vector<std::uint8_t>(text.begin(), text.end());
+    };
+    GltfFiles files = {{"my model.gltf", gltf("tri%20data.bin", "tex.png")},
+                       {"tri data.bin", t.b.bin},
+                       {"tex.png", readBytes(dir / "tex.png")}};
+    auto ok = loadGltfFromFiles(files, "my model.gltf");
+    ASSERT_TRUE(ok) << ok.error().message;
+    EXPECT_EQ(ok->triangleCount(), 1u);
+    ASSERT_EQ(ok->images.size(), 1u);
+    EXPECT_EQ(ok->images[0].width, 2); // step two ran: the texture is decoded
+
+    for (const std::string& uri :
+         {std::string("../secret.bin"), dir / "secret.bin", std::string("%2e%2e/secret.bin"),
+          std::string("sub/tri data.bin"), std::string("missing.bin"), std::string("./../tri data.bin")}) {
+        GltfFiles bad = files;
+        bad["bad.gltf"] = gltf(uri, "tex.png");
+        auto r = loadGltfFromFiles(bad, "bad.gltf");
+        ASSERT_FALSE(r) << uri;
+        EXPECT_EQ(r.error().code, ErrorCode::Parse) << uri;
+        EXPECT_NE(r.error().message.find("bad.gltf"), std::string::npos) << r.error().message;
+    }
+    auto noMain = loadGltfFromFiles(files, "other.gltf");
+    ASSERT_FALSE(noMain);
+    EXPECT_EQ(noMain.error().code, ErrorCode::NotFound);
+    EXPECT_EQ(noMain.error().field, "other.gltf");
+}
+
 // --- corrupt input: targeted damage names the field ------------------------------------------
 
 TEST(GltfLoaderTest, DamagedAccessorsNameTheAttribute) {

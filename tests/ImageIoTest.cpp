@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 using namespace dermis;
 using namespace dermis::test;
 using OIIO::TypeDesc;
@@ -98,6 +100,65 @@ TEST(ImageIoTest, Height16PngRoundTrip) {
     ASSERT_TRUE(back.ok());
     EXPECT_FLOAT_EQ(back->at(0, 0), 0.0f);
     EXPECT_NEAR(back->at(1, 0), -0.5f, 1.0 / 32767);
+}
+
+TEST(ImageIoTest, InMemoryEncodersMatchTheFilesAndReadBack) {
+    TempDir dir;
+    HeightImage img(5, 3);
+    for (std::size_t k = 0; k < img.data.size(); ++k)
+        img.data[k] = -1.0f + 2.0f * static_cast<float>(k) / 14.0f;
+    img.at(4, 2) = 3.0f; // clamped by the 16-bit mapping, kept by EXR and f32
+
+    auto exr = encodeFloatExr(img);
+    ASSERT_TRUE(exr) << exr.error().message;
+    ASSERT_TRUE(writeFloatImage(dir / "m.exr", img));
+    EXPECT_EQ(*exr, readBytes(dir / "m.exr")); // the file is exactly the in-memory encoding
+    auto in = OIIO::ImageInput::open(dir / "m.exr");
+    ASSERT_TRUE(in);
+    std::vector<float> px(img.data.size());
+    ASSERT_TRUE(in->read_image(0, 0, 0, 1, TypeDesc::FLOAT, px.data()));
+    EXPECT_EQ(px, img.data);
+
+    auto png = encodeHeight16Png(img);
+    ASSERT_TRUE(png) << png.error().message;
+    ASSERT_TRUE(writeHeight16Png(dir / "h.png", img));
+    EXPECT_EQ(*png, readBytes(dir / "h.png"));
+    auto back = readHeightImageFromMemory(*png);
+    ASSERT_TRUE(back) << back.error().message;
+    ASSERT_EQ(back->width, 5);
+    ASSERT_EQ(back->height, 3);
+    for (std::size_t k = 0; k + 1 < img.data.size(); ++k)
+        EXPECT_NEAR(back->data[k], img.data[k], 1.0 / 32767) << k;
+    EXPECT_FLOAT_EQ(back->at(4, 2), 1.0f);
+
+    auto raw = encodeF32(img);
+    ASSERT_TRUE(raw);
+    ASSERT_EQ(raw->size(), img.data.size() * 4);
+    for (std::size_t k = 0; k < img.data.size(); ++k) {
+        std::uint32_t bits = 0;
+        for (int b = 0; b < 4; ++b)
+            bits |= std::uint32_t((*raw)[k * 4 + static_cast<std::size_t>(b)]) << (8 * b);
+        float v = 0;
+        std::memcpy(&v, &bits, 4);
+        EXPECT_EQ(v, img.data[k]) << k;
+    }
+}
+
+TEST(ImageIoTest, InMemoryEncodersRefuseEmptyOrInconsistentImages) {
+    HeightImage empty;
+    HeightImage wrong(4, 4);
+    wrong.data.resize(3);
+    for (const HeightImage* img : {&empty, &wrong}) {
+        auto exr = encodeFloatExr(*img);
+        auto png = encodeHeight16Png(*img);
+        auto raw = encodeF32(*img);
+        ASSERT_FALSE(exr);
+        ASSERT_FALSE(png);
+        ASSERT_FALSE(raw);
+        EXPECT_EQ(exr.error().field, "image");
+        EXPECT_NE(png.error().message.find("dermis::encodeHeight16Png"), std::string::npos);
+        EXPECT_EQ(raw.error().code, ErrorCode::InvalidArgument);
+    }
 }
 
 TEST(ImageIoTest, DecodeImage8ExpandsGrey) {

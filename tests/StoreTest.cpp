@@ -1,7 +1,8 @@
-// StoreTest — the server's data folder (server/http/store): blobs and folder blobs with their
+// StoreTest — the server's data folder (server/service/store): blobs and folder blobs with their
 // metadata records, scene records, generated ids, unsafe names refused, unreadable records and
 // leftovers of interrupted writes skipped. Files only; no GL, no HTTP.
 #include "service/store.hpp"
+#include "io/atomic_file.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
@@ -37,7 +38,7 @@ TEST(StoreTest, BlobsRoundTripAndRemove) {
     EXPECT_TRUE(skipped.empty());
     EXPECT_EQ(blobs[0].id, id);
     EXPECT_EQ(blobs[0].meta["name"], "ridge");
-    EXPECT_EQ(*Store::readFile(blobs[0].file), bytes("PNGDATA"));
+    EXPECT_EQ(*readWholeFile(blobs[0].file), bytes("PNGDATA"));
     ASSERT_TRUE(store->removeBlob("patterns", id));
     EXPECT_TRUE(store->listBlobs("patterns", skipped).empty());
     EXPECT_FALSE(fs::exists(blobs[0].file));
@@ -54,7 +55,7 @@ TEST(StoreTest, FolderBlobsHoldSeveralFilesAndRefuseUnsafeNames) {
     auto blobs = store->listBlobs("models", skipped);
     ASSERT_EQ(blobs.size(), 1u);
     EXPECT_EQ(fs::path(blobs[0].file).filename(), "a.gltf");
-    EXPECT_EQ(*Store::readFile((fs::path(blobs[0].file).parent_path() / "a.bin").string()), bytes("BIN"));
+    EXPECT_EQ(*readWholeFile((fs::path(blobs[0].file).parent_path() / "a.bin").string()), bytes("BIN"));
     for (const char* bad : {"../x.bin", "/etc/passwd", "..", ".hidden", "a/b.bin", "a\\b", ""}) {
         EXPECT_FALSE(Store::isSafeFileName(bad)) << bad;
         auto s = store->putBlobFolder("models", Store::newId("m"), {{bad, bytes("x")}}, bad, {});
@@ -93,6 +94,8 @@ TEST(StoreTest, SkipsUnreadableRecordsAndCleansInterruptedWrites) {
     writeText(dir / "data/models/m_orphan.json", R"({"id":"m_orphan","file":"m_orphan.glb"})"); // no data
     writeText(dir / "data/scenes/s_x.json.tmp.123.0", "half a write");
     fs::create_directories(dir / "data/models/m_y.d.tmp.42");
+    fs::create_directories(dir / "data/upload.tmp.u_0123"); // an older version's scratch folder
+    writeText(dir / "data/patterns/p_z.png.tmp.7.1", "half an upload");
     auto store = Store::open(dir / "data");
     ASSERT_TRUE(store);
     std::vector<std::string> skipped;
@@ -101,18 +104,9 @@ TEST(StoreTest, SkipsUnreadableRecordsAndCleansInterruptedWrites) {
     EXPECT_EQ(skipped.size(), 2u);
     EXPECT_FALSE(fs::exists(dir / "data/scenes/s_x.json.tmp.123.0"));
     EXPECT_FALSE(fs::exists(dir / "data/models/m_y.d.tmp.42"));
-}
-
-TEST(StoreTest, DurableWritesReplaceWholeFiles) {
-    TempDir dir;
-    const std::string path = dir / "f.txt";
-    ASSERT_TRUE(Store::writeFileDurably(path, bytes("first version, long")));
-    ASSERT_TRUE(Store::writeFileDurably(path, bytes("second")));
-    EXPECT_EQ(*Store::readFile(path), bytes("second"));
-    EXPECT_FALSE(Store::writeFileDurably(dir / "no/such/folder/f.txt", bytes("x")));
-    EXPECT_EQ(fs::directory_iterator(dir.str()) == fs::directory_iterator(), false);
-    for (const auto& e : fs::directory_iterator(dir.str()))
-        EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+    EXPECT_FALSE(fs::exists(dir / "data/upload.tmp.u_0123"));
+    EXPECT_FALSE(fs::exists(dir / "data/patterns/p_z.png.tmp.7.1"));
+    EXPECT_TRUE(fs::exists(dir / "data/scenes/s_ok.json"));
 }
 
 } // namespace

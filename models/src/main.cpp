@@ -12,11 +12,13 @@
 #include "preview.hpp"
 
 #include "core/rig.hpp"
+#include "io/atomic_file.hpp"
+
+#include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <string>
 #include <system_error>
@@ -26,26 +28,11 @@ namespace {
 using namespace dermis::chargen;
 namespace fs = std::filesystem;
 
-int usage(const char* argv0) {
-    std::cerr << "usage: " << argv0 << " --out DIR [--preview PREFIX] [--quiet]\n"
-              << "  writes default.glb and default.charts.json into DIR; --preview also writes\n"
-              << "  PREFIX-poses.png, PREFIX-bends.png, PREFIX-charts.png, PREFIX-uv.png and\n"
-              << "  PREFIX-weights.png (CPU-rendered check images)\n";
-    return 2;
-}
-
-/// Writes `bytes` to `path` through a temporary file and a rename (never a partial file).
+/// Writes `bytes` to `path` whole (atomic_file.hpp: never a partial file).
 bool writeFileAtomic(const fs::path& path, const std::string& bytes) {
-    const fs::path tmp = path.string() + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) return false;
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-        if (!out) return false;
-    }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    return !ec;
+    return dermis::writeFileAtomically(path.string(),
+                                       std::vector<std::uint8_t>(bytes.begin(), bytes.end()))
+        .ok();
 }
 
 glm::vec3 chartColor(int c) {
@@ -220,22 +207,17 @@ bool writePreviews(const Character& ch, const std::string& prefix) {
 int main(int argc, char** argv) {
     std::string outDir, preview;
     bool quiet = false;
-    for (int k = 1; k < argc; ++k) {
-        const std::string a = argv[k];
-        if (a == "--out" && k + 1 < argc) {
-            outDir = argv[++k];
-        } else if (a == "--preview" && k + 1 < argc) {
-            preview = argv[++k];
-        } else if (a == "--quiet") {
-            quiet = true;
-        } else if (a == "-h" || a == "--help") {
-            usage(argv[0]);
-            return 0;
-        } else {
-            return usage(argv[0]);
-        }
+    CLI::App app{"Writes the built-in default character: default.glb and default.charts.json"};
+    app.add_option("--out", outDir, "Output folder (created if needed)")->required();
+    app.add_option("--preview", preview,
+                   "Also write PREFIX-poses.png, PREFIX-bends.png, PREFIX-charts.png, "
+                   "PREFIX-uv.png and PREFIX-weights.png (CPU-rendered check images)");
+    app.add_flag("--quiet", quiet, "No progress on stderr");
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;
     }
-    if (outDir.empty()) return usage(argv[0]);
 
     Character ch;
     std::string error;

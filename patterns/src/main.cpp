@@ -2,27 +2,21 @@
 //   dermis-patterngen --out DIR [--size N]
 // DIR receives <id>.png (16-bit grey, SPEC §2 value mapping), manifest.json (dermis.patterns/1)
 // and contact-sheet.png (8-bit RGB overview). Output is bit-identical from run to run.
+// Exit status: 0 on success, 1 when a file cannot be written, 2 on bad usage.
 #include "patterns.hpp"
 
+#include "io/atomic_file.hpp"
 #include "io/image_io.hpp"
 
+#include <CLI/CLI.hpp>
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <string>
 
 namespace {
-
-int usage(const char* argv0) {
-    std::cerr << "usage: " << argv0 << " --out DIR [--size N]\n"
-              << "  writes the built-in height patterns (16-bit PNG), manifest.json and\n"
-              << "  contact-sheet.png into DIR; N (default 512) is the side in pixels, 16..4096\n";
-    return 2;
-}
 
 bool writeRgbPng(const std::string& path, const dermis::patterngen::RgbImage& img) {
     auto out = OIIO::ImageOutput::create(path);
@@ -41,29 +35,15 @@ bool writeRgbPng(const std::string& path, const dermis::patterngen::RgbImage& im
 int main(int argc, char** argv) {
     std::string outDir;
     int size = 512;
-    for (int k = 1; k < argc; ++k) {
-        std::string a = argv[k];
-        if ((a == "--out" || a == "--size") && k + 1 < argc) {
-            std::string v = argv[++k];
-            if (a == "--out") {
-                outDir = v;
-            } else {
-                char* end = nullptr;
-                long n = std::strtol(v.c_str(), &end, 10);
-                if (end == v.c_str() || *end != '\0' || n < 16 || n > 4096) {
-                    std::cerr << "--size: expected an integer in [16, 4096], got '" << v << "'\n";
-                    return 2;
-                }
-                size = static_cast<int>(n);
-            }
-        } else if (a == "-h" || a == "--help") {
-            usage(argv[0]);
-            return 0;
-        } else {
-            return usage(argv[0]);
-        }
+    CLI::App app{"Writes the built-in height patterns (16-bit PNG), manifest.json and "
+                 "contact-sheet.png into a folder"};
+    app.add_option("--out", outDir, "Output folder (created if needed)")->required();
+    app.add_option("--size", size, "Side of each pattern in pixels")->check(CLI::Range(16, 4096));
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e) == 0 ? 0 : 2;
     }
-    if (outDir.empty()) return usage(argv[0]);
 
     std::error_code ec;
     std::filesystem::create_directories(outDir, ec);
@@ -84,13 +64,13 @@ int main(int argc, char** argv) {
         manifest.patterns.push_back(p.info);
     }
 
-    {
-        std::ofstream out(dir / "manifest.json", std::ios::binary | std::ios::trunc);
-        out << dermis::toJson(manifest).dump(2) << "\n";
-        if (!out) {
-            std::cerr << "cannot write " << (dir / "manifest.json").string() << "\n";
-            return 1;
-        }
+    const std::string manifestText = dermis::toJson(manifest).dump(2) + "\n";
+    if (auto st = dermis::writeFileAtomically(
+            (dir / "manifest.json").string(),
+            std::vector<std::uint8_t>(manifestText.begin(), manifestText.end()));
+        !st) {
+        std::cerr << st.error().message << "\n";
+        return 1;
     }
 
     if (!writeRgbPng((dir / "contact-sheet.png").string(),

@@ -102,9 +102,8 @@ int runBake(const BakeArgs& a) {
             return fail(s.error());
     }
     if (a.normals) {
-        // A bump-map unit rises bump_strength % of the map's width (in texels).
-        const double strength = 0.01 * plan->render.bumpStrength * maps.bump.width;
-        auto normal = normalMapFromBump(maps.bump, strength);
+        auto normal = normalMapFromBump(
+            maps.bump, normalMapStrength(plan->render.bumpStrength, maps.bump.width));
         if (!normal) return fail(normal.error());
         if (auto s = writeFrame(a.out + "/normal.png", encodeNormalMap8(*normal)); !s)
             return fail(s.error());

@@ -1,5 +1,5 @@
 // Joint angles of SPEC §2: the twist part of a swing–twist decomposition.
-#include "rig.hpp"
+#include "angles.hpp"
 
 #include <cmath>
 

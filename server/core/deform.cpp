@@ -63,19 +63,6 @@ Target defaultTarget(PatternKind k) {
     return k == PatternKind::Bulge ? Target::Displacement : Target::Bump;
 }
 
-Status validateDrive(const Drive& d, const std::string& prefix) {
-    const char* where = "dermis::validateDrive";
-    auto bad = [&](const char* f, const char* what) {
-        return makeError(ErrorCode::InvalidArgument, where, prefix + "/" + f, what);
-    };
-    if (!std::isfinite(d.thetaMin)) return bad("theta_min", "must be a finite number");
-    if (!std::isfinite(d.thetaMax)) return bad("theta_max", "must be a finite number");
-    if (d.thetaMin == d.thetaMax) return bad("theta_max", "must differ from theta_min");
-    if (!std::isfinite(d.h)) return bad("h", "must be a finite number");
-    if (d.h < 0.0) return bad("h", "must be >= 0");
-    return Ok{};
-}
-
 double normalizedT(double theta, double thetaMin, double thetaMax) {
     double t = (theta - thetaMin) / (thetaMax - thetaMin);
     return std::clamp(t, 0.0, 1.0);
@@ -103,11 +90,6 @@ double responseOffset(Response r, double t) {
 
 float deformConstant(DeformModel m, Response r, double t) {
     return static_cast<float>(m == DeformModel::Scale ? responseGain(r, t) : responseOffset(r, t));
-}
-
-float deformHeight(const Drive& d, float L, double theta) {
-    double t = normalizedT(theta, d.thetaMin, d.thetaMax);
-    return applyDeform(d.model, L, static_cast<float>(d.h), t, deformConstant(d.model, d.response, t));
 }
 
 } // namespace dermis

@@ -44,19 +44,6 @@ std::optional<PatternKind> patternKindFromString(std::string_view s);
 DeformModel defaultModel(PatternKind k);
 Target defaultTarget(PatternKind k);
 
-/// The drive parameters of one placement.
-struct Drive {
-    double thetaMin = 0.0; ///< degrees: angle at which the pattern is absent (t = 0)
-    double thetaMax = 90.0; ///< degrees: angle at which the pattern is full (t = 1); ≠ thetaMin
-    double h = 1.0;        ///< gain, ≥ 0
-    DeformModel model = DeformModel::Scale;
-    Response response = Response::Log2;
-};
-
-/// Checks a Drive: finite values, thetaMin ≠ thetaMax, h ≥ 0. The error names the field
-/// ("theta_min", "theta_max", "h") with `fieldPrefix` prepended (e.g. "/placements/3").
-Status validateDrive(const Drive& d, const std::string& fieldPrefix = "");
-
 /// t = clamp((theta − thetaMin) / (thetaMax − thetaMin), 0, 1). Works for reversed ranges
 /// (thetaMin > thetaMax). Precondition: validateDrive(d) succeeded and theta is finite.
 double normalizedT(double theta, double thetaMin, double thetaMax);
@@ -79,8 +66,5 @@ inline float applyDeform(DeformModel m, float L, float h, double t, float gainOr
 
 /// Convenience: the per-placement constant of applyDeform (gain for Scale, offset for Bias).
 float deformConstant(DeformModel m, Response r, double t);
-
-/// L_out for one value, combining the above (reference form, used by tests and the CPU path).
-float deformHeight(const Drive& d, float L, double theta);
 
 } // namespace dermis

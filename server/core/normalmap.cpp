@@ -93,4 +93,8 @@ Image8 encodeNormalMap8(const NormalImage& n) {
     return out;
 }
 
+double normalMapStrength(double bumpStrength, int mapWidth) {
+    return 0.01 * bumpStrength * mapWidth;
+}
+
 } // namespace dermis

@@ -44,6 +44,12 @@ struct NormalImage {
 /// a negative or non-finite strength (field "strength").
 Result<NormalImage> normalMapFromBump(const HeightImage& bump, double strength);
 
+/// The `strength` of a scene's normal map (the one formula for `bake --normals` and the
+/// server's normal-map route): a bump-map unit rises `bumpStrength` % of the map's width, in
+/// texels: 0.01 · bumpStrength · mapWidth. bumpStrength is the scene's render.bump_strength
+/// (≥ 0, validateRenderSettings).
+double normalMapStrength(double bumpStrength, int mapWidth);
+
 /// Encodes a normal map as RGBA8: each component c ∈ [−1, 1] becomes round((c·0.5 + 0.5)·255)
 /// (so 0 → 128, 1 → 255, −1 → 0; values outside [−1, 1] are clamped, non-finite ones encode as
 /// 0 → 128), alpha 255. Row order is kept (row 0 first). Returns an empty Image8 (0×0) when `n`

@@ -1,9 +1,10 @@
-// Dermis core — pose math: clip sampling, pose overrides, world matrices, joint angles, CPU
-// linear blend skinning (the paper's SSD).
+// Dermis core — pose math: clip sampling, pose overrides, world matrices, CPU linear blend
+// skinning (the paper's SSD). Joint angles are in angles.hpp (included here for convenience).
 //
 // Pure functions over a Model; no I/O. Thread-safe for concurrent calls on a const Model.
 #pragma once
 
+#include "angles.hpp"
 #include "model.hpp"
 #include "result.hpp"
 
@@ -45,17 +46,5 @@ struct SkinnedPart {
 /// whose joints/weights arrays do not match its vertex count follows influence 0; a part without
 /// normals gets computeNormals of the posed positions. Never reads out of bounds.
 std::vector<SkinnedPart> skin(const Model& model, const std::vector<glm::mat4>& world);
-
-/// A joint's rotation axis in its rest frame; normalised by the caller (see jointAngle).
-/// Returns theta in degrees in (−180, 180]: the twist angle of q_rel = q_rest⁻¹ · q_pose about
-/// `axis` (SPEC §2): theta = 2·atan2(dot(q_rel.xyz, a), q_rel.w), wrapped. q and −q give the same
-/// angle. Precondition: |axis| = 1.
-double jointAngle(const glm::quat& restLocal, const glm::quat& poseLocal, const glm::vec3& axis);
-
-/// q_rest · R_x(x) · R_y(y) · R_z(z), angles in degrees (the scene document's `axis_angles`).
-glm::quat axisAnglesRotation(const glm::quat& restLocal, double xDeg, double yDeg, double zDeg);
-
-/// Wraps degrees into (−180, 180].
-double wrapDegrees(double deg);
 
 } // namespace dermis

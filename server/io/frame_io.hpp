@@ -54,11 +54,10 @@ Result<std::vector<std::uint8_t>> encodeJpeg(const Image8& img, int quality = 90
 Result<std::vector<std::uint8_t>> encodeFrame(const Image8& img, FrameFormat f);
 
 /// Writes a frame to `path` in the format of its extension (frameFormatFromPath; anything else →
-/// InvalidArgument with the path as field), encoded as by encodeFrame. The bytes go to a fresh
-/// temporary file beside `path` ("<path>.tmp.<pid>.<n>", created with the process umask) which
-/// is then renamed over `path`, so readers never see a partial frame (a symbolic link at `path`
-/// is replaced, not followed); on failure the temporary file is removed and `path` is left as it
-/// was. Does not create folders and does not fsync.
+/// InvalidArgument with the path as field), encoded as by encodeFrame, replaced whole through
+/// writeFileAtomically (atomic_file.hpp, Durability::Atomic): readers never see a partial frame,
+/// a symbolic link at `path` is replaced, not followed, and on failure `path` is left as it was.
+/// Does not create folders and does not fsync.
 Status writeFrame(const std::string& path, const Image8& img);
 
 /// Decodes PNG or JPEG bytes (by magic number) to RGBA8 with libpng / libjpeg-turbo: values as

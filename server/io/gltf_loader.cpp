@@ -224,12 +224,18 @@ bool captureImage(tg::Image* image, const int index, std::string* err, std::stri
     return true;
 }
 
-/// The folder external resources must lie in (canonical); empty: no file access.
+/// Where external resources may come from: a folder on disk (canonical `root`), or the named
+/// files of an upload in memory (`memory`, seen by tinygltf under the virtual folder
+/// kMemoryRoot); neither: no file access.
 struct Sandbox {
     fs::path root;
+    const GltfFiles* memory = nullptr;
 };
 
-/// `path` made canonical if it names something inside the sandbox, else nullopt.
+/// The virtual folder of in-memory files (never touched on disk).
+const char* const kMemoryRoot = "/dermis-upload";
+
+/// `path` made canonical if it names something inside the sandbox's folder, else nullopt.
 std::optional<fs::path> confined(const std::string& path, const Sandbox& sb) {
     if (sb.root.empty() || path.empty() || path.find('\0') != std::string::npos)
         return std::nullopt;
@@ -241,8 +247,19 @@ std::optional<fs::path> confined(const std::string& path, const Sandbox& sb) {
     return p;
 }
 
+/// The in-memory file `path` names: "<kMemoryRoot>/<name>" exactly, no folders, no "..".
+const std::vector<std::uint8_t>* memoryFile(const std::string& path, const Sandbox& sb) {
+    if (!sb.memory || path.find('\0') != std::string::npos) return nullptr;
+    const fs::path p = fs::path(path).lexically_normal();
+    if (p.parent_path() != fs::path(kMemoryRoot)) return nullptr;
+    const auto it = sb.memory->find(p.filename().string());
+    return it == sb.memory->end() ? nullptr : &it->second;
+}
+
 bool sandboxFileExists(const std::string& path, void* user) {
-    const auto p = confined(path, *static_cast<Sandbox*>(user));
+    const Sandbox& sb = *static_cast<Sandbox*>(user);
+    if (sb.memory) return memoryFile(path, sb) != nullptr;
+    const auto p = confined(path, sb);
     std::error_code ec;
     return p && fs::is_regular_file(*p, ec);
 }
@@ -253,7 +270,17 @@ std::string sandboxExpand(const std::string& path, void*) {
 
 bool sandboxRead(std::vector<unsigned char>* out, std::string* err, const std::string& path,
                  void* user) {
-    const auto p = confined(path, *static_cast<Sandbox*>(user));
+    const Sandbox& sb = *static_cast<Sandbox*>(user);
+    if (sb.memory) {
+        const auto* bytes = memoryFile(path, sb);
+        if (!bytes || bytes->size() > kMaxGltfBytes) {
+            if (err) *err += "refused or not among the uploaded files: " + path + "\n";
+            return false;
+        }
+        out->assign(bytes->begin(), bytes->end());
+        return true;
+    }
+    const auto p = confined(path, sb);
     std::error_code ec;
     const auto size = p ? fs::file_size(*p, ec) : 0;
     if (!p || ec || !fs::is_regular_file(*p, ec) || size > kMaxGltfBytes) {
@@ -1138,9 +1165,8 @@ std::string tinygltfMessage(const std::string& err) {
     return s.empty() ? std::string("not a glTF 2.0 file") : s;
 }
 
-} // namespace
-
-Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir) {
+/// parseGltf with external files from `sandbox`.
+Result<ParsedGltf> parseIn(const std::vector<std::uint8_t>& bytes, Sandbox sandbox) {
     if (bytes.empty()) return parseError("", "empty input");
     if (bytes.size() > kMaxGltfBytes)
         return makeError(ErrorCode::Unsupported, kWhere, "",
@@ -1158,12 +1184,6 @@ Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::
         const char* json = reinterpret_cast<const char*>(bytes.data()) + jsonOffset;
         if (auto s = preflight(json, jsonLength); !s) return s.error();
 
-        Sandbox sandbox;
-        if (!baseDir.empty()) {
-            std::error_code ec;
-            sandbox.root = fs::weakly_canonical(fs::path(baseDir), ec);
-            if (ec) sandbox.root.clear();
-        }
         Captured captured;
         tg::TinyGLTF loader;
         loader.SetImageLoader(&captureImage, &captured);
@@ -1171,7 +1191,7 @@ Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::
                                               &sandboxWrite, &sandbox});
         tg::Model g;
         std::string err, warn;
-        const std::string base = sandbox.root.string();
+        const std::string base = sandbox.memory ? std::string(kMemoryRoot) : sandbox.root.string();
         const bool ok =
             binary ? loader.LoadBinaryFromMemory(&g, &err, &warn, bytes.data(),
                                                  static_cast<unsigned int>(length), base)
@@ -1184,6 +1204,18 @@ Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::
     } catch (const std::exception& e) {
         return parseError("", std::string("malformed file: ") + e.what());
     }
+}
+
+} // namespace
+
+Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir) {
+    Sandbox sandbox;
+    if (!baseDir.empty()) {
+        std::error_code ec;
+        sandbox.root = fs::weakly_canonical(fs::path(baseDir), ec);
+        if (ec) sandbox.root.clear();
+    }
+    return parseIn(bytes, std::move(sandbox));
 }
 
 Status loadGltfResources(ParsedGltf& parsed) {
@@ -1203,6 +1235,27 @@ Status loadGltfResources(ParsedGltf& parsed) {
     }
     parsed.images.entries.clear();
     return Ok{};
+}
+
+Result<Model> loadGltfFromFiles(const GltfFiles& files, const std::string& mainFile) {
+    const char* where = "dermis::loadGltfFromFiles";
+    const auto it = files.find(mainFile);
+    if (it == files.end())
+        return makeError(ErrorCode::NotFound, where, mainFile, "not among the given files");
+    Sandbox sandbox;
+    sandbox.memory = &files;
+    auto parsed = parseIn(it->second, std::move(sandbox));
+    if (!parsed) {
+        Error e = parsed.error();
+        e.message = std::string(where) + ": " + mainFile + ": " + e.message;
+        return e;
+    }
+    if (auto s = loadGltfResources(*parsed); !s) {
+        Error e = s.error();
+        e.message = std::string(where) + ": " + mainFile + ": " + e.message;
+        return e;
+    }
+    return std::move(parsed->model);
 }
 
 Result<Model> loadGltfFile(const std::string& path) {

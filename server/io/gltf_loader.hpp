@@ -4,7 +4,8 @@
 //      buffer-view images are captured as encoded bytes (tinygltf's image-loader hook) but not
 //      decoded.
 //   2. loadGltfResources: decodes the captured images with OpenImageIO into Model::images.
-// loadGltfFile does both for a file on disk (external .bin/.png resolved beside the .gltf).
+// loadGltfFile does both for a file on disk (external .bin/.png resolved beside the .gltf),
+// loadGltfFromFiles for a .gltf and its files held in memory (an upload).
 //
 // What is loaded: every triangle primitive (TRIANGLES; TRIANGLE_STRIP and TRIANGLE_FAN are
 // converted to lists) of every mesh reachable from the default scene (scene 0 when `scene` is
@@ -38,6 +39,7 @@
 #include "core/result.hpp"
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -72,5 +74,15 @@ Status loadGltfResources(ParsedGltf& parsed);
 
 /// Both steps for a file on disk.
 Result<Model> loadGltfFile(const std::string& path);
+
+/// Named files held in memory: plain file name → bytes.
+using GltfFiles = std::map<std::string, std::vector<std::uint8_t>>;
+
+/// Both steps for a .gltf (or .glb) given with its files in memory, as an upload brings them:
+/// `mainFile` names it among `files`; its external URIs (percent-decoded, as glTF asks) resolve
+/// only to other entries of `files` by plain name. A URI with a folder, "..", an absolute path or
+/// a name not in `files` fails like an unreadable file (Parse). Reads no file of this machine
+/// and writes none. NotFound (field `mainFile`) when `mainFile` is not in `files`.
+Result<Model> loadGltfFromFiles(const GltfFiles& files, const std::string& mainFile);
 
 } // namespace dermis

@@ -2,15 +2,15 @@
 // mapping and failure modes.
 #include "image_io.hpp"
 
+#include "io/atomic_file.hpp"
+
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <unistd.h>
 
 namespace dermis {
 namespace {
@@ -88,35 +88,8 @@ Result<HeightImage> readHeight(ImageInput& in, const char* where, const std::str
     return img;
 }
 
-/// RAII temporary file for formats whose OpenImageIO plugin cannot read from memory.
-struct TempFile {
-    std::string path;
-    explicit TempFile(std::string p) : path(std::move(p)) {}
-    TempFile(TempFile&& o) noexcept : path(std::move(o.path)) { o.path.clear(); }
-    TempFile(const TempFile&) = delete;
-    TempFile& operator=(const TempFile&) = delete;
-    TempFile& operator=(TempFile&&) = delete;
-    ~TempFile() {
-        if (!path.empty()) std::remove(path.c_str());
-    }
-};
-
-Result<TempFile> writeTemp(const std::vector<std::uint8_t>& bytes, const std::string& name) {
-    std::string tmpl = (std::filesystem::temp_directory_path() / "dermis-XXXXXX").string();
-    std::string ext = name.substr(name.find('.'));
-    tmpl += ext;
-    int fd = mkstemps(tmpl.data(), static_cast<int>(ext.size()));
-    if (fd < 0) return makeError(ErrorCode::Io, "dermis::readImage", "", "cannot create a temporary file");
-    ::close(fd);
-    TempFile t(tmpl);
-    std::ofstream out(t.path, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!out) return makeError(ErrorCode::Io, "dermis::readImage", "", "cannot write a temporary file");
-    return t;
-}
-
 /// Opens encoded bytes: through an in-memory proxy when the plugin supports it, else via a
-/// temporary file. `keep` holds whatever must outlive the returned ImageInput.
+/// ScratchFile that lives until `fn` returns.
 template <class Fn>
 auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where, Fn&& fn)
     -> decltype(fn(std::declval<ImageInput&>())) {
@@ -132,11 +105,11 @@ auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where,
         if (in) return fn(*in);
         OIIO::geterror(); // clear
     }
-    auto tmp = writeTemp(bytes, name);
+    auto tmp = ScratchFile::create(bytes, name.substr(name.find('.')));
     if (!tmp) return tmp.error();
     ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = ImageInput::open(tmp->path, &config);
+    auto in = ImageInput::open(tmp->path(), &config);
     if (!in) return oiioError(where, "", "unrecognised or corrupt image data");
     return fn(*in);
 }
@@ -187,40 +160,78 @@ Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes) {
     });
 }
 
-Status writeFloatImage(const std::string& path, const HeightImage& image) {
-    const char* where = "dermis::writeFloatImage";
+namespace {
+
+/// Encodes one channel through OpenImageIO into memory; `name` picks the writer by extension.
+Result<std::vector<std::uint8_t>> encodeThroughOiio(const char* where, const char* name,
+                                                    const ImageSpec& spec, TypeDesc type,
+                                                    const void* pixels) {
+    std::vector<unsigned char> buf;
+    OIIO::Filesystem::IOVecOutput proxy(buf);
+    auto out = OIIO::ImageOutput::create(name, &proxy);
+    if (!out || !out->supports("ioproxy")) {
+        std::string detail = OIIO::geterror();
+        return makeError(ErrorCode::Unsupported, where, "format",
+                         std::string("OpenImageIO cannot write ") + name + " to memory" +
+                             (detail.empty() ? "" : " (" + detail + ")"));
+    }
+    if (!out->open(name, spec) || !out->write_image(type, pixels) || !out->close())
+        return makeError(ErrorCode::Io, where, "", "cannot encode: " + out->geterror());
+    return std::vector<std::uint8_t>(buf.begin(), buf.end());
+}
+
+Status checkHeightImage(const char* where, const HeightImage& image) {
     if (image.width <= 0 || image.height <= 0 ||
         image.data.size() != static_cast<std::size_t>(image.width) * image.height)
         return makeError(ErrorCode::InvalidArgument, where, "image", "empty or inconsistent image");
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) return oiioError(where, path, "no image writer for this file name");
-    ImageSpec spec(image.width, image.height, 1, TypeDesc::FLOAT);
-    spec.channelnames = {"Y"};
-    if (!out->open(path, spec))
-        return makeError(ErrorCode::Io, where, path, "cannot open for writing: " + out->geterror());
-    if (!out->write_image(TypeDesc::FLOAT, image.data.data()) || !out->close())
-        return makeError(ErrorCode::Io, where, path, "cannot write: " + out->geterror());
     return Ok{};
 }
 
-Status writeHeight16Png(const std::string& path, const HeightImage& image) {
-    const char* where = "dermis::writeHeight16Png";
-    if (image.width <= 0 || image.height <= 0 ||
-        image.data.size() != static_cast<std::size_t>(image.width) * image.height)
-        return makeError(ErrorCode::InvalidArgument, where, "image", "empty or inconsistent image");
+} // namespace
+
+Result<std::vector<std::uint8_t>> encodeFloatExr(const HeightImage& image) {
+    const char* where = "dermis::encodeFloatExr";
+    if (auto s = checkHeightImage(where, image); !s) return s.error();
+    ImageSpec spec(image.width, image.height, 1, TypeDesc::FLOAT);
+    spec.channelnames = {"Y"};
+    return encodeThroughOiio(where, "map.exr", spec, TypeDesc::FLOAT, image.data.data());
+}
+
+Result<std::vector<std::uint8_t>> encodeHeight16Png(const HeightImage& image) {
+    const char* where = "dermis::encodeHeight16Png";
+    if (auto s = checkHeightImage(where, image); !s) return s.error();
     std::vector<std::uint16_t> px(image.data.size());
     for (std::size_t k = 0; k < px.size(); ++k) {
         double v = std::clamp(static_cast<double>(image.data[k]), -1.0, 1.0);
+        if (!std::isfinite(v)) v = 0.0;
         px[k] = static_cast<std::uint16_t>(std::lround(32768.0 + 32767.0 * v));
     }
-    auto out = OIIO::ImageOutput::create(path);
-    if (!out) return oiioError(where, path, "no image writer for this file name");
     ImageSpec spec(image.width, image.height, 1, TypeDesc::UINT16);
-    if (!out->open(path, spec))
-        return makeError(ErrorCode::Io, where, path, "cannot open for writing: " + out->geterror());
-    if (!out->write_image(TypeDesc::UINT16, px.data()) || !out->close())
-        return makeError(ErrorCode::Io, where, path, "cannot write: " + out->geterror());
-    return Ok{};
+    return encodeThroughOiio(where, "map.png", spec, TypeDesc::UINT16, px.data());
+}
+
+Result<std::vector<std::uint8_t>> encodeF32(const HeightImage& image) {
+    if (auto s = checkHeightImage("dermis::encodeF32", image); !s) return s.error();
+    std::vector<std::uint8_t> out(image.data.size() * sizeof(float));
+    for (std::size_t k = 0; k < image.data.size(); ++k) {
+        std::uint32_t bits = 0;
+        std::memcpy(&bits, &image.data[k], sizeof bits);
+        for (int b = 0; b < 4; ++b) // little-endian whatever the host's order
+            out[k * 4 + static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(bits >> (8 * b));
+    }
+    return out;
+}
+
+Status writeFloatImage(const std::string& path, const HeightImage& image) {
+    auto bytes = encodeFloatExr(image);
+    if (!bytes) return bytes.error();
+    return writeFileAtomically(path, *bytes, Durability::Atomic, "dermis::writeFloatImage");
+}
+
+Status writeHeight16Png(const std::string& path, const HeightImage& image) {
+    auto bytes = encodeHeight16Png(image);
+    if (!bytes) return bytes.error();
+    return writeFileAtomically(path, *bytes, Durability::Atomic, "dermis::writeHeight16Png");
 }
 
 } // namespace dermis

@@ -1,4 +1,5 @@
-// Dermis io shell — pattern images in, float height maps out, through OpenImageIO.
+// Dermis io shell — pattern images in, float height maps out (to memory or to a file), through
+// OpenImageIO. Formats a plugin cannot read from memory go through a ScratchFile.
 //
 // Value mapping of SPEC §2: 16-bit unsigned L = clamp((v − 32768)/32767, −1, 1); 8-bit unsigned
 // L = clamp((v − 128)/127, −1, 1); half/float/double images as they are, clamped to [−1, 1]; any
@@ -25,9 +26,20 @@ Result<HeightImage> readHeightImage(const std::string& path);
 /// Same, from encoded bytes in memory (PNG, TIFF, EXR, … by content).
 Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes);
 
-/// Writes a single-channel 32-bit float image (EXR by extension, row 0 first).
+/// Encodes a height map in memory as a single-channel ("Y") 32-bit float OpenEXR, row 0 first,
+/// values as they are. InvalidArgument for an empty or inconsistent image; Unsupported when
+/// OpenImageIO cannot write EXR to memory.
+Result<std::vector<std::uint8_t>> encodeFloatExr(const HeightImage& image);
+/// Encodes a height map in memory as a 16-bit grey PNG with the inverse of the 16-bit mapping:
+/// v = round(32768 + 32767·clamp(L, −1, 1)) (L = 0 → 32768; NaN → 32768). Same failures.
+Result<std::vector<std::uint8_t>> encodeHeight16Png(const HeightImage& image);
+/// The raw map: width·height little-endian IEEE-754 float32 values, row 0 first, no header
+/// (the server's `f32` format). InvalidArgument for an empty or inconsistent image.
+Result<std::vector<std::uint8_t>> encodeF32(const HeightImage& image);
+
+/// encodeFloatExr to a file, replaced whole (writeFileAtomically, atomic_file.hpp).
 Status writeFloatImage(const std::string& path, const HeightImage& image);
-/// Writes a 16-bit grey PNG with the inverse of the 16-bit mapping (L = 0 → 32768).
+/// encodeHeight16Png to a file, replaced whole.
 Status writeHeight16Png(const std::string& path, const HeightImage& image);
 
 /// Decodes an encoded image (PNG, JPEG, …) to RGBA8 (grey → RGB, missing alpha → 255).

@@ -2,6 +2,7 @@
 // document checks every scene change goes through.
 #include "service/service_state.hpp"
 
+#include "io/atomic_file.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/image_io.hpp"
 #include "io/scene_files.hpp"
@@ -159,7 +160,7 @@ Status Service::State::loadContent() {
     std::error_code ec;
     if (!std::filesystem::exists(setPath, ec)) return Ok{};
     const char* where = "dermis::Service::open";
-    auto bytes = Store::readFile(setPath);
+    auto bytes = readWholeFile(setPath);
     if (!bytes)
         return makeError(ErrorCode::Io, where, setPath, "cannot read the default pattern set: " + bytes.error().message);
     json doc = json::parse(bytes->begin(), bytes->end(), nullptr, false);
@@ -179,7 +180,7 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
         if (b.file.size() > 5 && b.file.compare(b.file.size() - 5, 5, ".gltf") == 0) {
             model = loadGltfFile(b.file); // a multi-file upload: resources beside it only
         } else {
-            auto bytes = Store::readFile(b.file);
+            auto bytes = readWholeFile(b.file);
             if (!bytes) {
                 warnings.push_back(b.file + ": unreadable");
                 continue;
@@ -199,7 +200,7 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
                                   std::make_shared<const Model>(std::move(*model)), bytesLen, false};
     }
     for (const Store::Blob& b : store->listBlobs("patterns", warnings)) {
-        auto bytes = Store::readFile(b.file);
+        auto bytes = readWholeFile(b.file);
         auto img = bytes ? readHeightImageFromMemory(*bytes) : Result<HeightImage>(bytes.error());
         if (!img) {
             warnings.push_back(b.file + ": " + img.error().message);

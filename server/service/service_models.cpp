@@ -7,13 +7,10 @@
 
 #include <cmath>
 #include <cstring>
-#include <filesystem>
-#include <set>
 
 namespace dermis {
 
 using namespace detail;
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -66,74 +63,54 @@ Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::
     auto parsed = parseGltf(glb, ""); // no base folder: no file of this machine is read
     if (!parsed) return parsed.error();
     if (auto s = loadGltfResources(*parsed); !s) return s.error();
-    Model& m = parsed->model;
-    if (auto st = checkModel(m, limits_, where); !st) return st.error();
-    ModelEntry e;
-    e.id = Store::newId("m");
-    e.name = sanitizeName(name);
-    e.bytes = glb.size();
-    e.model = std::make_shared<const Model>(std::move(m));
-    std::lock_guard<std::mutex> write(state_->writeMutex);
-    if (auto s = state_->store->putBlob("models", e.id, "glb", glb,
-                                        {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
-        !s)
-        return s.error();
-    json summary = modelSummary(e);
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    state_->models[e.id] = std::move(e);
-    return summary;
+    if (auto st = checkModel(parsed->model, limits_, where); !st) return st.error();
+    ModelEntry e{Store::newId("m"), sanitizeName(name),
+                 std::make_shared<const Model>(std::move(parsed->model)), glb.size(), false};
+    const std::string id = e.id;
+    return state_->addModelEntry(std::move(e), [&](Store& store, const json& meta) {
+        return store.putBlob("models", id, "glb", glb, meta);
+    });
 }
 
 Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const std::string& gltfName,
                                     const std::string& name) {
     const char* where = "dermis::Service::addModelFiles";
     std::size_t total = 0;
-    std::set<std::string> names;
     for (const UploadFile& f : files) {
         total += f.bytes.size();
+        if (total > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
+    }
+    GltfFiles named;
+    for (const UploadFile& f : files) {
         if (!Store::isSafeFileName(f.name))
             return makeError(ErrorCode::InvalidArgument, where, "files/" + f.name,
                              "a file name must be plain ([A-Za-z0-9._ -], no folders)");
-        if (!names.insert(f.name).second)
+        if (!named.emplace(f.name, f.bytes).second)
             return makeError(ErrorCode::InvalidArgument, where, "files/" + f.name, "given twice");
     }
-    if (total > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
-    if (gltfName.empty() || !names.count(gltfName))
+    if (gltfName.empty() || !named.count(gltfName))
         return makeError(ErrorCode::InvalidArgument, where, "gltf",
                          "no .gltf part (name the part \"gltf\" or give it a .gltf file name)");
-    // Parse from a private scratch folder: the loader reads external URIs only inside it.
-    const fs::path scratch = fs::path(state_->store->dir()) / ("upload.tmp." + Store::newId("u"));
-    std::error_code ec;
-    fs::create_directories(scratch, ec);
-    if (ec) return makeError(ErrorCode::Io, where, "", "cannot create a scratch folder: " + ec.message());
-    struct Cleanup {
-        fs::path p;
-        ~Cleanup() {
-            std::error_code e;
-            fs::remove_all(p, e);
-        }
-    } cleanup{scratch};
-    for (const UploadFile& f : files)
-        if (auto s = Store::writeFileDurably((scratch / f.name).string(), f.bytes); !s) return s.error();
-    auto model = loadGltfFile((scratch / gltfName).string());
+    // Parsed from memory: the .gltf's URIs resolve to the uploaded files only.
+    auto model = loadGltfFromFiles(named, gltfName);
     if (!model) return model.error();
     if (auto st = checkModel(*model, limits_, where); !st) return st.error();
-    ModelEntry e;
-    e.id = Store::newId("m");
-    e.name = sanitizeName(name.empty() ? gltfName : name);
-    e.bytes = total;
-    e.model = std::make_shared<const Model>(std::move(*model));
-    std::vector<std::pair<std::string, std::vector<std::uint8_t>>> stored;
-    for (const UploadFile& f : files)
-        stored.emplace_back(f.name, f.bytes);
-    std::lock_guard<std::mutex> write(state_->writeMutex);
-    if (auto s = state_->store->putBlobFolder("models", e.id, stored, gltfName,
-                                              {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
-        !s)
+    ModelEntry e{Store::newId("m"), sanitizeName(name.empty() ? gltfName : name),
+                 std::make_shared<const Model>(std::move(*model)), total, false};
+    const std::string id = e.id;
+    return state_->addModelEntry(std::move(e), [&](Store& store, const json& meta) {
+        return store.putBlobFolder("models", id, named, gltfName, meta);
+    });
+}
+
+Result<json> Service::State::addModelEntry(ModelEntry e,
+                                           const std::function<Status(Store&, const json&)>& write) {
+    std::lock_guard<std::mutex> writer(writeMutex);
+    if (auto s = write(*store, {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}}); !s)
         return s.error();
     json summary = modelSummary(e);
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    state_->models[e.id] = std::move(e);
+    std::unique_lock<std::shared_mutex> lock(mutex);
+    models[e.id] = std::move(e);
     return summary;
 }
 

@@ -7,13 +7,10 @@
 #include "io/image_io.hpp"
 
 #include <cmath>
-#include <cstring>
-#include <filesystem>
 
 namespace dermis {
 
 using namespace detail;
-namespace fs = std::filesystem;
 
 Result<EncodedImage> Service::State::render(const Snapshot& snap, const FrameParams& p) {
     FrameOverrides o;
@@ -95,7 +92,7 @@ Result<EncodedImage> Service::heightmap(const std::string& id, const std::string
     EncodedImage out;
     out.backend = state_->renderer->info().backend;
     if (normal) {
-        auto n = normalMapFromBump(map, 0.01 * snap->scene.render.bumpStrength * map.width);
+        auto n = normalMapFromBump(map, normalMapStrength(snap->scene.render.bumpStrength, map.width));
         if (!n) return n.error();
         const Image8 img = encodeNormalMap8(*n);
         auto bytes = encodeFrame(img, format == "png" ? FrameFormat::Png : FrameFormat::Exr);
@@ -104,23 +101,10 @@ Result<EncodedImage> Service::heightmap(const std::string& id, const std::string
         out.contentType = format == "png" ? "image/png" : "image/x-exr";
         return out;
     }
-    if (format == "f32") {
-        out.bytes.resize(map.data.size() * sizeof(float));
-        std::memcpy(out.bytes.data(), map.data.data(), out.bytes.size());
-        out.contentType = "application/octet-stream";
-        return out;
-    }
-    // png16 / exr through the image library, via a private temp file.
-    const std::string tmp = (fs::path(state_->store->dir()) /
-                             (Store::newId("tmp") + (format == "exr" ? ".exr" : ".png"))).string();
-    Status s = format == "exr" ? writeFloatImage(tmp, map) : writeHeight16Png(tmp, map);
-    if (!s) return s.error();
-    auto bytes = Store::readFile(tmp);
-    std::error_code ec;
-    fs::remove(tmp, ec);
+    auto bytes = format == "f32" ? encodeF32(map) : format == "exr" ? encodeFloatExr(map) : encodeHeight16Png(map);
     if (!bytes) return bytes.error();
     out.bytes = std::move(*bytes);
-    out.contentType = format == "exr" ? "image/x-exr" : "image/png";
+    out.contentType = format == "f32" ? "application/octet-stream" : format == "exr" ? "image/x-exr" : "image/png";
     return out;
 }
 

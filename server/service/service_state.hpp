@@ -127,6 +127,11 @@ struct Service::State {
     /// Plans and renders one frame of `snap` with `p`'s overrides; encodes it.
     Result<EncodedImage> render(const Snapshot& snap, const FrameParams& p);
 
+    /// Stores an accepted model through `write` (given the metadata record, under `writeMutex`)
+    /// and then lists it; the model's summary. Nothing is listed when `write` fails.
+    Result<json> addModelEntry(detail::ModelEntry e,
+                               const std::function<Status(Store&, const json&)>& write);
+
     /// Loading at open: built-in content, then stored uploads and scenes (warnings collected).
     Status loadContent();
     void loadStored(std::vector<std::string>& warnings);

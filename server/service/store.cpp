@@ -1,17 +1,13 @@
 #include "service/store.hpp"
 
-#include <fcntl.h>
+#include "io/atomic_file.hpp"
+
 #include <unistd.h>
 
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cstdio>
+#include <filesystem>
 #include <random>
 
 namespace dermis {
@@ -20,56 +16,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string errnoText() { return std::strerror(errno); }
-
-Status fsyncPath(const std::string& path, int flags) {
-    const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
-    if (fd < 0) return makeError(ErrorCode::Io, "dermis::Store", path, "cannot open: " + errnoText());
-    const int rc = ::fsync(fd);
-    ::close(fd);
-    if (rc != 0) return makeError(ErrorCode::Io, "dermis::Store", path, "fsync failed: " + errnoText());
-    return Ok{};
+/// Every store write: whole, synced, and its folder synced (atomic_file.hpp).
+Status writeDurably(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+    return writeFileAtomically(path, bytes, Durability::Durable, "dermis::Store");
 }
 
 } // namespace
-
-Result<std::vector<std::uint8_t>> Store::readFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return makeError(ErrorCode::NotFound, "dermis::Store::readFile", path, "cannot read");
-    return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), {});
-}
-
-Status Store::writeFileDurably(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-    const char* where = "dermis::Store::writeFileDurably";
-    static std::atomic<unsigned> counter{0};
-    const std::string tmp = path + ".tmp." + std::to_string(::getpid()) + "." +
-                            std::to_string(counter.fetch_add(1));
-    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) return makeError(ErrorCode::Io, where, path, "cannot create a temp file: " + errnoText());
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            const std::string why = errnoText();
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            return makeError(ErrorCode::Io, where, path, "write failed: " + why);
-        }
-        done += static_cast<std::size_t>(n);
-    }
-    if (::fsync(fd) != 0 || ::close(fd) != 0) {
-        const std::string why = errnoText();
-        ::unlink(tmp.c_str());
-        return makeError(ErrorCode::Io, where, path, "fsync failed: " + why);
-    }
-    if (::rename(tmp.c_str(), path.c_str()) != 0) {
-        const std::string why = errnoText();
-        ::unlink(tmp.c_str());
-        return makeError(ErrorCode::Io, where, path, "rename failed: " + why);
-    }
-    return fsyncPath(fs::path(path).parent_path().string(), O_RDONLY | O_DIRECTORY);
-}
 
 Result<Store> Store::open(const std::string& dataDir) {
     Store s;
@@ -82,16 +34,13 @@ Result<Store> Store::open(const std::string& dataDir) {
             return makeError(ErrorCode::Io, "dermis::Store::open", s.dir_,
                              std::string("cannot create ") + sub + "/: " + ec.message());
     }
-    // Leftover temp files of an interrupted write are garbage: the rename never happened.
+    // Leftover temporary files and folders of an interrupted write are garbage: the rename
+    // never happened. One rule for every writer: the name holds kTempMarker (atomic_file.hpp).
     std::vector<fs::path> leftovers;
-    for (const char* sub : {"models", "patterns", "scenes"})
-        for (const auto& e : fs::directory_iterator(fs::path(s.dir_) / sub, ec))
-            if (e.path().filename().string().find(".tmp.") != std::string::npos)
-                leftovers.push_back(e.path());
-    for (const auto& e : fs::directory_iterator(fs::path(s.dir_), ec)) {
-        const std::string name = e.path().filename().string();
-        if (name.rfind("upload.tmp.", 0) == 0 || name.rfind("tmp_", 0) == 0) leftovers.push_back(e.path());
-    }
+    for (const fs::path& folder : {fs::path(s.dir_), fs::path(s.dir_) / "models",
+                                   fs::path(s.dir_) / "patterns", fs::path(s.dir_) / "scenes"})
+        for (const auto& e : fs::directory_iterator(folder, ec))
+            if (isTempName(e.path().filename().string())) leftovers.push_back(e.path());
     for (const fs::path& p : leftovers)
         fs::remove_all(p, ec);
     return s;
@@ -116,11 +65,11 @@ Status Store::putBlob(const std::string& kind, const std::string& id, const std:
                       const std::vector<std::uint8_t>& bytes, nlohmann::json meta) {
     const fs::path folder = fs::path(dir_) / kind;
     const std::string file = (folder / (id + "." + ext)).string();
-    if (auto s = writeFileDurably(file, bytes); !s) return s;
+    if (auto s = writeDurably(file, bytes); !s) return s;
     meta["id"] = id;
     meta["file"] = id + "." + ext;
     const std::string text = meta.dump();
-    return writeFileDurably((folder / (id + ".json")).string(),
+    return writeDurably((folder / (id + ".json")).string(),
                             std::vector<std::uint8_t>(text.begin(), text.end()));
 }
 
@@ -133,11 +82,11 @@ bool Store::isSafeFileName(const std::string& name) {
 }
 
 Status Store::putBlobFolder(const std::string& kind, const std::string& id,
-                            const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files,
+                            const std::map<std::string, std::vector<std::uint8_t>>& files,
                             const std::string& mainFile, nlohmann::json meta) {
     const char* where = "dermis::Store::putBlobFolder";
     const fs::path folder = fs::path(dir_) / kind;
-    const fs::path tmp = folder / (id + ".d.tmp." + std::to_string(::getpid()));
+    const fs::path tmp = folder / (id + ".d" + kTempMarker + std::to_string(::getpid()));
     const fs::path final = folder / (id + ".d");
     std::error_code ec;
     fs::remove_all(tmp, ec);
@@ -148,7 +97,7 @@ Status Store::putBlobFolder(const std::string& kind, const std::string& id,
             fs::remove_all(tmp, ec);
             return makeError(ErrorCode::InvalidArgument, where, name, "not a plain file name");
         }
-        if (auto s = writeFileDurably((tmp / name).string(), bytes); !s) {
+        if (auto s = writeDurably((tmp / name).string(), bytes); !s) {
             fs::remove_all(tmp, ec);
             return s;
         }
@@ -158,11 +107,11 @@ Status Store::putBlobFolder(const std::string& kind, const std::string& id,
         fs::remove_all(tmp, ec);
         return makeError(ErrorCode::Io, where, final.string(), "rename failed: " + ec.message());
     }
-    if (auto s = fsyncPath(folder.string(), O_RDONLY | O_DIRECTORY); !s) return s;
+    if (auto s = syncFolder(folder.string(), "dermis::Store"); !s) return s;
     meta["id"] = id;
     meta["file"] = id + ".d/" + mainFile;
     const std::string text = meta.dump();
-    return writeFileDurably((folder / (id + ".json")).string(),
+    return writeDurably((folder / (id + ".json")).string(),
                             std::vector<std::uint8_t>(text.begin(), text.end()));
 }
 
@@ -172,7 +121,7 @@ std::vector<Store::Blob> Store::listBlobs(const std::string& kind,
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(fs::path(dir_) / kind, ec)) {
         if (e.path().extension() != ".json") continue;
-        auto bytes = readFile(e.path().string());
+        auto bytes = readWholeFile(e.path().string());
         nlohmann::json meta = bytes ? nlohmann::json::parse(bytes->begin(), bytes->end(), nullptr, false)
                                     : nlohmann::json();
         if (!meta.is_object() || !meta.contains("id") || !meta["id"].is_string() ||
@@ -209,13 +158,13 @@ Status Store::removeBlob(const std::string& kind, const std::string& id) {
         if (e.path().stem() == id) doomed.push_back(e.path());
     for (const fs::path& path : doomed)
         fs::remove_all(path, ec);
-    return fsyncPath(folder.string(), O_RDONLY | O_DIRECTORY);
+    return syncFolder(folder.string(), "dermis::Store");
 }
 
 Status Store::putScene(const std::string& id, std::uint64_t revision, const nlohmann::json& doc) {
     const nlohmann::json record = {{"id", id}, {"revision", revision}, {"scene", doc}};
     const std::string text = record.dump();
-    return writeFileDurably((fs::path(dir_) / "scenes" / (id + ".json")).string(),
+    return writeDurably((fs::path(dir_) / "scenes" / (id + ".json")).string(),
                             std::vector<std::uint8_t>(text.begin(), text.end()));
 }
 
@@ -224,7 +173,7 @@ Status Store::removeScene(const std::string& id) {
     std::error_code ec;
     fs::remove(folder / (id + ".json"), ec);
     if (ec) return makeError(ErrorCode::Io, "dermis::Store::removeScene", id, ec.message());
-    return fsyncPath(folder.string(), O_RDONLY | O_DIRECTORY);
+    return syncFolder(folder.string(), "dermis::Store");
 }
 
 std::vector<Store::SceneRecord> Store::listScenes(std::vector<std::string>& skipped) const {
@@ -232,7 +181,7 @@ std::vector<Store::SceneRecord> Store::listScenes(std::vector<std::string>& skip
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(fs::path(dir_) / "scenes", ec)) {
         if (e.path().extension() != ".json") continue;
-        auto bytes = readFile(e.path().string());
+        auto bytes = readWholeFile(e.path().string());
         nlohmann::json rec = bytes ? nlohmann::json::parse(bytes->begin(), bytes->end(), nullptr, false)
                                    : nlohmann::json();
         if (!rec.is_object() || !rec.contains("id") || !rec["id"].is_string() ||

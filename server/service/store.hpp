@@ -1,7 +1,9 @@
-// Dermis HTTP shell — the server's data directory: uploaded models and patterns, and scene
-// documents, each written atomically and durably before a call returns (temp file in the same
-// folder, fsync, rename over the target, fsync of the folder), so that an acknowledged edit
-// survives a crash or kill -9.
+// Dermis service — the server's data directory: uploaded models and patterns, and scene
+// documents, each written atomically and durably before a call returns (writeFileAtomically with
+// Durability::Durable: temp file in the same folder, fsync, rename over the target, fsync of the
+// folder), so that an acknowledged edit survives a crash or kill -9. Store::open removes what an
+// interrupted write left (names holding kTempMarker, at the top and in the three folders); the
+// store knows no other temporary names.
 //
 // Layout under the data directory:
 //   models/<id>.glb      + models/<id>.json    (metadata, written last: the commit record)
@@ -16,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -45,7 +48,7 @@ public:
     /// each file fsync'd), then <kind>/<id>.json with "file" = "<id>.d/<mainFile>". Names must be
     /// plain file names (checked: no '/', no "..", [A-Za-z0-9._ -] only).
     Status putBlobFolder(const std::string& kind, const std::string& id,
-                         const std::vector<std::pair<std::string, std::vector<std::uint8_t>>>& files,
+                         const std::map<std::string, std::vector<std::uint8_t>>& files,
                          const std::string& mainFile, nlohmann::json meta);
     /// A plain file name a client may give a file: [A-Za-z0-9._ -], not "." or "..", ≤ 128 chars.
     static bool isSafeFileName(const std::string& name);
@@ -62,11 +65,6 @@ public:
         nlohmann::json doc;
     };
     std::vector<SceneRecord> listScenes(std::vector<std::string>& skipped) const;
-
-    /// Reads a whole file (empty result with an error for a missing/unreadable file).
-    static Result<std::vector<std::uint8_t>> readFile(const std::string& path);
-    /// Durable atomic write of `bytes` to `path` (same-folder temp file, fsync, rename, fsync dir).
-    static Status writeFileDurably(const std::string& path, const std::vector<std::uint8_t>& bytes);
 
 private:
     std::string dir_;
