@@ -3,11 +3,7 @@
 // (FakeRenderer.hpp). Edits, revisions and events, failed edits changing nothing, limits, frame
 // parameters, height maps, batches, reopening, locking (a render in flight blocks no reader and no
 // upload), event back-pressure (resync), and opening with broken content.
-#include "service/service.hpp"
-#include "FakeRenderer.hpp"
-#include "TestFiles.hpp"
-
-#include "io/frame_io.hpp"
+#include "ServiceFixture.hpp"
 
 #include <gtest/gtest.h>
 
@@ -22,66 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
-
-/// Width and height from a PNG's IHDR chunk.
-std::pair<int, int> pngSize(const std::vector<std::uint8_t>& b) {
-    if (b.size() < 24 || b[0] != 0x89 || b[1] != 'P') return {0, 0};
-    auto be = [&](std::size_t o) { return int(b[o]) << 24 | int(b[o + 1]) << 16 | int(b[o + 2]) << 8 | int(b[o + 3]); };
-    return {be(16), be(20)};
-}
-
-/// An 8-bit grey PNG pattern of w×h.
-std::vector<std::uint8_t> patternPng(int w, int h) {
-    Image8 img;
-    img.width = w;
-    img.height = h;
-    img.rgba.resize(static_cast<std::size_t>(w) * h * 4);
-    for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i) {
-            std::uint8_t* p = &img.rgba[(static_cast<std::size_t>(j) * w + i) * 4];
-            p[0] = p[1] = p[2] = static_cast<std::uint8_t>((i * 255) / std::max(1, w - 1));
-            p[3] = 255;
-        }
-    return *encodePng(img, false);
-}
-
-/// The SSE message's "type" field ("event: …\ndata: {json}\n\n").
-std::string typeOf(const std::string& sse) {
-    const auto d = sse.find("data: ");
-    if (d == std::string::npos) return "";
-    return json::parse(sse.substr(d + 6)).value("type", "");
-}
-
-class ServiceTest : public ::testing::Test {
-protected:
-    void SetUp() override { open(); }
-
-    void open(const ServerLimits& limits = {}, const std::string& content = kSource) {
-        svc_.reset();
-        auto fake = std::make_unique<FakeRenderer>();
-        fake_ = fake.get();
-        ServiceConfig config;
-        config.dataDir = dir_ / "data";
-        config.contentDir = content;
-        config.limits = limits;
-        auto s = Service::open(config, std::move(fake));
-        ASSERT_TRUE(s) << s.error().message;
-        svc_ = std::move(*s);
-    }
-
-    std::string defaultScene() {
-        auto r = svc_->createScene({{"default_patterns", true}});
-        EXPECT_TRUE(r) << r.error().message;
-        return r ? (*r)["id"].get<std::string>() : "";
-    }
-
-    std::uint64_t revisionOf(const std::string& id) { return (*svc_->getScene(id))["revision"].get<std::uint64_t>(); }
-
-    TempDir dir_;
-    std::unique_ptr<Service> svc_;
-    FakeRenderer* fake_ = nullptr;
-};
+class ServiceTest : public ServiceFixture {};
 
 TEST_F(ServiceTest, OpensWithTheBuiltinContentAndTheInjectedRenderer) {
     EXPECT_EQ(svc_->info()["backend"], "fake");

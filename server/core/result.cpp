@@ -10,6 +10,7 @@ const char* errorCodeName(ErrorCode code) {
     case ErrorCode::Io: return "io_error";
     case ErrorCode::Unsupported: return "unsupported";
     case ErrorCode::Conflict: return "conflict";
+    case ErrorCode::StaleRevision: return "stale_revision";
     case ErrorCode::TooLarge: return "too_large";
     case ErrorCode::Unavailable: return "unavailable";
     case ErrorCode::Internal: return "internal";

@@ -8,6 +8,8 @@
 #pragma once
 
 #include <cassert>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -22,6 +24,7 @@ enum class ErrorCode {
     Io,              ///< a file could not be read or written
     Unsupported,     ///< valid input that this version does not handle
     Conflict,        ///< the request conflicts with current state (delete of a model in use)
+    StaleRevision,   ///< an edit based on a revision that is no longer current (If-Match)
     TooLarge,        ///< a body, image or size exceeds a configured limit
     Unavailable,     ///< a needed resource cannot be had now (no GL backend starts, queue full)
     Internal,        ///< a failure of a lower layer that is not the caller's fault (GL errors)
@@ -33,6 +36,8 @@ struct Error {
     ErrorCode code = ErrorCode::InvalidArgument;
     std::string message; ///< "dermis::function: field: what is wrong"
     std::string field;   ///< JSON pointer or field name; empty when no single field is to blame
+    /// ErrorCode::StaleRevision only: the revision that is current now.
+    std::optional<std::uint64_t> currentRevision;
 };
 
 /// Builds an Error whose message is "<where>: <field>: <what>" (field part omitted when empty).

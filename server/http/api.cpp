@@ -3,6 +3,7 @@
 // httplib and Api's own methods. The routes themselves live in api_<family>.cpp.
 #include "http/api_internal.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -29,6 +30,8 @@ int statusOf(ErrorCode code) {
         return 415;
     case ErrorCode::Conflict:
         return 409;
+    case ErrorCode::StaleRevision:
+        return 412;
     case ErrorCode::TooLarge:
         return 413;
     case ErrorCode::Unavailable:
@@ -51,6 +54,12 @@ void sendError(Res& res, int status, const std::string& code, const std::string&
 }
 
 void sendError(Res& res, const Error& e) {
+    if (e.currentRevision) { // 412: the body also says which revision is current
+        sendJson(res, statusOf(e.code),
+                 {{"error", {{"code", errorCodeName(e.code)}, {"message", e.message}, {"field", e.field}}},
+                  {"revision", *e.currentRevision}});
+        return;
+    }
     sendError(res, statusOf(e.code), errorCodeName(e.code), e.message, e.field);
 }
 
@@ -83,6 +92,47 @@ bool hasContentType(const Req& req, std::initializer_list<const char*> types) {
             return true;
     }
     return false;
+}
+
+std::string sceneEtag(std::uint64_t revision) {
+    return "\"r" + std::to_string(revision) + "\"";
+}
+
+void setEtag(Res& res, const json& answer) {
+    if (auto r = answer.find("revision"); r != answer.end() && r->is_number_unsigned())
+        res.set_header("ETag", sceneEtag(r->get<std::uint64_t>()));
+}
+
+bool editContext(const Req& req, Res& res, EditContext& out) {
+    if (req.has_header("If-Match")) {
+        std::string v = req.get_header_value("If-Match");
+        while (!v.empty() && (v.front() == ' ' || v.front() == '\t')) v.erase(v.begin());
+        while (!v.empty() && (v.back() == ' ' || v.back() == '\t')) v.pop_back();
+        if (v != "*") {
+            std::uint64_t revision = 0;
+            bool ok = v.size() >= 4 && v.size() <= 24 && v.compare(0, 2, "\"r") == 0 &&
+                      v.back() == '"';
+            for (std::size_t k = 2; ok && k + 1 < v.size(); ++k) {
+                ok = std::isdigit(static_cast<unsigned char>(v[k])) && revision < 100000000000000000ull;
+                revision = revision * 10 + static_cast<std::uint64_t>(v[k] - '0');
+            }
+            if (!ok || revision == 0) {
+                sendError(res, 400, "parse_error",
+                          "dermis::Api: If-Match: expected one strong ETag \"r<revision>\" as "
+                          "the scene's ETag header gives it (or *), got " +
+                              v.substr(0, 64),
+                          "If-Match");
+                return false;
+            }
+            out.ifMatch = revision;
+        }
+    }
+    out.client = req.get_header_value("X-Dermis-Client");
+    if (auto why = checkClientName(out.client); !why.empty()) {
+        sendError(res, 400, "parse_error", "dermis::Api: X-Dermis-Client: " + why, "X-Dermis-Client");
+        return false;
+    }
+    return true;
 }
 
 namespace {

@@ -72,6 +72,14 @@ std::vector<std::uint8_t> bytesOf(const std::string& s);
 /// present but malformed.
 bool intParam(const Req& req, Res& res, const char* name, std::optional<int>& out);
 bool numberParam(const Req& req, Res& res, const char* name, std::optional<double>& out);
+/// The edit context of a request (SPEC §6 Concurrency): `If-Match: "r<N>"` (or `*`: any) and
+/// `X-Dermis-Client`. False (and a 400 sent, field "If-Match" / "X-Dermis-Client") for a weak,
+/// malformed or multiple ETag or a client name over 64 characters or not printable ASCII.
+bool editContext(const Req& req, Res& res, EditContext& out);
+/// `"r<revision>"`, the ETag of a scene at that revision.
+std::string sceneEtag(std::uint64_t revision);
+/// Sets the ETag header from an answer's "revision" (when it has one).
+void setEtag(Res& res, const json& answer);
 /// Compares without an early exit (the time depends only on the lengths).
 bool constantTimeEquals(const std::string& a, const std::string& b);
 

@@ -1,79 +1,164 @@
 // Dermis HTTP shell — scene routes: documents (list, create, get, replace, delete), placements
-// (add, reorder, patch, remove) and the pose (replace, merge). Every edit answers
-// {"id", "revision", "scene"}; a failed edit changes nothing (the Service validates first).
+// (add, reorder, patch, remove), the pose (replace, merge), history (revisions, a revision's
+// document, revert) and presence. Every edit answers {"id", "revision", "scene"} with
+// `ETag: "r<revision>"`, honours `If-Match` (412 stale_revision with the current revision) and
+// records `X-Dermis-Client`; a failed edit changes nothing (the Service validates first).
 #include "http/api_internal.hpp"
 
 namespace dermis::api_detail {
 
 namespace {
 
-/// A route whose JSON body goes to one Service edit: `status` and its document on success, the
-/// document error otherwise.
-Handler jsonEdit(int status, std::function<Result<json>(Service&, const Req&, const json&)> edit) {
+using EditFn = std::function<Result<json>(Service&, const Req&, const json&, const EditContext&)>;
+
+/// A route whose JSON body goes to one Service edit: `status`, its document and its ETag on
+/// success, the document error otherwise.
+Handler jsonEdit(int status, EditFn edit) {
     return [status, edit = std::move(edit)](Api::Impl& a, const Req& req, Res& res) {
+        EditContext ctx;
+        if (!editContext(req, res, ctx)) return;
         json body;
         if (!jsonBody(req, res, body)) return;
-        auto r = edit(a.svc, req, body);
+        auto r = edit(a.svc, req, body, ctx);
         if (!r) return sendDocError(res, r.error());
+        setEtag(res, *r);
         sendJson(res, status, *r);
     };
+}
+
+/// An unsigned query parameter ≥ 1; true when absent or well-formed, else a 422 is sent.
+bool revisionParam(const Req& req, Res& res, const char* name, std::optional<std::uint64_t>& out) {
+    if (!req.has_param(name)) return true;
+    const std::string v = req.get_param_value(name);
+    std::uint64_t n = 0;
+    bool ok = !v.empty() && v.size() <= 18;
+    for (char c : v) {
+        ok = ok && std::isdigit(static_cast<unsigned char>(c));
+        if (ok) n = n * 10 + static_cast<std::uint64_t>(c - '0');
+    }
+    if (!ok || n == 0) {
+        sendError(res, 422, "invalid_argument",
+                  std::string("dermis::Api: ") + name + ": must be a revision number >= 1", name);
+        return false;
+    }
+    out = n;
+    return true;
+}
+
+void installDocumentRoutes(RouteTable& t) {
+    t.add("GET", "/scenes",
+          [](Api::Impl& a, const Req&, Res& res) { sendJson(res, 200, a.svc.listScenes()); });
+    t.add("POST", "/scenes", [](Api::Impl& a, const Req& req, Res& res) {
+        EditContext ctx;
+        if (!editContext(req, res, ctx)) return;
+        json body;
+        if (!jsonBody(req, res, body)) return;
+        auto r = a.svc.createScene(body, ctx);
+        if (!r) return sendDocError(res, r.error());
+        res.set_header("Location", kPrefix + "/scenes/" + (*r)["id"].get<std::string>());
+        setEtag(res, *r);
+        sendJson(res, 201, *r);
+    });
+    t.add("GET", "/scenes/{id}", [](Api::Impl& a, const Req& req, Res& res) {
+        std::optional<std::uint64_t> revision;
+        if (!revisionParam(req, res, "revision", revision)) return;
+        auto r = revision ? a.svc.getSceneRevision(req.matches[1], *revision)
+                          : a.svc.getScene(req.matches[1]);
+        if (!r) return sendError(res, r.error());
+        setEtag(res, *r);
+        sendJson(res, 200, *r);
+    });
+    t.add("PUT", "/scenes/{id}",
+          jsonEdit(200, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {
+              return s.replaceScene(req.matches[1], body, ctx);
+          }));
+    t.add("DELETE", "/scenes/{id}", [](Api::Impl& a, const Req& req, Res& res) {
+        EditContext ctx;
+        if (!editContext(req, res, ctx)) return;
+        auto r = a.svc.deleteScene(req.matches[1], ctx);
+        if (!r) return sendError(res, r.error());
+        res.status = 204;
+    });
+}
+
+void installPlacementRoutes(RouteTable& t) {
+    t.add("POST", "/scenes/{id}/placements",
+          jsonEdit(201, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {
+              return s.addPlacement(req.matches[1], body, ctx);
+          }));
+    t.add("PUT", "/scenes/{id}/placements",
+          jsonEdit(200, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {
+              return s.reorderPlacements(req.matches[1], body, ctx);
+          }));
+    t.add("PATCH", "/scenes/{id}/placements/{pid}",
+          jsonEdit(200, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {
+              return s.patchPlacement(req.matches[1], req.matches[2], body, ctx);
+          }));
+    t.add("DELETE", "/scenes/{id}/placements/{pid}", [](Api::Impl& a, const Req& req, Res& res) {
+        EditContext ctx;
+        if (!editContext(req, res, ctx)) return;
+        auto r = a.svc.deletePlacement(req.matches[1], req.matches[2], ctx);
+        if (!r) return sendDocError(res, r.error());
+        setEtag(res, *r);
+        sendJson(res, 200, *r);
+    });
+    t.add("PUT", "/scenes/{id}/pose",
+          jsonEdit(200, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {
+              return s.putPose(req.matches[1], body, ctx);
+          }));
+    t.add("PATCH", "/scenes/{id}/pose",
+          jsonEdit(200, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {
+              return s.patchPose(req.matches[1], body, ctx);
+          }));
+}
+
+void installHistoryRoutes(RouteTable& t) {
+    t.add("GET", "/scenes/{id}/revisions", [](Api::Impl& a, const Req& req, Res& res) {
+        std::optional<int> limit;
+        std::optional<std::uint64_t> before;
+        if (!intParam(req, res, "limit", limit) || !revisionParam(req, res, "before", before)) return;
+        if (limit && (*limit < 1 || *limit > 1000))
+            return sendError(res, 422, "invalid_argument", "dermis::Api: limit: must be in [1, 1000]",
+                             "limit");
+        auto r = a.svc.listRevisions(req.matches[1], static_cast<std::size_t>(limit.value_or(50)),
+                                     before);
+        if (!r) return sendError(res, r.error());
+        setEtag(res, *r);
+        sendJson(res, 200, *r);
+    });
+    t.add("POST", "/scenes/{id}/revert",
+          jsonEdit(200, [](Service& s, const Req& req, const json& body,
+                           const EditContext& ctx) -> Result<json> {
+              const auto rev = body.is_object() ? body.find("revision") : body.end();
+              if (!body.is_object() || rev == body.end() || !rev->is_number_unsigned() ||
+                  rev->get<std::uint64_t>() == 0)
+                  return makeError(ErrorCode::InvalidArgument, "dermis::Api", "/revision",
+                                   "the body must be {\"revision\": N} with N >= 1");
+              if (body.size() != 1)
+                  return makeError(ErrorCode::InvalidArgument, "dermis::Api", "",
+                                   "only \"revision\" may be given");
+              return s.revert(req.matches[1], rev->get<std::uint64_t>(), ctx);
+          }));
+    t.add("POST", "/scenes/{id}/presence", [](Api::Impl& a, const Req& req, Res& res) {
+        json body;
+        if (!jsonBody(req, res, body)) return;
+        auto r = a.svc.postPresence(req.matches[1], body);
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
+    t.add("GET", "/scenes/{id}/presence", [](Api::Impl& a, const Req& req, Res& res) {
+        auto r = a.svc.listPresence(req.matches[1]);
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
 }
 
 } // namespace
 
 void installSceneRoutes(RouteTable& t) {
-    t.add("GET", "/scenes",
-          [](Api::Impl& a, const Req&, Res& res) { sendJson(res, 200, a.svc.listScenes()); });
-    t.add("POST", "/scenes", [](Api::Impl& a, const Req& req, Res& res) {
-        json body;
-        if (!jsonBody(req, res, body)) return;
-        auto r = a.svc.createScene(body);
-        if (!r) return sendDocError(res, r.error());
-        res.set_header("Location", kPrefix + "/scenes/" + (*r)["id"].get<std::string>());
-        sendJson(res, 201, *r);
-    });
-    t.add("GET", "/scenes/{id}", [](Api::Impl& a, const Req& req, Res& res) {
-        auto r = a.svc.getScene(req.matches[1]);
-        if (!r) return sendError(res, r.error());
-        sendJson(res, 200, *r);
-    });
-    t.add("PUT", "/scenes/{id}", jsonEdit(200, [](Service& s, const Req& req, const json& body) {
-              return s.replaceScene(req.matches[1], body);
-          }));
-    t.add("DELETE", "/scenes/{id}", [](Api::Impl& a, const Req& req, Res& res) {
-        auto r = a.svc.deleteScene(req.matches[1]);
-        if (!r) return sendError(res, r.error());
-        res.status = 204;
-    });
-
-    // --- placements
-    t.add("POST", "/scenes/{id}/placements",
-          jsonEdit(201, [](Service& s, const Req& req, const json& body) {
-              return s.addPlacement(req.matches[1], body);
-          }));
-    t.add("PUT", "/scenes/{id}/placements",
-          jsonEdit(200, [](Service& s, const Req& req, const json& body) {
-              return s.reorderPlacements(req.matches[1], body);
-          }));
-    t.add("PATCH", "/scenes/{id}/placements/{pid}",
-          jsonEdit(200, [](Service& s, const Req& req, const json& body) {
-              return s.patchPlacement(req.matches[1], req.matches[2], body);
-          }));
-    t.add("DELETE", "/scenes/{id}/placements/{pid}", [](Api::Impl& a, const Req& req, Res& res) {
-        auto r = a.svc.deletePlacement(req.matches[1], req.matches[2]);
-        if (!r) return sendDocError(res, r.error());
-        sendJson(res, 200, *r);
-    });
-
-    // --- pose
-    t.add("PUT", "/scenes/{id}/pose",
-          jsonEdit(200, [](Service& s, const Req& req, const json& body) {
-              return s.putPose(req.matches[1], body);
-          }));
-    t.add("PATCH", "/scenes/{id}/pose",
-          jsonEdit(200, [](Service& s, const Req& req, const json& body) {
-              return s.patchPose(req.matches[1], body);
-          }));
+    installDocumentRoutes(t);
+    installPlacementRoutes(t);
+    installHistoryRoutes(t);
 }
 
 } // namespace dermis::api_detail

@@ -18,7 +18,8 @@ json ServerLimits::toJson() const {
             {"max_triangles", maxTriangles},      {"max_joints", maxJoints},
             {"max_placements", maxPlacements},    {"queue_length", queueLength},
             {"request_timeout_seconds", requestTimeoutSeconds},
-            {"max_batch_frames", maxBatchFrames}};
+            {"max_batch_frames", maxBatchFrames},
+            {"presence_seconds", presenceSeconds}};
 }
 
 namespace detail {
@@ -215,7 +216,13 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
             warnings.push_back("scene " + r.id + ": " + prepared.error().message);
             continue;
         }
-        scenes[r.id] = SceneEntry{prepared->canonical, std::move(prepared->scene), r.revision};
+        auto history = store->loadHistory(r.id, r.revision, r.doc);
+        if (!history) {
+            warnings.push_back("scene " + r.id + ": " + history.error().message);
+            continue;
+        }
+        scenes[r.id] = SceneEntry{prepared->canonical, std::move(prepared->scene), r.revision,
+                                  std::move(*history)};
     }
 }
 

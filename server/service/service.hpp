@@ -14,8 +14,9 @@
 // (503 + Retry-After).
 //
 // Files: service.cpp (open, info), service_models.cpp, service_patterns.cpp,
-// service_scenes.cpp (documents and edits), service_renders.cpp (frames, maps, batch),
-// service_events.cpp; shared private state in service_state.hpp.
+// service_scenes.cpp (documents and edits), service_history.cpp (revisions, revert, presence),
+// service_renders.cpp (frames, maps, batch), service_events.cpp; shared private state in
+// service_state.hpp.
 //
 // Documents that arrive here name models and patterns only by generated ids ("m_…", "p_…") or
 // built-in names ("builtin:default", "crease"); never by path.
@@ -55,6 +56,7 @@ struct ServerLimits {
     int queueLength = 16;          ///< renders waiting for the GL thread
     int requestTimeoutSeconds = 30;
     std::size_t maxBatchFrames = 512;
+    double presenceSeconds = 30.0; ///< a presence entry lapses this long after its last refresh
     nlohmann::json toJson() const;
 };
 
@@ -102,6 +104,20 @@ private:
     bool resyncQueued_ = false;
 };
 
+/// Who makes an edit and which revision it was based on (SPEC §6 Concurrency).
+struct EditContext {
+    /// The revision the client read (If-Match: "r<N>"); when set and not the scene's current
+    /// revision, the edit fails with ErrorCode::StaleRevision (Error::currentRevision set) and
+    /// nothing changes. Unset: the edit applies to whatever is current.
+    std::optional<std::uint64_t> ifMatch;
+    /// X-Dermis-Client: recorded in the history and carried by events. ≤ 64 printable ASCII
+    /// characters ("" = not named); checked by the HTTP layer (checkClientName).
+    std::string client;
+};
+
+/// Empty when `name` may name a client (≤ 64 characters, printable ASCII), else why not.
+std::string checkClientName(const std::string& name);
+
 /// Where a service keeps things and how far it goes.
 struct ServiceConfig {
     std::string dataDir;    ///< uploads and scenes, written durably (`serve --data`)
@@ -148,22 +164,52 @@ public:
     Status deletePattern(const std::string& id);
 
     // --- scenes (every answer is {"id", "revision", "scene"})
+    // Every edit makes revision n+1 and keeps it (history), durably, with `ctx.client` and an op
+    // such as "patch placement elbow_l"; events carry {type, scene, revision, client, op,
+    // placement}. With `ctx.ifMatch` set to another revision than the current one, an edit
+    // fails with ErrorCode::StaleRevision and changes nothing.
     nlohmann::json listScenes() const;
     /// `body` is a scene document, or {"model": …, "default_patterns": true} to start from the
     /// default pattern set (only on builtin:default).
-    Result<nlohmann::json> createScene(const nlohmann::json& body);
+    Result<nlohmann::json> createScene(const nlohmann::json& body, const EditContext& ctx = {});
     Result<nlohmann::json> getScene(const std::string& id) const;
-    Result<nlohmann::json> replaceScene(const std::string& id, const nlohmann::json& doc);
-    Status deleteScene(const std::string& id);
-    Result<nlohmann::json> addPlacement(const std::string& id, const nlohmann::json& placement);
+    Result<nlohmann::json> replaceScene(const std::string& id, const nlohmann::json& doc,
+                                        const EditContext& ctx = {});
+    Status deleteScene(const std::string& id, const EditContext& ctx = {});
+    Result<nlohmann::json> addPlacement(const std::string& id, const nlohmann::json& placement,
+                                        const EditContext& ctx = {});
     Result<nlohmann::json> patchPlacement(const std::string& id, const std::string& pid,
-                                          const nlohmann::json& patch);
-    Result<nlohmann::json> deletePlacement(const std::string& id, const std::string& pid);
+                                          const nlohmann::json& patch, const EditContext& ctx = {});
+    Result<nlohmann::json> deletePlacement(const std::string& id, const std::string& pid,
+                                           const EditContext& ctx = {});
     /// `order`: every placement id once, in the new order.
-    Result<nlohmann::json> reorderPlacements(const std::string& id, const nlohmann::json& order);
-    Result<nlohmann::json> putPose(const std::string& id, const nlohmann::json& pose);
+    Result<nlohmann::json> reorderPlacements(const std::string& id, const nlohmann::json& order,
+                                             const EditContext& ctx = {});
+    Result<nlohmann::json> putPose(const std::string& id, const nlohmann::json& pose,
+                                   const EditContext& ctx = {});
     /// Merges: "animation"/"time" replace, "joints" entries replace per joint (null removes).
-    Result<nlohmann::json> patchPose(const std::string& id, const nlohmann::json& patch);
+    Result<nlohmann::json> patchPose(const std::string& id, const nlohmann::json& patch,
+                                     const EditContext& ctx = {});
+
+    // --- history (SPEC §6 History; service_history.cpp)
+    /// {"id", "revision" (current), "revisions": [{revision, time (RFC 3339, UTC), op, client}]},
+    /// newest first: at most `limit` (1..1000) revisions below `before` (all when unset).
+    Result<nlohmann::json> listRevisions(const std::string& id, std::size_t limit,
+                                         std::optional<std::uint64_t> before) const;
+    /// {"id", "revision": N, "current_revision", "scene"}: the document as it was at revision N.
+    Result<nlohmann::json> getSceneRevision(const std::string& id, std::uint64_t revision) const;
+    /// A new revision whose document equals revision N's (undo and redo are reverts). Fails
+    /// (NotFound, field "revision") for a revision the scene does not keep, and like any edit
+    /// when N's document no longer validates (a model or pattern it used was deleted).
+    Result<nlohmann::json> revert(const std::string& id, std::uint64_t revision,
+                                  const EditContext& ctx = {});
+    /// Presence (what each person has selected): `body` = {client, selection: [pid…] (≤ 256),
+    /// color}; broadcast as a `presence` event and listed until limits.presenceSeconds (30 s)
+    /// after the last refresh; the next presence call on the scene after that announces
+    /// {"type": "presence", "client", "selection": [], "left": true}.
+    /// Answers {"scene", "presence": [{client, selection, color, expires_in}]}.
+    Result<nlohmann::json> postPresence(const std::string& id, const nlohmann::json& body);
+    Result<nlohmann::json> listPresence(const std::string& id);
 
     // --- renders
     Result<EncodedImage> frame(const std::string& id, const FrameParams& params);

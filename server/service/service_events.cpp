@@ -50,8 +50,8 @@ bool Subscription::closed() const {
     return closed_;
 }
 
-void Service::State::publish(const std::string& sceneId, const json& event) {
-    const std::string text = "event: change\ndata: " + event.dump() + "\n\n";
+void Service::State::publish(const std::string& sceneId, const json& event, const char* name) {
+    const std::string text = std::string("event: ") + name + "\ndata: " + event.dump() + "\n\n";
     std::lock_guard<std::mutex> lock(subsMutex);
     auto [a, b] = subs.equal_range(sceneId);
     for (auto it = a; it != b; ++it)

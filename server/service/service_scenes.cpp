@@ -7,8 +7,19 @@ namespace dermis {
 
 using namespace detail;
 
-Result<json> Service::State::commit(const std::string& id, const json& newDoc, const char* what,
-                                    bool create) {
+Status Service::State::checkIfMatch(const std::string& id, const EditContext& ctx,
+                                    std::uint64_t current) {
+    if (!ctx.ifMatch || *ctx.ifMatch == current) return Ok{};
+    Error e = makeError(ErrorCode::StaleRevision, "dermis::Service", "If-Match",
+                        "scene " + id + " is at revision " + std::to_string(current) +
+                            ", not " + std::to_string(*ctx.ifMatch) +
+                            ": read it again and redo the edit");
+    e.currentRevision = current;
+    return e;
+}
+
+Result<json> Service::State::commit(const std::string& id, const json& newDoc, const EditInfo& info,
+                                    const EditContext& ctx, bool create) {
     Prepared prepared;
     std::uint64_t revision = 1;
     {
@@ -20,7 +31,8 @@ Result<json> Service::State::commit(const std::string& id, const json& newDoc, c
     }
     // Durable before visible; readers and renders go on meanwhile (writeMutex keeps other
     // mutations out, so the state validated above is still the state swapped into below).
-    if (auto s = store->putScene(id, revision, prepared.canonical); !s) return s.error();
+    const Store::RevisionInfo kept{revision, nowSeconds(), info.op, ctx.client};
+    if (auto s = store->putScene(id, kept, prepared.canonical); !s) return s.error();
     json answer = {{"id", id}, {"revision", revision}, {"scene", prepared.canonical}};
     {
         std::unique_lock<std::shared_mutex> lock(mutex);
@@ -28,12 +40,16 @@ Result<json> Service::State::commit(const std::string& id, const json& newDoc, c
         e.doc = std::move(prepared.canonical);
         e.scene = std::move(prepared.scene);
         e.revision = revision;
+        e.history.push_back(kept);
     }
-    publish(id, {{"type", what}, {"scene", id}, {"revision", revision}});
+    json event = {{"type", info.type}, {"scene", id},      {"revision", revision},
+                  {"client", ctx.client}, {"op", info.op}, {"placement", info.placement}};
+    if (info.placement.empty()) event["placement"] = nullptr;
+    publish(id, event);
     return answer;
 }
 
-Result<json> Service::State::edit(const std::string& id, const char* what,
+Result<json> Service::State::edit(const std::string& id, const EditContext& ctx, EditInfo& info,
                                   const std::function<Status(json&)>& change) {
     std::lock_guard<std::mutex> write(writeMutex);
     json doc;
@@ -41,10 +57,11 @@ Result<json> Service::State::edit(const std::string& id, const char* what,
         std::shared_lock<std::shared_mutex> lock(mutex);
         auto it = scenes.find(id);
         if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
+        if (auto s = checkIfMatch(id, ctx, it->second.revision); !s) return s.error();
         doc = it->second.doc;
     }
     if (auto s = change(doc); !s) return s.error();
-    return commit(id, doc, what, false);
+    return commit(id, doc, info, ctx, false);
 }
 
 json Service::listScenes() const {
@@ -56,7 +73,7 @@ json Service::listScenes() const {
     return {{"scenes", out}};
 }
 
-Result<json> Service::createScene(const json& body) {
+Result<json> Service::createScene(const json& body, const EditContext& ctx) {
     if (!body.is_object()) return bad("", "a scene document must be a JSON object");
     json doc = body;
     if (auto dp = doc.find("default_patterns"); dp != doc.end()) {
@@ -76,7 +93,7 @@ Result<json> Service::createScene(const json& body) {
         }
     }
     std::lock_guard<std::mutex> write(state_->writeMutex);
-    return state_->commit(Store::newId("s"), doc, "created", true);
+    return state_->commit(Store::newId("s"), doc, EditInfo{"created", "create", ""}, ctx, true);
 }
 
 Result<json> Service::getScene(const std::string& id) const {
@@ -86,25 +103,32 @@ Result<json> Service::getScene(const std::string& id) const {
     return json{{"id", id}, {"revision", it->second.revision}, {"scene", it->second.doc}};
 }
 
-Result<json> Service::replaceScene(const std::string& id, const json& doc) {
-    return state_->edit(id, "replaced", [&](json& d) -> Status {
+Result<json> Service::replaceScene(const std::string& id, const json& doc, const EditContext& ctx) {
+    EditInfo info{"replaced", "replace scene", ""};
+    return state_->edit(id, ctx, info, [&](json& d) -> Status {
         d = doc;
         return Ok{};
     });
 }
 
-Status Service::deleteScene(const std::string& id) {
+Status Service::deleteScene(const std::string& id, const EditContext& ctx) {
     std::lock_guard<std::mutex> write(state_->writeMutex);
     {
         std::shared_lock<std::shared_mutex> lock(state_->mutex);
-        if (!state_->scenes.count(id)) return notFound("id", "no scene \"" + id + "\"");
+        auto it = state_->scenes.find(id);
+        if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
+        if (auto s = State::checkIfMatch(id, ctx, it->second.revision); !s) return s;
     }
     if (auto s = state_->store->removeScene(id); !s) return s;
     {
         std::unique_lock<std::shared_mutex> lock(state_->mutex);
         state_->scenes.erase(id);
     }
-    state_->publish(id, {{"type", "deleted"}, {"scene", id}});
+    state_->publish(id, {{"type", "deleted"}, {"scene", id}, {"client", ctx.client}, {"op", "delete scene"}});
+    {
+        std::lock_guard<std::mutex> pl(state_->presenceMutex);
+        state_->presence.erase(id);
+    }
     std::lock_guard<std::mutex> sl(state_->subsMutex);
     auto [a, b] = state_->subs.equal_range(id);
     for (auto it = a; it != b; ++it)
@@ -125,9 +149,11 @@ int placementIndex(const json& doc, const std::string& pid) {
 
 } // namespace
 
-Result<json> Service::addPlacement(const std::string& id, const json& placement) {
+Result<json> Service::addPlacement(const std::string& id, const json& placement,
+                                   const EditContext& ctx) {
     if (!placement.is_object()) return bad("", "a placement must be a JSON object");
-    return state_->edit(id, "placement_added", [&](json& doc) -> Status {
+    EditInfo info{"placement_added", "", ""};
+    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
         json p = placement;
         if (!p.contains("id")) { // a fresh id that no other placement has
             std::string pid;
@@ -137,16 +163,20 @@ Result<json> Service::addPlacement(const std::string& id, const json& placement)
             }
             p["id"] = pid;
         }
+        if (p["id"].is_string()) info.placement = p["id"].get<std::string>();
+        info.op = "add placement " + info.placement;
         doc["placements"].push_back(p);
         return Ok{};
     });
 }
 
-Result<json> Service::patchPlacement(const std::string& id, const std::string& pid, const json& patch) {
+Result<json> Service::patchPlacement(const std::string& id, const std::string& pid, const json& patch,
+                                     const EditContext& ctx) {
     if (!patch.is_object()) return bad("", "a placement patch must be a JSON object");
     if (auto i = patch.find("id"); i != patch.end() && (!i->is_string() || i->get<std::string>() != pid))
         return bad("/id", "a placement's id cannot be changed");
-    return state_->edit(id, "placement_updated", [&](json& doc) -> Status {
+    EditInfo info{"placement_updated", "patch placement " + pid, pid};
+    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
         const int k = placementIndex(doc, pid);
         if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
         doc["placements"][static_cast<std::size_t>(k)].merge_patch(patch);
@@ -154,8 +184,10 @@ Result<json> Service::patchPlacement(const std::string& id, const std::string& p
     });
 }
 
-Result<json> Service::deletePlacement(const std::string& id, const std::string& pid) {
-    return state_->edit(id, "placement_deleted", [&](json& doc) -> Status {
+Result<json> Service::deletePlacement(const std::string& id, const std::string& pid,
+                                      const EditContext& ctx) {
+    EditInfo info{"placement_deleted", "delete placement " + pid, pid};
+    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
         const int k = placementIndex(doc, pid);
         if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
         doc["placements"].erase(static_cast<std::size_t>(k));
@@ -163,9 +195,11 @@ Result<json> Service::deletePlacement(const std::string& id, const std::string& 
     });
 }
 
-Result<json> Service::reorderPlacements(const std::string& id, const json& order) {
+Result<json> Service::reorderPlacements(const std::string& id, const json& order,
+                                        const EditContext& ctx) {
     if (!order.is_array()) return bad("", "the order must be an array of placement ids");
-    return state_->edit(id, "placements_reordered", [&](json& doc) -> Status {
+    EditInfo info{"placements_reordered", "reorder placements", ""};
+    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
         const json& old = doc["placements"];
         if (order.size() != old.size())
             return bad("", "the order must list each of the " + std::to_string(old.size()) + " placements once");
@@ -185,17 +219,19 @@ Result<json> Service::reorderPlacements(const std::string& id, const json& order
     });
 }
 
-Result<json> Service::putPose(const std::string& id, const json& pose) {
+Result<json> Service::putPose(const std::string& id, const json& pose, const EditContext& ctx) {
     if (!pose.is_object()) return bad("/pose", "a pose must be a JSON object");
-    return state_->edit(id, "pose", [&](json& doc) -> Status {
+    EditInfo info{"pose", "set pose", ""};
+    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
         doc["pose"] = pose;
         return Ok{};
     });
 }
 
-Result<json> Service::patchPose(const std::string& id, const json& patch) {
+Result<json> Service::patchPose(const std::string& id, const json& patch, const EditContext& ctx) {
     if (!patch.is_object()) return bad("/pose", "a pose patch must be a JSON object");
-    return state_->edit(id, "pose", [&](json& doc) -> Status {
+    EditInfo info{"pose", "patch pose", ""};
+    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
         json& pose = doc["pose"];
         if (!pose.is_object()) pose = json::object();
         for (auto e = patch.begin(); e != patch.end(); ++e) {

@@ -49,6 +49,21 @@ struct SceneEntry {
     json doc; ///< canonical document (toJson of scene)
     Scene scene;
     std::uint64_t revision = 1;
+    std::vector<Store::RevisionInfo> history; ///< kept revisions, oldest first (last = current)
+};
+
+/// What an edit is, for the history and the events.
+struct EditInfo {
+    const char* type = "";  ///< event type: "created", "placement_updated", …
+    std::string op;         ///< history op: "patch placement elbow_l", …
+    std::string placement;  ///< the placement it concerns ("" = none)
+};
+
+/// One person's presence on a scene.
+struct PresenceEntry {
+    json selection = json::array();
+    std::string color;
+    double expires = 0.0; ///< nowSeconds() at which it lapses
 };
 
 Error bad(const std::string& field, const std::string& what);
@@ -117,12 +132,24 @@ struct Service::State {
     /// Same for a document that is not stored (batch); caller holds `mutex` shared.
     Snapshot snapshotOf(const Scene& scene, std::shared_ptr<const Model> model) const;
 
-    /// Validates `newDoc`, writes it durably, swaps it in and announces it. Caller holds
-    /// `writeMutex` (and not `mutex`).
-    Result<json> commit(const std::string& id, const json& newDoc, const char* what, bool create);
-    /// Takes `writeMutex`, copies scene `id`'s document, lets `change` modify the copy, commits.
-    Result<json> edit(const std::string& id, const char* what, const std::function<Status(json&)>& change);
-    void publish(const std::string& sceneId, const json& event);
+    /// Validates `newDoc`, writes it durably as a new revision (history included), swaps it in
+    /// and announces it. Caller holds `writeMutex` (and not `mutex`).
+    Result<json> commit(const std::string& id, const json& newDoc, const detail::EditInfo& info,
+                        const EditContext& ctx, bool create);
+    /// Takes `writeMutex`, checks ctx.ifMatch, copies scene `id`'s document, lets `change`
+    /// modify the copy (it may also complete `info`), commits.
+    Result<json> edit(const std::string& id, const EditContext& ctx, detail::EditInfo& info,
+                      const std::function<Status(json&)>& change);
+    /// StaleRevision when `ctx.ifMatch` is set and is not `current`.
+    static Status checkIfMatch(const std::string& id, const EditContext& ctx, std::uint64_t current);
+    /// Sends `event` to the scene's subscribers as an SSE message named `name`.
+    void publish(const std::string& sceneId, const json& event, const char* name = "change");
+
+    std::mutex presenceMutex;
+    std::map<std::string, std::map<std::string, detail::PresenceEntry>> presence; ///< scene → client
+    /// Drops lapsed presence entries of a scene, announcing each; the live ones as JSON.
+    /// Caller holds presenceMutex.
+    json livePresence(const std::string& sceneId);
 
     /// Plans and renders one frame of `snap` with `p`'s overrides; encodes it.
     Result<EncodedImage> render(const Snapshot& snap, const FrameParams& p);

@@ -161,21 +161,6 @@ Status Store::removeBlob(const std::string& kind, const std::string& id) {
     return syncFolder(folder.string(), "dermis::Store");
 }
 
-Status Store::putScene(const std::string& id, std::uint64_t revision, const nlohmann::json& doc) {
-    const nlohmann::json record = {{"id", id}, {"revision", revision}, {"scene", doc}};
-    const std::string text = record.dump();
-    return writeDurably((fs::path(dir_) / "scenes" / (id + ".json")).string(),
-                            std::vector<std::uint8_t>(text.begin(), text.end()));
-}
-
-Status Store::removeScene(const std::string& id) {
-    const fs::path folder = fs::path(dir_) / "scenes";
-    std::error_code ec;
-    fs::remove(folder / (id + ".json"), ec);
-    if (ec) return makeError(ErrorCode::Io, "dermis::Store::removeScene", id, ec.message());
-    return syncFolder(folder.string(), "dermis::Store");
-}
-
 std::vector<Store::SceneRecord> Store::listScenes(std::vector<std::string>& skipped) const {
     std::vector<SceneRecord> out;
     std::error_code ec;

@@ -8,7 +8,8 @@
 // Layout under the data directory:
 //   models/<id>.glb      + models/<id>.json    (metadata, written last: the commit record)
 //   patterns/<id>.<ext>  + patterns/<id>.json
-//   scenes/<id>.json     ({"id", "revision", "scene"})
+//   scenes/<id>.json     ({"id", "revision", "scene"}: the current revision)
+//   scenes/<id>.history/ (r<N>.json per kept revision, index.jsonl: one line per revision)
 // Ids are generated ("m_…", "p_…", "s_…": 16 hex digits) — never taken from a client — so no file
 // name comes from a request. Thread-safe: the caller serialises mutations (Service's lock).
 #pragma once
@@ -56,9 +57,34 @@ public:
     std::vector<Blob> listBlobs(const std::string& kind, std::vector<std::string>& skipped) const;
     Status removeBlob(const std::string& kind, const std::string& id);
 
-    /// Writes scenes/<id>.json = {"id", "revision", "scene": doc}.
+    /// One kept revision of a scene (SPEC §6 History).
+    struct RevisionInfo {
+        std::uint64_t revision = 0;
+        double time = 0.0;  ///< seconds since the Unix epoch
+        std::string op;     ///< what made it, e.g. "patch placement elbow_l"
+        std::string client; ///< X-Dermis-Client of the edit ("" = not named)
+    };
+    /// Writes a new revision of a scene, each step durable, in this order: the revision's own
+    /// document scenes/<id>.history/r<N>.json = {"revision", "time", "op", "client", "scene"},
+    /// a line {"revision", "time", "op", "client"} appended to scenes/<id>.history/index.jsonl,
+    /// then the current record scenes/<id>.json = {"id", "revision", "scene"} — the commit
+    /// point: a crash before it leaves the scene at its previous revision (loadHistory forgets
+    /// the newer leftovers).
+    Status putScene(const std::string& id, const RevisionInfo& info, const nlohmann::json& doc);
+    /// Same with no op or client and the current time (tests, tools).
     Status putScene(const std::string& id, std::uint64_t revision, const nlohmann::json& doc);
+    /// Removes the current record, then the scene's history.
     Status removeScene(const std::string& id);
+    /// The document of revision `revision` of scene `id` (history/r<N>.json): NotFound (field
+    /// "revision") when that revision is not kept, Parse when its file is damaged.
+    Result<nlohmann::json> readRevision(const std::string& id, std::uint64_t revision) const;
+    /// The kept revisions of a scene whose current record says `current`, oldest first, from
+    /// the index (later lines win over earlier ones for the same revision; a torn last line is
+    /// ignored; revisions above `current` — an interrupted commit — are dropped). A scene written
+    /// before history existed, or whose current revision is missing from the index, gets that
+    /// revision written now from `currentDoc` (op "imported"). Io error when that write fails.
+    Result<std::vector<RevisionInfo>> loadHistory(const std::string& id, std::uint64_t current,
+                                                  const nlohmann::json& currentDoc);
     struct SceneRecord {
         std::string id;
         std::uint64_t revision = 0;
