@@ -9,7 +9,7 @@
 //   api_scenes.cpp   /scenes, placements, pose
 //   api_renders.cpp  frames, height maps, the stateless batch (/render)
 //   api_events.cpp   /scenes/{id}/events (server-sent events)
-// Registration with httplib, Api::routes() (checked against openapi.yaml by ApiHttpTest), the
+// Registration with httplib, Api::routes() (checked against openapi.yaml by RoutesHttpTest), the
 // 405 Allow lists and the open-route check of authentication all read that table, so a route
 // exists in all of them or in none.
 //

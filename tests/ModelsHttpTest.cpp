@@ -1,0 +1,208 @@
+// ModelsHttpTest — the /api/v1/models routes end to end on one server (HttpTestFixture.hpp: a real
+// dermis::Service + dermis::Api on 127.0.0.1, a GL context on $DERMIS_TEST_GL, cpp-httplib clients
+// over loopback). It checks:
+//   * models: built-in details, .glb uploads of the shared models (CesiumMan, KayKit Barbarian,
+//     RiggedFigure without UVs), UV layouts as JSON and PNG, deletion (409 while a scene uses it);
+//   * a multipart .gltf with its external buffer, and multipart uploads that are refused (missing
+//     buffer, a URI outside the folder, a folder in a part name, no .gltf part, not JSON).
+#include "HttpTestFixture.hpp"
+
+using namespace dermis;
+using namespace dermis::test;
+using namespace dermis::test::http;
+
+namespace {
+
+/// One server (no token).
+class ModelsHttpTest : public SharedServerTest {};
+
+// ================================================================================================
+// Models
+// ================================================================================================
+
+TEST_F(ModelsHttpTest, BuiltinModelIsListedWithItsDetails) {
+    Http h = http();
+    Reply list = h.get("/models");
+    ASSERT_EQ(list.status, 200) << list;
+    bool found = false;
+    for (const json all = list.js(); const json& m : all["models"])
+        found = found || m["id"] == "builtin:default";
+    EXPECT_TRUE(found) << list;
+
+    Reply r = h.get("/models/builtin:default");
+    ASSERT_EQ(r.status, 200) << r;
+    const json m = r.js();
+    EXPECT_EQ(m["id"], "builtin:default");
+    EXPECT_TRUE(m["has_uvs"].get<bool>());
+    EXPECT_NEAR(m["triangles"].get<double>(), 4300, 100);
+    ASSERT_TRUE(m["joints"].is_array());
+    EXPECT_EQ(m["joints"].size(), 51u);
+    std::set<std::string> names;
+    int roots = 0;
+    for (const json& j : m["joints"]) {
+        ASSERT_TRUE(j["name"].is_string()) << j;
+        names.insert(j["name"].get<std::string>());
+        ASSERT_TRUE(j["rest_rotation"].is_array() && j["rest_rotation"].size() == 4) << j;
+        double n2 = 0;
+        for (const json& c : j["rest_rotation"])
+            n2 += c.get<double>() * c.get<double>();
+        EXPECT_NEAR(n2, 1.0, 1e-3) << j;
+        if (j["parent"].is_null())
+            ++roots;
+        else
+            EXPECT_TRUE(j["parent"].is_string()) << j;
+    }
+    EXPECT_EQ(roots, 1);
+    for (const json& j : m["joints"])
+        if (j["parent"].is_string()) EXPECT_TRUE(names.count(j["parent"].get<std::string>())) << j;
+    EXPECT_TRUE(names.count("forearm.l") && names.count("spine_02") && names.count("root"));
+    ASSERT_TRUE(m["clips"].is_array());
+    EXPECT_EQ(m["clips"].size(), 7u);
+    for (const json& c : m["clips"]) {
+        EXPECT_TRUE(c["name"].is_string());
+        EXPECT_GT(c["duration"].get<double>(), 0.0) << c;
+    }
+}
+
+TEST_F(ModelsHttpTest, CesiumManUploadsInspectsAndDeletes) {
+    Http h = http();
+    // A name with path tricks is only a label.
+    Reply up =
+        h.upload("/models?name=..%2F..%2Fetc%2Fpasswd", readBytes(kCesiumMan), "model/gltf-binary");
+    ASSERT_EQ(up.status, 201) << up;
+    const json created = up.js();
+    const std::string id = created["id"];
+    EXPECT_EQ(id.rfind("m_", 0), 0u) << id;
+    EXPECT_EQ(created["joints"], 19);
+    EXPECT_EQ(created["name"].get<std::string>().find('/'), std::string::npos) << created;
+
+    Reply got = h.get("/models/" + id);
+    ASSERT_EQ(got.status, 200) << got;
+    const json m = got.js();
+    EXPECT_EQ(m["joints"].size(), 19u);
+    EXPECT_TRUE(m["has_uvs"].get<bool>());
+    EXPECT_EQ(m["triangles"], 4672);
+    EXPECT_GE(m["clips"].size(), 1u);
+
+    bool listed = false;
+    for (const json all = h.get("/models").js(); const json& e : all["models"])
+        listed = listed || e["id"] == id;
+    EXPECT_TRUE(listed);
+
+    Reply uv = h.get("/models/" + id + "/uv-layout");
+    ASSERT_EQ(uv.status, 200) << uv;
+    const json layout = uv.js();
+    ASSERT_TRUE(layout["edges"].is_array());
+    EXPECT_GT(layout["edge_count"].get<std::size_t>(), 1000u);
+    EXPECT_EQ(layout["edges"].size(), 4 * layout["edge_count"].get<std::size_t>());
+    for (const json& v : layout["edges"])
+        ASSERT_TRUE(v.is_number() && std::isfinite(v.get<double>()));
+
+    Reply png = h.get("/models/" + id + "/uv-layout?format=png&size=256");
+    ASSERT_EQ(png.status, 200) << png;
+    EXPECT_EQ(png.header("Content-Type"), "image/png");
+    auto img = decodeFrame(png.bytes());
+    ASSERT_TRUE(img) << img.error().message;
+    EXPECT_EQ(img->width, 256);
+    EXPECT_EQ(img->height, 256);
+    std::size_t lit = 0;
+    for (std::size_t i = 0; i < img->rgba.size(); i += 4)
+        lit += img->rgba[i] == 255;
+    EXPECT_GT(lit, 1000u);
+
+    EXPECT_EQ(h.del("/models/" + id).status, 204);
+    expectError(h.get("/models/" + id), 404, "id");
+    expectError(h.del("/models/" + id), 404, "id");
+}
+
+TEST_F(ModelsHttpTest, GltfWithExternalFilesUploadsAsMultipart) {
+    auto post = [&](const httplib::MultipartFormDataItems& items) {
+        httplib::Client cli("127.0.0.1", server_->port());
+        auto r = cli.Post((std::string(kApi) + "/models?name=tri").c_str(), items);
+        Reply out;
+        if (r) {
+            out.status = r->status;
+            out.body = r->body;
+        }
+        return out;
+    };
+    const auto [gltf, bin] = triangleGltf("tri.bin");
+    Reply ok = post({{"gltf", gltf, "tri.gltf", "model/gltf+json"},
+                     {"buffer", bin, "tri.bin", "application/octet-stream"}});
+    ASSERT_EQ(ok.status, 201) << ok;
+    const std::string id = ok.js()["id"];
+    EXPECT_EQ(ok.js()["triangles"], 1);
+    Reply got = http().get("/models/" + id);
+    ASSERT_EQ(got.status, 200) << got;
+    EXPECT_EQ(got.js()["vertices"], 3);
+    // A scene on it renders.
+    const std::string sid = createScene({{"format", "dermis.scene/1"}, {"model", id},
+                                         {"render", {{"size", {64, 64}}}}});
+    Reply frame = http().get("/scenes/" + sid + "/frame");
+    EXPECT_EQ(frame.status, 200) << frame;
+    EXPECT_EQ(http().del("/scenes/" + sid).status, 204);
+    EXPECT_EQ(http().del("/models/" + id).status, 204);
+
+    // The buffer is missing; the .gltf points outside its folder; a part name with a folder;
+    // no .gltf part at all: 4xx JSON errors, nothing stored.
+    const auto [escaping, bin2] = triangleGltf("../tri.bin");
+    const std::vector<std::pair<std::string, httplib::MultipartFormDataItems>> bad = {
+        {"missing buffer", {{"gltf", gltf, "tri.gltf", ""}}},
+        {"escaping uri", {{"gltf", escaping, "tri.gltf", ""}, {"buffer", bin2, "tri.bin", ""}}},
+        {"folder in a part name", {{"gltf", gltf, "tri.gltf", ""}, {"buffer", bin, "../tri.bin", ""}}},
+        {"no gltf part", {{"buffer", bin, "tri.bin", ""}}},
+        {"not json", {{"gltf", "not json", "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}}},
+    };
+    const std::size_t models = http().get("/models").js()["models"].size();
+    for (const auto& [name, items] : bad) {
+        Reply r = post(items);
+        EXPECT_GE(r.status, 400) << name << ": " << r;
+        EXPECT_LT(r.status, 500) << name << ": " << r;
+        EXPECT_TRUE(r.js().contains("error")) << name << ": " << r;
+    }
+    EXPECT_EQ(http().get("/models").js()["models"].size(), models);
+}
+
+TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
+    Http h = http();
+    Reply barb = h.upload("/models", readBytes(kBarbarian), "model/gltf-binary");
+    ASSERT_EQ(barb.status, 201) << barb;
+    const std::string barbId = barb.js()["id"];
+    Reply bm = h.get("/models/" + barbId);
+    ASSERT_EQ(bm.status, 200);
+    EXPECT_EQ(bm.js()["joints"].size(), 41u);
+    EXPECT_GE(bm.js()["clips"].size(), 70u);
+
+    // A scene on an uploaded model renders.
+    json doc = {{"format", "dermis.scene/1"},
+                {"model", barbId},
+                {"heightmap", {{"size", {256, 256}}}},
+                {"render", {{"size", {96, 96}}, {"msaa", 1}}}};
+    const std::string sid = createScene(doc);
+    Reply frame = h.get("/scenes/" + sid + "/frame");
+    ASSERT_EQ(frame.status, 200) << frame;
+    auto img = decodeFrame(frame.bytes());
+    ASSERT_TRUE(img);
+    EXPECT_EQ(img->width, 96);
+    expectError(h.del("/models/" + barbId), 409, "id"); // in use
+    EXPECT_EQ(h.del("/scenes/" + sid).status, 204);
+    EXPECT_EQ(h.del("/models/" + barbId).status, 204);
+
+    Reply fig = h.upload("/models", readBytes(kRiggedFigure), "model/gltf-binary");
+    ASSERT_EQ(fig.status, 201) << fig;
+    const std::string figId = fig.js()["id"];
+    EXPECT_FALSE(fig.js()["has_uvs"].get<bool>());
+    expectError(h.get("/models/" + figId + "/uv-layout"), 422, "id");
+    expectError(h.get("/models/" + figId + "/uv-layout?format=png"), 422, "id");
+    json withPlacement = {{"format", "dermis.scene/1"},
+                          {"model", figId},
+                          {"placements", {placementOf("crease", "a")}}};
+    expectError(h.post("/scenes", withPlacement), 422, "/placements/0");
+    // Without placements it is a valid scene.
+    const std::string figScene = createScene(
+        {{"format", "dermis.scene/1"}, {"model", figId}, {"heightmap", {{"size", {256, 256}}}}});
+    EXPECT_EQ(h.del("/scenes/" + figScene).status, 204);
+    EXPECT_EQ(h.del("/models/" + figId).status, 204);
+}
+
+} // namespace

@@ -1,0 +1,127 @@
+// RendersHttpTest — renders without a stored scene and under load, end to end (HttpTestFixture.hpp:
+// a real dermis::Service + dermis::Api on 127.0.0.1, a GL context on $DERMIS_TEST_GL, cpp-httplib
+// clients over loopback). It checks:
+//   * the stateless batch (POST /render): multipart/mixed with one decodable image part per frame,
+//     PNG and JPEG;
+//   * back-pressure: with a render queue of 1 (a second server), concurrent frames answer 200 or
+//     503 + Retry-After, and renders go through again once the burst is over.
+#include "HttpTestFixture.hpp"
+
+using namespace dermis;
+using namespace dermis::test;
+using namespace dermis::test::http;
+
+namespace {
+
+/// One server (no token).
+class RendersHttpTest : public SharedServerTest {};
+
+// ================================================================================================
+// Stateless batch
+// ================================================================================================
+
+TEST_F(RendersHttpTest, BatchStreamsOneImagePartPerFrame) {
+    Http h = http();
+    json body = {{"scene", smallScene()},
+                 {"frames", json::array({{{"time", 0.2}},
+                                         {{"time", 0.8}},
+                                         {{"pose", {{"animation", "squat"}, {"time", 1.0}}}}})},
+                 {"format", "png"}};
+    Reply r = h.post("/render", body);
+    ASSERT_EQ(r.status, 200) << r;
+    EXPECT_EQ(r.header("X-Dermis-Frames"), "3");
+    const std::string ct = r.header("Content-Type");
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(ct, m, std::regex("^multipart/mixed; *boundary=\"?([^\";]+)\"?")))
+        << ct;
+    const auto parts = multipartParts(r.body, m[1]);
+    ASSERT_EQ(parts.size(), 3u) << r.body.size();
+    std::vector<Image8> frames;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        SCOPED_TRACE(k);
+        EXPECT_NE(parts[k].headers.find("Content-Type: image/png"), std::string::npos)
+            << parts[k].headers;
+        EXPECT_NE(parts[k].headers.find("X-Dermis-Frame: " + std::to_string(k)), std::string::npos);
+        auto img = decodeFrame({parts[k].content.begin(), parts[k].content.end()});
+        ASSERT_TRUE(img) << img.error().message;
+        EXPECT_EQ(img->width, 128);
+        EXPECT_EQ(img->height, 128);
+        frames.push_back(std::move(*img));
+    }
+    ASSERT_EQ(frames.size(), 3u);
+    EXPECT_GT(pixelsDiffering(frames[0], frames[2]), 20u); // squat vs elbow curl
+
+    // JPEG batches too.
+    body["format"] = "jpeg";
+    body["frames"] = json::array({{{"time", 0.0}}});
+    Reply jr = h.post("/render", body);
+    ASSERT_EQ(jr.status, 200) << jr;
+    std::smatch jm;
+    const std::string jct = jr.header("Content-Type");
+    ASSERT_TRUE(std::regex_search(jct, jm, std::regex("boundary=\"?([^\";]+)\"?")));
+    const auto jparts = multipartParts(jr.body, jm[1]);
+    ASSERT_EQ(jparts.size(), 1u);
+    EXPECT_NE(jparts[0].headers.find("image/jpeg"), std::string::npos);
+    EXPECT_TRUE(decodeFrame({jparts[0].content.begin(), jparts[0].content.end()}));
+}
+
+// ================================================================================================
+// Back-pressure (a second server, with a render queue of 1)
+// ================================================================================================
+
+class RendersHttpQueueTest : public ::testing::Test {
+  protected:
+    static void SetUpTestSuite() {
+        ServerLimits l = mainLimits();
+        l.queueLength = 1;
+        server_ = LiveServer::start(l, "", error_);
+    }
+    static void TearDownTestSuite() { server_.reset(); }
+    void SetUp() override {
+        ASSERT_TRUE(server_ && error_.empty()) << "the server did not start: " << error_;
+    }
+    static inline std::unique_ptr<LiveServer> server_;
+    static inline std::string error_;
+};
+
+TEST_F(RendersHttpQueueTest, AFullQueueAnswers503WithRetryAfter) {
+    Http h(server_->port());
+    const std::string id = h.post("/scenes", {{"default_patterns", true}}).js().value("id", "");
+    ASSERT_FALSE(id.empty());
+    constexpr int kClients = 8;
+    std::vector<Reply> replies(kClients);
+    std::vector<std::thread> threads;
+    std::atomic<int> ready{0};
+    for (int i = 0; i < kClients; ++i)
+        threads.emplace_back([&, i] {
+            ++ready;
+            while (ready < kClients)
+                std::this_thread::yield();
+            replies[static_cast<std::size_t>(i)] =
+                h.get("/scenes/" + id + "/frame?width=1024&height=1024&msaa=4");
+        });
+    for (std::thread& t : threads)
+        t.join();
+    int ok = 0, busy = 0;
+    for (const Reply& r : replies) {
+        if (r.status == 200) {
+            ++ok;
+            auto img = decodeFrame(r.bytes());
+            ASSERT_TRUE(img);
+            EXPECT_EQ(img->width, 1024);
+        } else {
+            ++busy;
+            expectError(r, 503);
+            EXPECT_EQ(r.js()["error"]["code"], "unavailable") << r;
+            EXPECT_FALSE(r.header("Retry-After").empty()) << r;
+        }
+    }
+    EXPECT_GE(ok, 1);
+    std::cout << "[ RendersHttpQueueTest ] " << ok << " × 200, " << busy << " × 503\n";
+    // Once the burst is over, renders go through again.
+    EXPECT_EQ(h.get("/scenes/" + id + "/frame?width=64&height=64").status, 200);
+    Reply info = h.get("/info");
+    EXPECT_EQ(info.js()["render_queue"], 0);
+}
+
+} // namespace
