@@ -1,5 +1,6 @@
 // FramePlanTest — the one path from a scene to a frame (core planFrame) and the one check of
 // render settings (core validateRenderSettings). Pure: a small hand-built rig, no files.
+#include "core/bake.hpp"
 #include "core/frame_plan.hpp"
 #include "core/render_settings.hpp"
 
@@ -68,6 +69,32 @@ TEST(FramePlanTest, PlansPoseHeightsAndSettings) {
     EXPECT_EQ(plan->heights.width, 32);
     EXPECT_EQ(plan->heights.height, 16);
     EXPECT_EQ(plan->render.size, (std::array<int, 2>{200, 100}));
+}
+
+TEST(FramePlanTest, DisabledPlacementsAreCheckedButContributeNothing) {
+    const Model m = tinyModel();
+    const PatternImages images = tinyImages();
+    Scene s = tinyScene();
+    Placement off = s.placements[0];
+    off.id = "b";
+    off.enabled = false;
+    off.h = 5.0;
+    s.placements.push_back(off);
+    auto plan = planFrame(s, m, images, nullptr);
+    ASSERT_TRUE(plan) << plan.error().message;
+    ASSERT_EQ(plan->heights.placements.size(), 1u);
+    EXPECT_EQ(plan->heights.placements[0].h, 1.0);
+    auto with = bakeHeightMaps(plan->heights, 1);
+    s.placements.pop_back();
+    auto without = bakeScene(s, m, images);
+    ASSERT_TRUE(with && without);
+    EXPECT_EQ(with->bump.data, without->bump.data);
+    // A disabled placement must still be valid: an unknown joint fails naming it.
+    off.joint = "nope";
+    s.placements.push_back(off);
+    auto bad = planFrame(s, m, images, nullptr);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().field, "/placements/1/joint");
 }
 
 TEST(FramePlanTest, KeepsItsImagesAlive) {

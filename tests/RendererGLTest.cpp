@@ -280,6 +280,28 @@ TEST_F(RendererGLTest, HeightPassOfTheDefaultSceneEqualsTheCpuReference) {
     }
 }
 
+TEST_F(RendererGLTest, DisabledPlacementsLeaveTheGpuMapsAsIfAbsent) {
+    auto loaded = loadSceneFile(kSource + "/models/default.scene.json");
+    ASSERT_TRUE(loaded) << loaded.error().message;
+    auto model = std::make_shared<const Model>(loaded->model);
+    Scene disabled = loaded->scene, removed = loaded->scene;
+    removed.placements.clear();
+    for (std::size_t k = 0; k < disabled.placements.size(); ++k) {
+        if (k % 3 == 0) removed.placements.push_back(disabled.placements[k]);
+        else disabled.placements[k].enabled = false;
+    }
+    auto maps = [&](const Scene& scene) -> Result<HeightMaps> {
+        auto frame = makeSceneFrame(scene, model, loaded->images, nullptr, {0.75});
+        if (!frame) return frame.error();
+        return gl().bakeHeightMaps(*frame->request.heights);
+    };
+    auto a = maps(disabled), b = maps(removed), all = maps(loaded->scene);
+    ASSERT_TRUE(a && b && all);
+    EXPECT_EQ(a->bump.data, b->bump.data);
+    EXPECT_EQ(a->displacement.data, b->displacement.data);
+    EXPECT_NE(a->bump.data, all->bump.data) << "disabling placements changed nothing";
+}
+
 TEST_F(RendererGLTest, HeightPassRejectsBadInput) {
     HeightPassInput in;
     in.width = 0;

@@ -327,6 +327,20 @@ TEST(SceneTest, RoundTripOfNormalisedVectorsIsStable) {
     }
 }
 
+TEST(SceneTest, EnabledAndLabelRoundTrip) {
+    const Scene defaults = parseOk(placement(""));
+    EXPECT_TRUE(defaults.placements[0].enabled);
+    EXPECT_EQ(defaults.placements[0].label, "");
+    const std::string label = "inner elbow \u2014 left"; // UTF-8, 120 bytes allowed
+    const Scene s = parseOk(placement(R"("enabled":false,"label":")" + label + R"(")"));
+    EXPECT_FALSE(s.placements[0].enabled);
+    EXPECT_EQ(s.placements[0].label, "inner elbow \xE2\x80\x94 left");
+    const json j = dermis::toJson(s);
+    EXPECT_EQ(j["placements"][0]["enabled"], false);
+    EXPECT_EQ(j["placements"][0]["label"], "inner elbow \xE2\x80\x94 left");
+    expectStableRoundTrip(placement(R"("enabled":false,"label":")" + std::string(120, 'y') + R"(")"));
+}
+
 TEST(SceneTest, SerialisationWritesEveryField) {
     json j = dermis::toJson(parseOk(placement("")));
     EXPECT_EQ(j["format"], "dermis.scene/1");
@@ -336,7 +350,8 @@ TEST(SceneTest, SerialisationWritesEveryField) {
     EXPECT_TRUE(j["patterns"].is_object());
     const json& p = j["placements"][0];
     for (const char* key : {"id", "pattern", "center", "scale", "rotation", "joint", "axis",
-                            "theta_min", "theta_max", "h", "model", "target", "response"})
+                            "theta_min", "theta_max", "h", "model", "target", "response",
+                            "enabled", "label"})
         EXPECT_TRUE(p.contains(key)) << key;
     EXPECT_EQ(p["axis"], "x");
     EXPECT_EQ(p["response"], "log2");
@@ -466,6 +481,10 @@ const BadCase kBadCases[] = {
     {"HNegative", placement(R"("h":-1)"), "/placements/0/h"},
     {"HOverflow", placement(R"("h":1e400)"), "/placements/0/h"},
     {"HBool", placement(R"("h":true)"), "/placements/0/h"},
+    {"EnabledString", placement(R"("enabled":"false")"), "/placements/0/enabled"},
+    {"EnabledNumber", placement(R"("enabled":0)"), "/placements/0/enabled"},
+    {"LabelNumber", placement(R"("label":7)"), "/placements/0/label"},
+    {"LabelTooLong", placement(R"("label":")" + std::string(121, 'x') + R"(")"), "/placements/0/label"},
     {"ModelUnknown", placement(R"("model":"linear")"), "/placements/0/model"},
     {"TargetUnknown", placement(R"("target":"normal")"), "/placements/0/target"},
     {"ResponseUnknown", placement(R"("response":"log10")"), "/placements/0/response"},

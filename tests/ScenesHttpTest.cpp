@@ -176,4 +176,26 @@ TEST_F(ScenesHttpTest, SceneLifecycleWithEditsAndRenders) {
     expectError(h.del("/scenes/" + id), 404, "id");
 }
 
+TEST_F(ScenesHttpTest, DisabledAndLabelledPlacements) {
+    Http h = http();
+    const std::string id = createScene(smallScene());
+    const std::string s = "/scenes/" + id;
+    Reply on = h.get(s + "/heightmaps/bump?format=f32");
+    ASSERT_EQ(on.status, 200) << on;
+    Reply patched = h.patch(s + "/placements/elbow", {{"enabled", false}, {"label", "left elbow crease"}});
+    ASSERT_EQ(patched.status, 200) << patched;
+    EXPECT_EQ(patched.js()["scene"]["placements"][0]["enabled"], false);
+    EXPECT_EQ(patched.js()["scene"]["placements"][0]["label"], "left elbow crease");
+    Reply off = h.get(s + "/heightmaps/bump?format=f32");
+    ASSERT_EQ(off.status, 200) << off;
+    ASSERT_EQ(off.body.size(), on.body.size());
+    EXPECT_NE(on.body, off.body);
+    EXPECT_EQ(off.body, std::string(off.body.size(), '\0')) << "a disabled placement contributes nothing";
+    expectError(h.patch(s + "/placements/elbow", {{"enabled", "no"}}), 422, "/placements/0/enabled");
+    expectError(h.patch(s + "/placements/elbow", {{"label", std::string(121, 'x')}}), 422,
+                "/placements/0/label");
+    EXPECT_EQ(h.get(s).js()["revision"], 2);
+    EXPECT_EQ(h.del(s).status, 204);
+}
+
 } // namespace

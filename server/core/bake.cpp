@@ -88,6 +88,7 @@ Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const M
                              "no image loaded for pattern '" + p.pattern + "'");
         auto theta = placementAngle(model, pose, p, i);
         if (!theta) return theta.error();
+        if (!p.enabled) continue; // checked like the others, contributes nothing
         BakePlacement b;
         if (!it->second)
             return makeError(ErrorCode::NotFound, where, ptr + "/pattern",

@@ -33,7 +33,8 @@ Result<double> placementAngle(const Model& model, const LocalPose& pose, const P
 /// immutable: a frame plan keeps the images it points to alive while the owner's map changes.
 using PatternImages = std::map<std::string, std::shared_ptr<const PatternImage>>;
 
-/// Resolves every placement to a BakePlacement (pointers into `images`, patternId set). Fails when the model
+/// Resolves every enabled placement to a BakePlacement (pointers into `images`, patternId set), in
+/// document order; disabled ones are checked like the others but left out. Fails when the model
 /// has no TEXCOORD_0 ("/placements/<i>": why), a joint is unknown, or an image is missing.
 Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const Model& model,
                                                      const LocalPose& pose,

@@ -60,6 +60,8 @@ json toJson(const Scene& scene) {
         e["model"] = std::string(toString(p.model));
         e["target"] = std::string(toString(p.target));
         e["response"] = std::string(toString(p.response));
+        e["enabled"] = p.enabled;
+        e["label"] = p.label;
         placements.push_back(std::move(e));
     }
     doc["placements"] = std::move(placements);

@@ -58,7 +58,12 @@ struct Placement {
     DeformModel model = DeformModel::Scale;
     Target target = Target::Bump;
     Response response = Response::Log2;
+    bool enabled = true; ///< false: kept in the document, contributes nothing (SPEC §6)
+    std::string label;   ///< free text for people, ≤ kMaxLabelLength bytes of UTF-8
 };
+
+/// Longest placement label, in bytes.
+constexpr std::size_t kMaxLabelLength = 120;
 
 /// A joint override of the pose: exactly one of rotation / axisAngles is set.
 struct JointPose {

@@ -271,6 +271,25 @@ Status parsePlacementModel(const Reader& rd, const json& v, const std::string& p
     return Ok{};
 }
 
+/// For people and the editor: enabled (default true), label (≤ kMaxLabelLength bytes).
+Status parsePlacementMeta(const Reader& rd, const json& v, const std::string& ptr, Placement& out) {
+    if (const json* e = Reader::find(v, "enabled")) {
+        if (!e->is_boolean())
+            return rd.bad(ptr + "/enabled", "expected true or false, got " + describeType(*e));
+        out.enabled = e->get<bool>();
+    }
+    if (const json* l = Reader::find(v, "label")) {
+        auto text = rd.string(*l, ptr + "/label", false);
+        if (!text) return text.error();
+        if (text->size() > kMaxLabelLength)
+            return rd.bad(ptr + "/label", "is " + std::to_string(text->size()) +
+                                              " bytes, longer than " +
+                                              std::to_string(kMaxLabelLength));
+        out.label = *text;
+    }
+    return Ok{};
+}
+
 /// One placement, field groups in document order of precedence (the pattern's defaults first).
 Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const Scene& scene,
                       const PatternManifest& manifest, const std::set<std::string>& reservedIds,
@@ -281,6 +300,7 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
     if (auto s = parsePlacementPattern(rd, v, ptr, scene, manifest, out); !s) return s;
     if (auto s = parsePlacementFootprint(rd, v, ptr, out); !s) return s;
     if (auto s = parsePlacementDriver(rd, v, ptr, out); !s) return s;
+    if (auto s = parsePlacementMeta(rd, v, ptr, out); !s) return s;
     return parsePlacementModel(rd, v, ptr, out);
 }
 
