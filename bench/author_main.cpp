@@ -1,0 +1,181 @@
+// dermis-authorbench — the authoring API (SPEC §6) on a scene with a long history, over HTTP on
+// loopback; prints JSON. Usage: dermis-authorbench [--revisions N] [--repeat N] [--gl BACKEND]
+// (default 10,000 revisions, 50 requests per figure).
+//
+// Starts the server in-process (Service + Api on 127.0.0.1, a temporary data folder), creates a
+// small scene on the default character and edits it until it has N revisions (through the Service
+// directly: every one written durably, as over HTTP), then measures p50/p99 over loopback:
+//  * scene_read (GET /scenes/{id}), revision_read (GET ?revision=k, k spread over the history,
+//    read from disk), revisions_page (GET /revisions?limit=50, newest and from the middle);
+//  * edit (PATCH a placement with If-Match), revert (POST /revert to an old revision);
+//  * reopen_ms: Service::open of the data folder with that history.
+#include "http/api.hpp"
+#include "service/service.hpp"
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <thread>
+#include <unistd.h>
+
+using namespace dermis;
+using json = nlohmann::json;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms(Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+json percentiles(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    auto at = [&](double q) {
+        const std::size_t i = std::min(
+            v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1);
+        return std::round(v[i] * 1000) / 1000;
+    };
+    return {{"p50_ms", at(0.5)}, {"p99_ms", at(0.99)}, {"requests", v.size()}};
+}
+
+const json kScene = json::parse(R"({
+  "format": "dermis.scene/1", "model": "builtin:default", "heightmap": {"size": [256, 256]},
+  "placements": [{"id": "elbow", "pattern": "crease", "center": [0.3, 0.4], "scale": [0.08, 0.05],
+                  "joint": "forearm.l", "axis": "x", "theta_min": 0, "theta_max": 120}],
+  "render": {"size": [128, 128], "msaa": 1}})");
+
+} // namespace
+
+int main(int argc, char** argv) {
+    int revisions = 10000, repeat = 50;
+    GlBackend backend = GlBackend::Auto;
+    for (int i = 1; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--revisions") == 0 && i + 1 < argc) {
+            revisions = std::max(10, std::atoi(argv[++i]));
+        } else if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
+            repeat = std::max(5, std::atoi(argv[++i]));
+        } else if (std::strcmp(argv[i], "--gl") == 0 && i + 1 < argc) {
+            auto b = glBackendFromString(argv[++i]);
+            if (!b) return 2;
+            backend = *b;
+        } else {
+            std::cerr << "usage: dermis-authorbench [--revisions N] [--repeat N] [--gl BACKEND]\n";
+            return 2;
+        }
+    }
+    const std::filesystem::path data = std::filesystem::temp_directory_path() /
+                                       ("dermis-authorbench-" + std::to_string(::getpid()));
+    auto service = Service::open(data.string(), backend, ServerLimits{});
+    if (!service) {
+        std::cerr << service.error().message << "\n";
+        return 1;
+    }
+    auto created = (*service)->createScene(kScene);
+    if (!created) {
+        std::cerr << created.error().message << "\n";
+        return 1;
+    }
+    const std::string id = (*created)["id"];
+    const auto fill0 = Clock::now();
+    for (int r = 2; r <= revisions; ++r) {
+        auto e = (*service)->patchPlacement(id, "elbow", {{"h", 1.0 + (r % 50) * 0.01}},
+                                            EditContext{{}, "bench"});
+        if (!e) {
+            std::cerr << e.error().message << "\n";
+            return 1;
+        }
+    }
+    const double fillMs = ms(fill0, Clock::now());
+
+    ApiOptions opt;
+    opt.port = 0;
+    auto api = std::make_unique<Api>(**service, opt);
+    auto port = api->bind();
+    if (!port) {
+        std::cerr << port.error().message << "\n";
+        return 1;
+    }
+    std::thread serverThread([&] { api->run(); });
+    httplib::Client c("127.0.0.1", *port);
+    c.set_keep_alive(true);
+    c.set_tcp_nodelay(true);
+    c.set_read_timeout(60, 0);
+    const std::string base = "/api/v1/scenes/" + id;
+    json results = json::array();
+    bool failed = false;
+    auto measure = [&](const char* name, const std::function<bool(int)>& request) {
+        std::vector<double> lat;
+        for (int r = 0; r <= repeat && !failed; ++r) {
+            const auto t0 = Clock::now();
+            if (!request(r)) {
+                failed = true;
+                std::cerr << name << ": request " << r << " failed\n";
+            }
+            if (r > 0) lat.push_back(ms(t0, Clock::now()));
+        }
+        if (failed) return;
+        json j = percentiles(lat);
+        j["name"] = name;
+        j["revisions"] = revisions;
+        results.push_back(j);
+    };
+    auto ok = [](const httplib::Result& res) {
+        if (res && res->status != 200) std::cerr << res->status << " " << res->body << "\n";
+        return res && res->status == 200;
+    };
+    measure("scene_read", [&](int) { return ok(c.Get(base)); });
+    measure("revision_read", [&](int r) {
+        const int k = 1 + (r * 7919) % (revisions - 1);
+        return ok(c.Get(base + "?revision=" + std::to_string(k)));
+    });
+    measure("revisions_page_newest", [&](int) { return ok(c.Get(base + "/revisions?limit=50")); });
+    measure("revisions_page_middle", [&](int) {
+        return ok(c.Get(base + "/revisions?limit=50&before=" + std::to_string(revisions / 2)));
+    });
+    std::uint64_t current = static_cast<std::uint64_t>(revisions);
+    measure("edit_if_match", [&](int r) {
+        httplib::Headers h{{"If-Match", "\"r" + std::to_string(current) + "\""},
+                           {"X-Dermis-Client", "bench"}};
+        auto res = c.Patch(base + "/placements/elbow", h, json{{"h", 1.0 + r * 0.001}}.dump(),
+                           "application/json");
+        ++current;
+        return ok(res);
+    });
+    measure("revert", [&](int r) {
+        auto res = c.Post(base + "/revert", json{{"revision", 1 + (r * 13) % revisions}}.dump(), "application/json");
+        ++current;
+        return ok(res);
+    });
+    api->stop();
+    serverThread.join();
+    api.reset(); // before the service it serves
+    service->reset();
+    const auto open0 = Clock::now();
+    auto reopened = Service::open(data.string(), backend, ServerLimits{});
+    const double reopenMs = ms(open0, Clock::now());
+    const bool reopenOk = reopened && (*reopened)->getScene(id);
+    reopened = makeError(ErrorCode::Internal, "", "", "closed");
+    std::error_code ec;
+    std::filesystem::remove_all(data, ec);
+    if (failed || !reopenOk) {
+        std::cerr << "a request failed\n";
+        return 1;
+    }
+    std::cout << json{{"benchmark", "dermis-authorbench"},
+                      {"revisions", revisions},
+                      {"fill_ms_per_edit", std::round(fillMs / (revisions - 1) * 1000) / 1000},
+                      {"reopen_ms", std::round(reopenMs * 10) / 10},
+                      {"hardware_threads", std::thread::hardware_concurrency()},
+                      {"results", results}}
+                     .dump(2)
+              << "\n";
+    return 0;
+}
