@@ -103,6 +103,7 @@ Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const M
         b.response = p.response;
         b.h = p.h;
         b.t = normalizedT(*theta, p.thetaMin, p.thetaMax);
+        b.source = static_cast<int>(i);
         out.push_back(b);
     }
     return out;

@@ -74,6 +74,7 @@ struct BakePlacement {
     Response response = Response::Log2;
     double h = 1.0;
     double t = 0.0; ///< normalised angle from normalizedT
+    int source = -1; ///< index of the scene placement it comes from (−1: not from a scene)
 };
 
 /// The contribution of one placement at a UV point (0 outside its footprint).

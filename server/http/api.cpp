@@ -254,6 +254,7 @@ const RouteTable& routeTable() {
         installPatternRoutes(t);
         installSceneRoutes(t);
         installRenderRoutes(t);
+        installInspectRoutes(t);
         installEventRoutes(t);
         return t;
     }();

@@ -133,6 +133,7 @@ void installModelRoutes(RouteTable& table);
 void installPatternRoutes(RouteTable& table);
 void installSceneRoutes(RouteTable& table);
 void installRenderRoutes(RouteTable& table);
+void installInspectRoutes(RouteTable& table);
 void installEventRoutes(RouteTable& table);
 
 // --- browser sessions (api_session.cpp) ----------------------------------------------------------

@@ -15,6 +15,7 @@
 //
 // Files: service.cpp (open, info), service_models.cpp, service_patterns.cpp,
 // service_scenes.cpp (documents and edits), service_history.cpp (revisions, revert, presence),
+// service_inspect.cpp (probe, activation),
 // service_renders.cpp (frames, maps, batch), service_events.cpp; shared private state in
 // service_state.hpp.
 //
@@ -210,6 +211,17 @@ public:
     /// Answers {"scene", "presence": [{client, selection, color, expires_in}]}.
     Result<nlohmann::json> postPresence(const std::string& id, const nlohmann::json& body);
     Result<nlohmann::json> listPresence(const std::string& id);
+
+    // --- inspection (CPU only; service_inspect.cpp)
+    /// Why a texel has its height (SPEC §6 Probe): {u, v, texel: [x, y], map_size, base, bump,
+    /// displacement, contributions: [{placement, pattern, target, t, L, height}]} at the texel of
+    /// the scene's maps containing (u, v), at `time` (default the scene's pose time). Fails on u
+    /// or v outside [0, 1] (field "u"/"v") or a bad time (field "time").
+    Result<nlohmann::json> probe(const std::string& id, double u, double v,
+                                 std::optional<double> time);
+    /// Each placement's t over clip `clip` at `fps` (SPEC §6 Activation): {scene, clip, fps,
+    /// times, placements: {pid: [t…]}, flags: [{placement, kind, at}]} (core clipActivation).
+    Result<nlohmann::json> activation(const std::string& id, const std::string& clip, double fps);
 
     // --- renders
     Result<EncodedImage> frame(const std::string& id, const FrameParams& params);

@@ -1,0 +1,78 @@
+// Inspection of a stored scene, CPU only (SPEC §6): probe — why a texel has its height — and
+// activation — each placement's t over a clip, with flags. Both run on a snapshot, unlocked.
+#include "service/service_state.hpp"
+
+#include "core/activation.hpp"
+#include "core/probe.hpp"
+
+#include <cmath>
+
+namespace dermis {
+
+using namespace detail;
+
+namespace {
+
+/// Seconds and t values rounded to 1e-6 (keeps the JSON short; far below what a person reads).
+double rounded(double x) {
+    return std::round(x * 1e6) / 1e6;
+}
+
+} // namespace
+
+Result<json> Service::probe(const std::string& id, double u, double v, std::optional<double> time) {
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    FrameOverrides o;
+    o.time = time;
+    auto plan = planFrame(snap->scene, *snap->model, snap->images, snap->base, o);
+    if (!plan) {
+        Error e = plan.error();
+        if (e.field == "/pose/time") e.field = "time";
+        return e;
+    }
+    auto r = probeHeights(plan->heights, u, v);
+    if (!r) return r.error();
+    json contributions = json::array();
+    for (const ProbeContribution& c : r->contributions) {
+        const Placement& p = snap->scene.placements.at(static_cast<std::size_t>(c.source));
+        contributions.push_back({{"placement", p.id},
+                                 {"pattern", p.pattern},
+                                 {"target", std::string(toString(c.target))},
+                                 {"t", rounded(c.t)},
+                                 {"L", c.L},
+                                 {"height", c.height}});
+    }
+    return json{{"u", u},
+                {"v", v},
+                {"texel", {r->texelX, r->texelY}},
+                {"map_size", {plan->heights.width, plan->heights.height}},
+                {"base", r->base},
+                {"bump", r->bump},
+                {"displacement", r->displacement},
+                {"contributions", std::move(contributions)}};
+}
+
+Result<json> Service::activation(const std::string& id, const std::string& clip, double fps) {
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    auto a = clipActivation(snap->scene, *snap->model, clip, fps);
+    if (!a) return a.error();
+    json times = json::array();
+    for (double t : a->times) times.push_back(rounded(t));
+    json placements = json::object();
+    for (std::size_t i = 0; i < a->t.size(); ++i) {
+        json values = json::array();
+        for (double t : a->t[i]) values.push_back(rounded(t));
+        placements[snap->scene.placements[i].id] = std::move(values);
+    }
+    json flags = json::array();
+    for (const ActivationFlag& f : a->flags)
+        flags.push_back({{"placement", snap->scene.placements[f.placement].id},
+                         {"kind", std::string(toString(f.kind))},
+                         {"at", f.at ? json(rounded(*f.at)) : json()}});
+    return json{{"scene", id},       {"clip", clip},           {"fps", fps},
+                {"times", times},    {"placements", placements}, {"flags", flags}};
+}
+
+} // namespace dermis
