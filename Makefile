@@ -4,7 +4,7 @@ ASAN_BUILD ?= build-asan
 JOBS ?= 2
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-asan run offline bench loadbench patterns character clean format
+.PHONY: all deps build test test-asan run offline bench loadbench authorbench patterns character clean format
 
 all: build
 
@@ -48,6 +48,9 @@ bench: build
 
 loadbench: build
 	$(BUILD)/bench/dermis-loadbench $(BENCH_ARGS)
+
+authorbench: build
+	$(BUILD)/bench/dermis-authorbench $(BENCH_ARGS)
 
 # Regenerates the built-in pattern library (patterns/*.png, manifest.json, contact sheet).
 patterns: build

@@ -8,6 +8,7 @@
 //  * scene_read (GET /scenes/{id}), revision_read (GET ?revision=k, k spread over the history,
 //    read from disk), revisions_page (GET /revisions?limit=50, newest and from the middle);
 //  * edit (PATCH a placement with If-Match), revert (POST /revert to an old revision);
+//  * probe (GET /probe at the elbow crease), activation (GET /activation of elbow_curl at 30 fps);
 //  * reopen_ms: Service::open of the data folder with that history.
 #include "http/api.hpp"
 #include "service/service.hpp"
@@ -139,6 +140,12 @@ int main(int argc, char** argv) {
     measure("revisions_page_newest", [&](int) { return ok(c.Get(base + "/revisions?limit=50")); });
     measure("revisions_page_middle", [&](int) {
         return ok(c.Get(base + "/revisions?limit=50&before=" + std::to_string(revisions / 2)));
+    });
+    measure("probe", [&](int r) {
+        return ok(c.Get(base + "/probe?u=" + std::to_string(0.28 + 0.001 * (r % 40)) + "&v=0.4"));
+    });
+    measure("activation_elbow_curl_30fps", [&](int) {
+        return ok(c.Get(base + "/activation?clip=elbow_curl&fps=30"));
     });
     std::uint64_t current = static_cast<std::uint64_t>(revisions);
     measure("edit_if_match", [&](int r) {
