@@ -8,7 +8,8 @@
 //  * scene_read (GET /scenes/{id}), revision_read (GET ?revision=k, k spread over the history,
 //    read from disk), revisions_page (GET /revisions?limit=50, newest and from the middle);
 //  * edit (PATCH a placement with If-Match), revert (POST /revert to an old revision);
-//  * probe (GET /probe at the elbow crease), activation (GET /activation of elbow_curl at 30 fps);
+//  * probe (GET /probe at the elbow crease), activation (GET /activation of elbow_curl at 30 fps),
+//    lint of the default pattern set (18 placements, 7 clips);
 //  * reopen_ms: Service::open of the data folder with that history.
 #include "http/api.hpp"
 #include "service/service.hpp"
@@ -147,6 +148,13 @@ int main(int argc, char** argv) {
     measure("activation_elbow_curl_30fps", [&](int) {
         return ok(c.Get(base + "/activation?clip=elbow_curl&fps=30"));
     });
+    auto full = (*service)->createScene({{"default_patterns", true}});
+    if (!full) {
+        std::cerr << full.error().message << "\n";
+        return 1;
+    }
+    const std::string fullBase = "/api/v1/scenes/" + (*full)["id"].get<std::string>();
+    measure("lint_default_scene", [&](int) { return ok(c.Get(fullBase + "/lint")); });
     std::uint64_t current = static_cast<std::uint64_t>(revisions);
     measure("edit_if_match", [&](int r) {
         httplib::Headers h{{"If-Match", "\"r" + std::to_string(current) + "\""},

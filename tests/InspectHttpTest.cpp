@@ -57,4 +57,41 @@ TEST_F(InspectHttpTest, ProbeAndActivation) {
     ASSERT_EQ(h.del(s).status, 204);
 }
 
+TEST_F(InspectHttpTest, LintFindsOverlapsAndUnusedUploads) {
+    Http h = http();
+    const std::string id = createScene(smallScene());
+    const std::string s = "/scenes/" + id;
+    Reply clean = h.get(s + "/lint");
+    ASSERT_EQ(clean.status, 200) << clean;
+    ASSERT_TRUE(clean.js().is_array());
+    // smallScene() puts its "elbow" crease at (0.3, 0.4): the chest in the default atlas, where
+    // forearm.l has no weight. Lint says so.
+    bool noInfluence = false;
+    for (const json& f : clean.js())
+        noInfluence = noInfluence || (f["code"] == "no_influence" && f["placement"] == "elbow");
+    EXPECT_TRUE(noInfluence) << clean;
+
+    json twin = smallScene()["placements"][0];
+    twin["id"] = "twin";
+    twin["center"][0] = twin["center"][0].get<double>() + 0.01;
+    ASSERT_EQ(h.post(s + "/placements", twin).status, 201);
+    Reply up = h.upload("/patterns?name=lonely", domePng(), "image/png");
+    ASSERT_EQ(up.status, 201) << up;
+    const std::string pid = up.js()["id"];
+    Reply lint = h.get(s + "/lint");
+    ASSERT_EQ(lint.status, 200) << lint;
+    bool overlap = false, unused = false;
+    for (const json& f : lint.js()) {
+        EXPECT_TRUE(f["severity"] == "warning" || f["severity"] == "info") << f;
+        overlap = overlap || (f["code"] == "overlap" && f["placement"] == "elbow");
+        unused = unused || (f["code"] == "unused_upload" && f["placement"].is_null() &&
+                            f["message"].get<std::string>().find(pid) != std::string::npos);
+    }
+    EXPECT_TRUE(overlap) << lint;
+    EXPECT_TRUE(unused) << lint;
+    expectError(h.get("/scenes/s_0000000000000000/lint"), 404, "id");
+    ASSERT_EQ(h.del("/patterns/" + pid).status, 204);
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
 } // namespace

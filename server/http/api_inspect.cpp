@@ -1,5 +1,5 @@
 // Dermis HTTP shell — inspection routes (SPEC §6, CPU only): probe (why a texel has its height)
-// and activation (each placement's t over a clip, with flags).
+// activation (each placement's t over a clip, with flags) and lint.
 #include "http/api_internal.hpp"
 
 namespace dermis::api_detail {
@@ -23,6 +23,11 @@ void installInspectRoutes(RouteTable& t) {
         if (!req.has_param("clip"))
             return sendError(res, 422, "invalid_argument", "dermis::Api: clip is required", "clip");
         auto r = a.svc.activation(req.matches[1], req.get_param_value("clip"), fps.value_or(30.0));
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
+    t.add("GET", "/scenes/{id}/lint", [](Api::Impl& a, const Req& req, Res& res) {
+        auto r = a.svc.lint(req.matches[1]);
         if (!r) return sendError(res, r.error());
         sendJson(res, 200, *r);
     });

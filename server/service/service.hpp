@@ -222,6 +222,10 @@ public:
     /// Each placement's t over clip `clip` at `fps` (SPEC §6 Activation): {scene, clip, fps,
     /// times, placements: {pid: [t…]}, flags: [{placement, kind, at}]} (core clipActivation).
     Result<nlohmann::json> activation(const std::string& id, const std::string& clip, double fps);
+    /// What may be wrong with a scene that validates (SPEC §6 Lint): [{code, severity, placement,
+    /// message}] from core lintScene, plus `unused_upload` (info) for every uploaded pattern no
+    /// scene uses.
+    Result<nlohmann::json> lint(const std::string& id);
 
     // --- renders
     Result<EncodedImage> frame(const std::string& id, const FrameParams& params);

@@ -1,11 +1,14 @@
-// Inspection of a stored scene, CPU only (SPEC §6): probe — why a texel has its height — and
-// activation — each placement's t over a clip, with flags. Both run on a snapshot, unlocked.
+// Inspection of a stored scene, CPU only (SPEC §6): probe — why a texel has its height —,
+// activation — each placement's t over a clip, with flags — and lint. All run on a snapshot,
+// unlocked.
 #include "service/service_state.hpp"
 
 #include "core/activation.hpp"
+#include "core/lint.hpp"
 #include "core/probe.hpp"
 
 #include <cmath>
+#include <set>
 
 namespace dermis {
 
@@ -73,6 +76,38 @@ Result<json> Service::activation(const std::string& id, const std::string& clip,
                          {"at", f.at ? json(rounded(*f.at)) : json()}});
     return json{{"scene", id},       {"clip", clip},           {"fps", fps},
                 {"times", times},    {"placements", placements}, {"flags", flags}};
+}
+
+Result<json> Service::lint(const std::string& id) {
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    std::vector<std::string> unused;
+    {
+        std::shared_lock<std::shared_mutex> lock(state_->mutex);
+        std::set<std::string> used;
+        for (const auto& [sid, e] : state_->scenes) {
+            for (const Placement& p : state_->resolved(e.scene).placements) used.insert(p.pattern);
+            if (e.scene.heightmapBase) used.insert(*e.scene.heightmapBase);
+            for (const auto& [alias, target] : e.scene.patterns) used.insert(target);
+        }
+        for (const auto& [pid, e] : state_->patterns)
+            if (!e.builtin && !used.count(pid)) unused.push_back(pid);
+    }
+    const UvLookup lookup(*snap->model);
+    json out = json::array();
+    for (const LintFinding& f : lintScene(snap->scene, *snap->model, lookup, snap->images))
+        out.push_back({{"code", f.code},
+                       {"severity", std::string(toString(f.severity))},
+                       {"placement", f.placement >= 0
+                                         ? json(snap->scene.placements[static_cast<std::size_t>(f.placement)].id)
+                                         : json()},
+                       {"message", f.message}});
+    for (const std::string& pid : unused)
+        out.push_back({{"code", "unused_upload"},
+                       {"severity", "info"},
+                       {"placement", nullptr},
+                       {"message", "uploaded pattern " + pid + " is used by no scene"}});
+    return out;
 }
 
 } // namespace dermis

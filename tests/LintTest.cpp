@@ -1,0 +1,142 @@
+// LintTest — the UV → surface lookup and the scene lint of SPEC §6, on the default character and
+// purpose-built scenes: a footprint hanging off a UV chart, two overlapping footprints on one
+// target, a θ range no clip reaches, a driver joint with no influence under the footprint; the
+// default elbow crease gets none of these. No GL, no HTTP.
+#include "core/lint.hpp"
+#include "io/scene_files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace dermis;
+
+namespace {
+
+const std::string kScene = std::string(DERMIS_SOURCE_DIR) + "/models/default.scene.json";
+
+class LintTest : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        auto l = loadSceneFile(kScene);
+        ASSERT_TRUE(l) << l.error().message;
+        loaded_ = new LoadedScene(std::move(*l));
+        lookup_ = new UvLookup(loaded_->model);
+    }
+    static void TearDownTestSuite() {
+        delete lookup_;
+        delete loaded_;
+    }
+    void SetUp() override { ASSERT_NE(loaded_, nullptr); }
+
+    static const Placement& elbow() {
+        for (const Placement& p : loaded_->scene.placements)
+            if (p.id == "elbow_l") return p;
+        throw std::runtime_error("no elbow_l in the default scene");
+    }
+    /// Lint of a scene holding only `placements`.
+    static std::vector<LintFinding> lint(const std::vector<Placement>& placements) {
+        Scene s = loaded_->scene;
+        s.placements = placements;
+        return lintScene(s, loaded_->model, *lookup_, loaded_->images);
+    }
+    static bool has(const std::vector<LintFinding>& f, const std::string& code, int placement) {
+        for (const LintFinding& x : f)
+            if (x.code == code && x.placement == placement) return true;
+        return false;
+    }
+    static inline LoadedScene* loaded_ = nullptr;
+    static inline UvLookup* lookup_ = nullptr;
+};
+
+TEST_F(LintTest, LookupFindsTrianglesPositionsWeightsAndCharts) {
+    const Model& m = loaded_->model;
+    EXPECT_GT(lookup_->chartCount(), 4);
+    int checked = 0;
+    for (std::size_t pi = 0; pi < m.parts.size(); ++pi) {
+        const MeshPart& p = m.parts[pi];
+        for (std::size_t t = 0; t < p.indices.size() / 3; t += 97) {
+            glm::dvec2 c(0.0);
+            glm::vec3 pos(0.0f);
+            for (int k = 0; k < 3; ++k) {
+                c += glm::dvec2(p.uvs[p.indices[3 * t + k]]) / 3.0;
+                pos += p.positions[p.indices[3 * t + k]] / 3.0f;
+            }
+            const auto hit = lookup_->find(c);
+            ASSERT_TRUE(hit) << "triangle " << t;
+            EXPECT_EQ(hit->part, static_cast<int>(pi));
+            EXPECT_EQ(hit->triangle, static_cast<int>(t)); // the atlas has no overlaps
+            EXPECT_NEAR(hit->bary.x, 1.0f / 3, 1e-4f);
+            EXPECT_LT(glm::length(lookup_->position(*hit) - pos), 1e-5f);
+            float sum = 0.0f;
+            for (int joint : m.joints) sum += lookup_->weightOf(*hit, joint);
+            EXPECT_NEAR(sum, 1.0f, 1e-4f);
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 20);
+    EXPECT_FALSE(lookup_->find({-0.1, 0.5}));
+    EXPECT_FALSE(lookup_->find({0.5, 1.5}));
+    EXPECT_FALSE(lookup_->find({NAN, 0.5}));
+}
+
+TEST_F(LintTest, TheDefaultElbowCreaseIsClean) {
+    const auto f = lint({elbow()});
+    for (const LintFinding& x : f) ADD_FAILURE() << x.code << ": " << x.message;
+}
+
+TEST_F(LintTest, FindsEachPurposeBuiltProblem) {
+    // Off a chart: slide the crease towards empty atlas space; lint says off_chart exactly when
+    // a sample where the pattern is not flat lands outside every chart.
+    const HeightImage& crease = loaded_->images.at(elbow().pattern)->pixels;
+    Placement off = elbow();
+    off.id = "off";
+    int hanging = 0;
+    for (int k = 0; k < 60; ++k) {
+        off.center[0] = elbow().center[0] + 0.004 * k;
+        Footprint fp;
+        fp.center = {off.center[0], off.center[1]};
+        fp.scale = {off.scale[0], off.scale[1]};
+        bool expected = false;
+        for (int j = 0; j < 12; ++j)
+            for (int i = 0; i < 12; ++i) {
+                const glm::dvec2 st((i + 0.5) / 12, (j + 0.5) / 12);
+                if (std::abs(sampleBilinear(crease, st.x, st.y)) > 0.02f && !lookup_->find(fp.toUV(st)))
+                    expected = true;
+            }
+        EXPECT_EQ(has(lint({off}), "off_chart", 0), expected) << "shifted by " << 0.004 * k;
+        hanging += expected;
+    }
+    EXPECT_GT(hanging, 0) << "the crease never hung off its chart";
+
+    // Two footprints overlapping on the bump map (a third on displacement overlaps nothing).
+    Placement twin = elbow(), other = elbow();
+    twin.id = "twin";
+    twin.center[0] += 0.01;
+    other.id = "other";
+    other.target = Target::Displacement;
+    const auto overlap = lint({elbow(), twin, other});
+    EXPECT_TRUE(has(overlap, "overlap", 0));
+    EXPECT_FALSE(has(overlap, "overlap", 1)) << "each pair is reported once";
+    for (const LintFinding& x : overlap)
+        if (x.code == "overlap") EXPECT_EQ(x.message.find("other"), std::string::npos) << x.message;
+
+    // A θ range no clip reaches.
+    Placement far = elbow();
+    far.id = "far";
+    far.thetaMin = 170;
+    far.thetaMax = 179;
+    EXPECT_TRUE(has(lint({far}), "unreachable_range", 0));
+
+    // A driver joint with no skin weight under the footprint.
+    Placement knee = elbow();
+    knee.id = "knee_driven";
+    knee.joint = "shin.l";
+    EXPECT_TRUE(has(lint({knee}), "no_influence", 0));
+
+    // Disabled placements are not linted.
+    far.enabled = false;
+    EXPECT_TRUE(lint({far}).empty());
+}
+
+} // namespace
