@@ -94,4 +94,33 @@ TEST_F(InspectHttpTest, LintFindsOverlapsAndUnusedUploads) {
     ASSERT_EQ(h.del(s).status, 204);
 }
 
+TEST_F(InspectHttpTest, PickHitsTheCharacterAndMissesTheBackground) {
+    Http h = http();
+    const std::string id = createScene(smallScene());
+    const std::string s = "/scenes/" + id;
+    Reply bg = h.get(s + "/pick?x=1&y=1&width=128&height=128");
+    ASSERT_EQ(bg.status, 200) << bg;
+    EXPECT_EQ(bg.js()["hit"], false);
+    Reply body = h.get(s + "/pick?x=64&y=50&width=128&height=128");
+    ASSERT_EQ(body.status, 200) << body;
+    const json p = body.js();
+    ASSERT_EQ(p["hit"], true) << p;
+    EXPECT_EQ(p["uv"].size(), 2u);
+    EXPECT_EQ(p["position"].size(), 3u);
+    ASSERT_FALSE(p["joints"].empty());
+    EXPECT_LE(p["joints"].size(), 4u);
+    double sum = 0;
+    for (const json& j : p["joints"]) sum += j["weight"].get<double>();
+    EXPECT_LE(sum, 1.0001);
+    EXPECT_FALSE(p["suggested"]["joint"].get<std::string>().empty());
+    EXPECT_NE(p["suggested"]["theta_min"], p["suggested"]["theta_max"]);
+
+    expectError(h.get(s + "/pick?x=128&y=5&width=128&height=128"), 422, "x");
+    expectError(h.get(s + "/pick?x=5&y=-1&width=128&height=128"), 422, "y");
+    expectError(h.get(s + "/pick?x=5&y=5&width=0&height=128"), 422, "width");
+    expectError(h.get(s + "/pick?y=5"), 422, "x");
+    expectError(h.get(s + "/pick?x=5&y=5&pitch=200"), 422, "pitch");
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
 } // namespace

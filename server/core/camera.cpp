@@ -85,4 +85,11 @@ Ray pixelRay(const FrameCamera& camera, glm::dvec2 pixel) {
     return {origin, glm::normalize(glm::dvec3(far) / far.w - origin)};
 }
 
+double autoDisplacementScale(const Model& model) {
+    const Bounds b = framingBounds(skin(model, worldMatrices(model, restPose(model))));
+    const glm::vec3 ext = b.max - b.min;
+    const double m = std::max({ext.x, ext.y, ext.z});
+    return m > 0.0 && std::isfinite(m) ? 0.01 * m : 0.01;
+}
+
 } // namespace dermis

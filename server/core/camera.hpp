@@ -43,6 +43,11 @@ struct Bounds {
 /// finite vertex give the cube [−1, 1]³, so that an empty model still gets a camera.
 Bounds framingBounds(const std::vector<SkinnedPart>& parts);
 
+/// The displacement scale "auto" resolves to: 1% of the largest extent of the rest-pose bounds
+/// (a bulge of L·h = 1 rises 1% of the character's height). Bump mapping uses 0.25 × this ×
+/// bump_strength as the height of a bump-map unit.
+double autoDisplacementScale(const Model& model);
+
 /// One frame's camera (see the header comment for the conventions).
 struct FrameCamera {
     glm::mat4 view{1.0f};                 ///< world → eye (glm::lookAt)

@@ -13,13 +13,6 @@ namespace dermis {
 
 using namespace gl;
 
-double autoDisplacementScale(const Model& model) {
-    const Bounds b = framingBounds(skin(model, worldMatrices(model, restPose(model))));
-    const glm::vec3 ext = b.max - b.min;
-    const double m = std::max({ext.x, ext.y, ext.z});
-    return m > 0.0 && std::isfinite(m) ? 0.01 * m : 0.01;
-}
-
 GLuint GpuModel::baseColorTexture(const Model& model, const Part& part) const {
     if (part.material < 0 || static_cast<std::size_t>(part.material) >= model.materials.size())
         return 0;

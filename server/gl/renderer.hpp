@@ -26,6 +26,7 @@
 #pragma once
 
 #include "core/bake.hpp"
+#include "core/camera.hpp"
 #include "core/frame_plan.hpp"
 #include "core/heightmap.hpp"
 #include "core/model.hpp"
@@ -149,9 +150,5 @@ private:
 /// The request points into the plan's images: keep `plan` alive while the request is used.
 FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> model);
 
-/// The displacement scale "auto" resolves to: 1% of the largest extent of the rest-pose bounds
-/// (a bulge of L·h = 1 rises 1% of the character's height). Bump mapping uses 0.25 × this ×
-/// bump_strength as the height of a bump-map unit.
-double autoDisplacementScale(const Model& model);
 
 } // namespace dermis

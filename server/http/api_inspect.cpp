@@ -5,6 +5,21 @@
 namespace dermis::api_detail {
 
 void installInspectRoutes(RouteTable& t) {
+    t.add("GET", "/scenes/{id}/pick", [](Api::Impl& a, const Req& req, Res& res) {
+        FrameParams p;
+        std::optional<double> x, y;
+        if (!numberParam(req, res, "x", x) || !numberParam(req, res, "y", y) ||
+            !intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
+            !numberParam(req, res, "yaw", p.yaw) || !numberParam(req, res, "pitch", p.pitch) ||
+            !numberParam(req, res, "distance", p.distance) || !numberParam(req, res, "time", p.time))
+            return;
+        if (!x || !y)
+            return sendError(res, 422, "invalid_argument", "dermis::Api: x and y are required",
+                             !x ? "x" : "y");
+        auto r = a.svc.pick(req.matches[1], p, *x, *y);
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
     t.add("GET", "/scenes/{id}/probe", [](Api::Impl& a, const Req& req, Res& res) {
         std::optional<double> u, v, time;
         if (!numberParam(req, res, "u", u) || !numberParam(req, res, "v", v) ||

@@ -213,6 +213,11 @@ public:
     Result<nlohmann::json> listPresence(const std::string& id);
 
     // --- inspection (CPU only; service_inspect.cpp)
+    /// Pixel (x, y) of the frame `params` render (SPEC §6 Pick; format/msaa ignored) → {hit:
+    /// false} or {hit: true, uv, position, part, triangle, joints: [{name, weight}] (top 4),
+    /// suggested: {joint, axis, theta_min, theta_max}} (core pickFrame, suggestDriver). Fails
+    /// on a pixel outside the frame (field "x"/"y") and like frame() on bad parameters.
+    Result<nlohmann::json> pick(const std::string& id, const FrameParams& params, double x, double y);
     /// Why a texel has its height (SPEC §6 Probe): {u, v, texel: [x, y], map_size, base, bump,
     /// displacement, contributions: [{placement, pattern, target, t, L, height}]} at the texel of
     /// the scene's maps containing (u, v), at `time` (default the scene's pose time). Fails on u

@@ -1,10 +1,12 @@
-// Inspection of a stored scene, CPU only (SPEC §6): probe — why a texel has its height —,
+// Inspection of a stored scene, CPU only (SPEC §6): pick — frame pixel to skin —, probe — why a
+// texel has its height —,
 // activation — each placement's t over a clip, with flags — and lint. All run on a snapshot,
 // unlocked.
 #include "service/service_state.hpp"
 
 #include "core/activation.hpp"
 #include "core/lint.hpp"
+#include "core/pick.hpp"
 #include "core/probe.hpp"
 
 #include <cmath>
@@ -108,6 +110,30 @@ Result<json> Service::lint(const std::string& id) {
                        {"placement", nullptr},
                        {"message", "uploaded pattern " + pid + " is used by no scene"}});
     return out;
+}
+
+Result<json> Service::pick(const std::string& id, const FrameParams& params, double x, double y) {
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    auto plan = state_->plan(*snap, params);
+    if (!plan) return plan.error();
+    auto hit = pickFrame(*plan, *snap->model, x, y);
+    if (!hit) return hit.error();
+    if (!*hit) return json{{"hit", false}};
+    const Model& m = *snap->model;
+    json joints = json::array();
+    for (auto [node, weight] : (*hit)->joints)
+        joints.push_back({{"name", m.nodes[static_cast<std::size_t>(node)].name}, {"weight", weight}});
+    const SuggestedDriver d = suggestDriver(m, (*hit)->joints);
+    const PickHit& h = **hit;
+    return json{{"hit", true},
+                {"uv", {h.uv.x, h.uv.y}},
+                {"position", {h.position.x, h.position.y, h.position.z}},
+                {"part", h.part},
+                {"triangle", h.triangle},
+                {"joints", std::move(joints)},
+                {"suggested", {{"joint", d.joint}, {"axis", d.axis}, {"theta_min", d.thetaMin},
+                               {"theta_max", d.thetaMax}}}};
 }
 
 } // namespace dermis

@@ -12,7 +12,7 @@ namespace dermis {
 
 using namespace detail;
 
-Result<EncodedImage> Service::State::render(const Snapshot& snap, const FrameParams& p) {
+Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& p) const {
     FrameOverrides o;
     o.width = p.width;
     o.height = p.height;
@@ -23,7 +23,13 @@ Result<EncodedImage> Service::State::render(const Snapshot& snap, const FramePar
     o.time = p.time;
     RenderLimits rl;
     rl.maxSide = limits.maxRenderSide;
-    auto plan = planFrame(snap.scene, *snap.model, snap.images, snap.base, o, rl);
+    auto planned = planFrame(snap.scene, *snap.model, snap.images, snap.base, o, rl);
+    if (!planned) return detail::asParamError(planned.error(), p);
+    return planned;
+}
+
+Result<EncodedImage> Service::State::render(const Snapshot& snap, const FrameParams& p) {
+    auto plan = this->plan(snap, p);
     if (!plan) return plan.error();
     auto result = renderer->renderFrame(frameRequest(*plan, snap.model));
     if (!result) return result.error();
@@ -36,7 +42,7 @@ Result<EncodedImage> Service::State::render(const Snapshot& snap, const FramePar
     return out;
 }
 
-namespace {
+namespace detail {
 
 /// A frame's query parameters name the render settings they override: an error in an overridden
 /// setting names the parameter ("width"), not the document field ("/render/size/0").
@@ -60,7 +66,7 @@ Error asParamError(Error e, const FrameParams& p) {
     return e;
 }
 
-} // namespace
+} // namespace detail
 
 Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p) {
     if (p.format != "png" && p.format != "jpeg") return bad("format", "must be png or jpeg");

@@ -73,6 +73,10 @@ double nowSeconds();
 /// [A-Za-z0-9_. -] only, at most 64 characters.
 std::string sanitizeName(const std::string& name);
 
+/// An error in a render setting a frame parameter overrode names the parameter ("width"), not
+/// the document field ("/render/size/0").
+Error asParamError(Error e, const FrameParams& p);
+
 /// Counts renders waiting for or using the renderer; refuses beyond the queue length.
 class QueueSlot {
 public:
@@ -151,6 +155,8 @@ struct Service::State {
     /// Caller holds presenceMutex.
     json livePresence(const std::string& sceneId);
 
+    /// The frame plan of `snap` with `p`'s overrides (errors name the parameters).
+    Result<FramePlan> plan(const Snapshot& snap, const FrameParams& p) const;
     /// Plans and renders one frame of `snap` with `p`'s overrides; encodes it.
     Result<EncodedImage> render(const Snapshot& snap, const FrameParams& p);
 

@@ -1,0 +1,47 @@
+// Dermis core — from a pixel of a frame to the skin (SPEC §6 Pick): an exact CPU ray cast against
+// the posed (skinned) mesh of the frame a plan describes, with the same camera the renderer uses
+// (core/camera), and a suggested driver for a pattern placed there.
+//
+// The ray meets the skinned triangles, not the displaced surface: where displacement is large
+// (a few % of the body), a pixel on a silhouette edge may hit or miss differently than the frame
+// shows. Pure; O(triangles) per pick (no acceleration structure: the default character takes a
+// fraction of a millisecond).
+#pragma once
+
+#include "frame_plan.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace dermis {
+
+struct PickHit {
+    int part = -1, triangle = -1;
+    glm::vec3 bary{0.0f};         ///< barycentric weights of the triangle's corners
+    glm::vec2 uv{0.0f};           ///< TEXCOORD_0 there (0, 0 for a part without UVs)
+    glm::vec3 position{0.0f};     ///< world position on the posed mesh
+    double distance = 0.0;        ///< from the eye
+    /// The (at most 4) largest skin weights there: node index, weight; largest first.
+    std::vector<std::pair<int, float>> joints;
+};
+
+/// The nearest posed triangle under pixel (x, y) (pixel coordinates of core/camera: the centre
+/// of pixel (col, row) is (col + 0.5, row + 0.5)) of the frame `plan` renders; nullopt on the
+/// background. Fails (InvalidArgument, field "x"/"y") when the pixel is outside the frame.
+Result<std::optional<PickHit>> pickFrame(const FramePlan& plan, const Model& model, double x, double y);
+
+struct SuggestedDriver {
+    std::string joint;
+    std::string axis = "x"; ///< "x", "y" or "z" (the joint's rest frame)
+    double thetaMin = 0.0, thetaMax = 90.0;
+};
+
+/// A driver for a pattern on the skin held by `joints` (node, weight): of the weighted joints
+/// (each the child of the pair it forms with its parent joint), the one and axis whose angle
+/// moves most over the model's clips, weighted by its skin weight; θ from the angle nearest the
+/// rest pose (0 when the motion passes through it) to the far end of the motion, rounded to
+/// 0.5°. Without clips: the most weighted joint, x, 0–90. Empty joint name when `joints` is.
+SuggestedDriver suggestDriver(const Model& model, const std::vector<std::pair<int, float>>& joints);
+
+} // namespace dermis
