@@ -9,7 +9,8 @@
 //    read from disk), revisions_page (GET /revisions?limit=50, newest and from the middle);
 //  * edit (PATCH a placement with If-Match), revert (POST /revert to an old revision);
 //  * probe (GET /probe at the elbow crease), activation (GET /activation of elbow_curl at 30 fps),
-//    lint of the default pattern set (18 placements, 7 clips), pick of a 512² frame's pixel;
+//    lint of the default pattern set (18 placements, 7 clips), pick of a 512² frame's pixel,
+//    mirror of the left elbow crease (a new twin each time);
 //  * reopen_ms: Service::open of the data folder with that history.
 #include "http/api.hpp"
 #include "service/service.hpp"
@@ -157,6 +158,10 @@ int main(int argc, char** argv) {
     measure("lint_default_scene", [&](int) { return ok(c.Get(fullBase + "/lint")); });
     measure("pick_512", [&](int r) {
         return ok(c.Get(fullBase + "/pick?width=512&height=512&x=" + std::to_string(200 + r % 100) + "&y=200"));
+    });
+    measure("mirror_placement", [&](int) {
+        auto res = c.Post(fullBase + "/placements/elbow_l/mirror", "", "application/json");
+        return res && res->status == 201;
     });
     std::uint64_t current = static_cast<std::uint64_t>(revisions);
     measure("edit_if_match", [&](int r) {

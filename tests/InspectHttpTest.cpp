@@ -3,6 +3,7 @@
 // activation of the scene's clip lists every placement; bad parameters are clear 4xx errors.
 #include "HttpTestFixture.hpp"
 
+#include <cmath>
 #include <cstring>
 
 using namespace dermis;
@@ -120,6 +121,45 @@ TEST_F(InspectHttpTest, PickHitsTheCharacterAndMissesTheBackground) {
     expectError(h.get(s + "/pick?x=5&y=5&width=0&height=128"), 422, "width");
     expectError(h.get(s + "/pick?y=5"), 422, "x");
     expectError(h.get(s + "/pick?x=5&y=5&pitch=200"), 422, "pitch");
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
+TEST_F(InspectHttpTest, MirrorAddsTheTwinOnTheOtherSide) {
+    Http h = http();
+    Reply created = h.post("/scenes", {{"default_patterns", true}});
+    ASSERT_EQ(created.status, 201) << created;
+    const std::string s = "/scenes/" + created.js()["id"].get<std::string>();
+    json right;
+    const json doc = created.js(); // js() parses a fresh value: keep it alive while iterating
+    for (const json& p : doc["scene"]["placements"])
+        if (p["id"] == "elbow_r") right = p;
+    ASSERT_TRUE(right.is_object());
+    ASSERT_EQ(h.del(s + "/placements/elbow_r").status, 200);
+
+    httplib::Headers stale{{"If-Match", "\"r1\""}};
+    expectError(h.call("POST", s + "/placements/elbow_l/mirror", "", "", stale), 412, "If-Match");
+    Reply m = h.call("POST", s + "/placements/elbow_l/mirror", "", "", {{"X-Dermis-Client", "ana"}});
+    ASSERT_EQ(m.status, 201) << m;
+    EXPECT_EQ(m.header("ETag"), "\"r3\"");
+    json twin;
+    const json mirrored = m.js();
+    for (const json& p : mirrored["scene"]["placements"])
+        if (p["id"] == "elbow_r") twin = p;
+    ASSERT_TRUE(twin.is_object()) << m;
+    EXPECT_EQ(twin["joint"], "forearm.r");
+    EXPECT_EQ(twin["pattern"], "crease");
+    const double du = (twin["center"][0].get<double>() - right["center"][0].get<double>()) * 1024;
+    const double dv = (twin["center"][1].get<double>() - right["center"][1].get<double>()) * 1024;
+    EXPECT_LE(std::hypot(du, dv), 2.0) << twin;
+    Reply again = h.call("POST", s + "/placements/elbow_l/mirror", "", "", {});
+    ASSERT_EQ(again.status, 201) << again;
+    EXPECT_EQ(again.js()["scene"]["placements"].back()["id"], "elbow_r_2");
+    EXPECT_EQ(h.get(s + "/revisions?limit=1").js()["revisions"][0]["op"], "mirror placement elbow_l");
+
+    // A footprint centre on no UV chart cannot be mirrored; an unknown placement is 404.
+    ASSERT_EQ(h.patch(s + "/placements/stomach", {{"center", {0.995, 0.995}}, {"scale", {0.005, 0.005}}}).status, 200);
+    expectError(h.call("POST", s + "/placements/stomach/mirror", "", "", {}), 422, "center");
+    expectError(h.call("POST", s + "/placements/nope/mirror", "", "", {}), 404, "pid");
     ASSERT_EQ(h.del(s).status, 204);
 }
 

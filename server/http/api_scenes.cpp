@@ -102,6 +102,14 @@ void installPlacementRoutes(RouteTable& t) {
         setEtag(res, *r);
         sendJson(res, 200, *r);
     });
+    t.add("POST", "/scenes/{id}/placements/{pid}/mirror", [](Api::Impl& a, const Req& req, Res& res) {
+        EditContext ctx;
+        if (!editContext(req, res, ctx)) return;
+        auto r = a.svc.mirrorPlacement(req.matches[1], req.matches[2], ctx);
+        if (!r) return sendDocError(res, r.error());
+        setEtag(res, *r);
+        sendJson(res, 201, *r);
+    });
     t.add("PUT", "/scenes/{id}/pose",
           jsonEdit(200, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {
               return s.putPose(req.matches[1], body, ctx);

@@ -183,6 +183,11 @@ public:
                                           const nlohmann::json& patch, const EditContext& ctx = {});
     Result<nlohmann::json> deletePlacement(const std::string& id, const std::string& pid,
                                            const EditContext& ctx = {});
+    /// Adds the mirror twin of placement `pid` (SPEC §6 Mirror; core mirrorPlacement): id with its
+    /// side swapped (elbow_l → elbow_r) or "<pid>_mirror", made unique. Fails (InvalidArgument)
+    /// when the footprint centre is on no chart or the joint has no twin by name or position.
+    Result<nlohmann::json> mirrorPlacement(const std::string& id, const std::string& pid,
+                                           const EditContext& ctx = {});
     /// `order`: every placement id once, in the new order.
     Result<nlohmann::json> reorderPlacements(const std::string& id, const nlohmann::json& order,
                                              const EditContext& ctx = {});

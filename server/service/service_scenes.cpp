@@ -1,6 +1,8 @@
 // Scene documents and their edits: create, replace, delete; placements; pose.
 #include "service/service_state.hpp"
 
+#include "core/mirror.hpp"
+
 #include <set>
 
 namespace dermis {
@@ -191,6 +193,42 @@ Result<json> Service::deletePlacement(const std::string& id, const std::string& 
         const int k = placementIndex(doc, pid);
         if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
         doc["placements"].erase(static_cast<std::size_t>(k));
+        return Ok{};
+    });
+}
+
+Result<json> Service::mirrorPlacement(const std::string& id, const std::string& pid,
+                                      const EditContext& ctx) {
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    const Placement* source = nullptr;
+    for (const Placement& p : snap->scene.placements)
+        if (p.id == pid) source = &p;
+    if (!source) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
+    const Model& model = *snap->model;
+    const UvLookup lookup(model);
+    auto twin = dermis::mirrorPlacement(*source, model, lookup, symmetryPlane(model));
+    if (!twin) {
+        Error e = twin.error();
+        e.code = ErrorCode::InvalidArgument; // the placement cannot be mirrored: 422
+        return e;
+    }
+    // The twin's id: the source's with its side swapped (elbow_l → elbow_r), else "<pid>_mirror".
+    std::string base = pid + "_mirror";
+    for (auto [from, to] : {std::pair{"_l", "_r"}, std::pair{"_r", "_l"}, std::pair{"_L", "_R"},
+                            std::pair{"_R", "_L"}, std::pair{".l", ".r"}, std::pair{".r", ".l"}})
+        if (pid.size() > 2 && pid.compare(pid.size() - 2, 2, from) == 0) base = pid.substr(0, pid.size() - 2) + to;
+    EditInfo info{"placement_added", "mirror placement " + pid, ""};
+    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+        std::string newId = base;
+        for (int k = 2; placementIndex(doc, newId) >= 0; ++k) newId = base + "_" + std::to_string(k);
+        info.placement = newId;
+        // toJson of a one-placement scene gives the placement's canonical form.
+        Scene one;
+        one.placements.push_back(*twin);
+        one.placements[0].id = newId;
+        one.placements[0].pattern = doc["placements"][static_cast<std::size_t>(placementIndex(doc, pid))]["pattern"];
+        doc["placements"].push_back(dermis::toJson(one)["placements"][0]);
         return Ok{};
     });
 }

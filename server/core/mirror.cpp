@@ -1,0 +1,271 @@
+// Mirror twins of placements. See mirror.hpp.
+#include "mirror.hpp"
+
+#include "camera.hpp"
+
+#include <glm/gtc/matrix_access.hpp>
+#include <glm/gtc/quaternion.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace dermis {
+
+namespace {
+
+/// The largest footprint side a scene accepts (scene_parse.cpp's limit).
+constexpr double kMaxPlacementScaleForMirror = 16.0;
+
+std::vector<SkinnedPart> restWorld(const Model& m) {
+    return skin(m, worldMatrices(m, restPose(m)));
+}
+
+glm::vec3 reflect(glm::vec3 p, const SymmetryPlane& s) {
+    p[s.axis] = 2.0f * s.offset - p[s.axis];
+    return p;
+}
+
+/// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5), with
+/// its barycentric weights.
+glm::dvec3 closestBary(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+    const glm::dvec3 bp = p - b;
+    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        const double v = d1 / (d1 - d3);
+        return {1 - v, v, 0};
+    }
+    const glm::dvec3 cp = p - c;
+    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        const double w = d2 / (d2 - d6);
+        return {1 - w, 0, w};
+    }
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return {0, 1 - w, w};
+    }
+    const double denom = 1.0 / (va + vb + vc);
+    const double v = vb * denom, w = vc * denom;
+    return {1 - v - w, v, w};
+}
+
+/// UV of the rest-mesh point nearest to world point q (parts with UVs only).
+std::optional<glm::dvec2> nearestUv(const Model& m, const std::vector<SkinnedPart>& rest, glm::vec3 q) {
+    double best = std::numeric_limits<double>::max();
+    std::optional<glm::dvec2> uv;
+    for (std::size_t pi = 0; pi < m.parts.size() && pi < rest.size(); ++pi) {
+        const MeshPart& p = m.parts[pi];
+        if (p.uvs.empty()) continue;
+        const auto& pos = rest[pi].positions;
+        for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+            const std::uint32_t i[3] = {p.indices[t], p.indices[t + 1], p.indices[t + 2]};
+            if (i[0] >= pos.size() || i[1] >= pos.size() || i[2] >= pos.size() ||
+                i[0] >= p.uvs.size() || i[1] >= p.uvs.size() || i[2] >= p.uvs.size())
+                continue;
+            const glm::dvec3 b = closestBary(glm::dvec3(q), glm::dvec3(pos[i[0]]), glm::dvec3(pos[i[1]]),
+                                             glm::dvec3(pos[i[2]]));
+            const glm::dvec3 c = b.x * glm::dvec3(pos[i[0]]) + b.y * glm::dvec3(pos[i[1]]) + b.z * glm::dvec3(pos[i[2]]);
+            const double d = glm::length(c - glm::dvec3(q));
+            if (d < best) {
+                best = d;
+                uv = b.x * glm::dvec2(p.uvs[i[0]]) + b.y * glm::dvec2(p.uvs[i[1]]) + b.z * glm::dvec2(p.uvs[i[2]]);
+            }
+        }
+    }
+    return uv;
+}
+
+/// Rest-world position of the surface at a UV point.
+std::optional<glm::vec3> surfaceAt(const Model& m, const std::vector<SkinnedPart>& rest,
+                                   const UvLookup& lookup, glm::dvec2 uv) {
+    const auto hit = lookup.find(uv);
+    if (!hit) return std::nullopt;
+    const MeshPart& p = m.parts[static_cast<std::size_t>(hit->part)];
+    const auto& pos = rest[static_cast<std::size_t>(hit->part)].positions;
+    glm::vec3 out(0.0f);
+    for (int k = 0; k < 3; ++k) out += hit->bary[k] * pos[p.indices[3 * static_cast<std::size_t>(hit->triangle) + k]];
+    return out;
+}
+
+std::string lower(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+} // namespace
+
+SymmetryPlane symmetryPlane(const Model& model) {
+    const auto rest = restWorld(model);
+    std::vector<glm::vec3> all;
+    for (const auto& p : rest) all.insert(all.end(), p.positions.begin(), p.positions.end());
+    SymmetryPlane best;
+    if (all.empty()) return best;
+    const Bounds b = framingBounds(rest);
+    const glm::vec3 centre = 0.5f * (b.min + b.max);
+    const std::size_t stride = std::max<std::size_t>(1, all.size() / 150);
+    best.error = std::numeric_limits<float>::max();
+    for (int axis = 0; axis < 3; ++axis) {
+        SymmetryPlane s{axis, centre[axis], 0.0f};
+        double sum = 0.0;
+        std::size_t n = 0;
+        for (std::size_t k = 0; k < all.size(); k += stride, ++n) {
+            const glm::vec3 q = reflect(all[k], s);
+            float d = std::numeric_limits<float>::max();
+            for (const glm::vec3& v : all) d = std::min(d, glm::length(v - q));
+            sum += d;
+        }
+        s.error = static_cast<float>(sum / static_cast<double>(std::max<std::size_t>(n, 1)));
+        if (s.error < best.error) best = s;
+    }
+    return best;
+}
+
+std::string mirrorJointName(const Model& model, const std::string& joint) {
+    static const std::pair<const char*, const char*> kSuffixes[] = {{"_l", "_r"}, {".l", ".r"}, {"left", "right"}};
+    static const std::pair<const char*, const char*> kPrefixes[] = {{"l_", "r_"}, {"left", "right"}};
+    const std::string lj = lower(joint);
+    auto tryName = [&](const std::string& candidate) -> std::string {
+        const std::string lc = lower(candidate);
+        for (int n : model.joints)
+            if (lower(model.nodes[static_cast<std::size_t>(n)].name) == lc && lc != lj)
+                return model.nodes[static_cast<std::size_t>(n)].name;
+        return "";
+    };
+    for (auto [a, b] : kSuffixes)
+        for (auto [from, to] : {std::pair{a, b}, std::pair{b, a}}) {
+            const std::size_t len = std::strlen(from);
+            if (lj.size() > len && lj.compare(lj.size() - len, len, from) == 0)
+                if (auto n = tryName(joint.substr(0, joint.size() - len) + to); !n.empty()) return n;
+        }
+    for (auto [a, b] : kPrefixes)
+        for (auto [from, to] : {std::pair{a, b}, std::pair{b, a}}) {
+            const std::size_t len = std::strlen(from);
+            if (lj.size() > len && lj.compare(0, len, from) == 0)
+                if (auto n = tryName(to + joint.substr(len)); !n.empty()) return n;
+        }
+    // Left/Right or _L_/_R_ anywhere in the name (mixamorig:LeftArm, leg_joint_L_1).
+    for (auto [from, to] : {std::pair{"left", "right"}, std::pair{"right", "left"},
+                            std::pair{"_l_", "_r_"}, std::pair{"_r_", "_l_"}})
+        if (auto at = lj.find(from); at != std::string::npos)
+            if (auto n = tryName(joint.substr(0, at) + to + joint.substr(at + std::strlen(from))); !n.empty())
+                return n;
+    return "";
+}
+
+namespace {
+
+/// Rest world rotation in double: the world matrices' rotation parts with scale removed
+/// (Gram–Schmidt, so that a slightly skewed float matrix still gives a rotation).
+glm::dquat restWorldRotationD(const Model& model, int n) {
+    const auto world = worldMatrices(model, restPose(model));
+    glm::dmat3 m(glm::dmat4(world[static_cast<std::size_t>(n)]));
+    m[0] = glm::normalize(m[0]);
+    m[1] = glm::normalize(m[1] - glm::dot(m[1], m[0]) * m[0]);
+    m[2] = glm::cross(m[0], m[1]) * (glm::dot(glm::cross(m[0], m[1]), m[2]) < 0 ? -1.0 : 1.0);
+    return glm::normalize(glm::quat_cast(m));
+}
+
+glm::dmat3 reflectionD(int axis) {
+    glm::dmat3 r(1.0);
+    r[axis][axis] = -1.0;
+    return r;
+}
+
+} // namespace
+
+glm::quat restWorldRotation(const Model& model, int n) {
+    return glm::quat(restWorldRotationD(model, n));
+}
+
+glm::quat mirrorDelta(const glm::quat& qj, const glm::quat& qt, const glm::quat& delta, int axis) {
+    const glm::dmat3 r = reflectionD(axis);
+    const glm::dquat dj(qj), dt(qt), dd(delta);
+    const glm::dmat3 worldDelta = glm::mat3_cast(dj * dd * glm::inverse(dj));
+    const glm::dmat3 mirrored = r * worldDelta * r;
+    return glm::quat(glm::normalize(glm::inverse(dt) * glm::quat_cast(mirrored) * dt));
+}
+
+glm::vec3 mirrorAxis(const Model& model, int j, int t, const glm::vec3& axis, int planeAxis) {
+    const glm::dvec3 world = restWorldRotationD(model, j) * glm::dvec3(axis);
+    const glm::dvec3 mirrored = -(reflectionD(planeAxis) * world);
+    return glm::vec3(glm::normalize(glm::inverse(restWorldRotationD(model, t)) * mirrored));
+}
+
+Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
+                                  const SymmetryPlane& plane) {
+    const char* where = "dermis::mirrorPlacement";
+    if (!model.hasUVs()) return makeError(ErrorCode::Unsupported, where, "/uvs", "the model has no UVs");
+    const auto rest = restWorld(model);
+    Footprint fp;
+    fp.center = {p.center[0], p.center[1]};
+    fp.scale = {p.scale[0], p.scale[1]};
+    fp.rotationDeg = p.rotation;
+    auto mapUv = [&](glm::dvec2 uv) -> std::optional<glm::dvec2> {
+        const auto s = surfaceAt(model, rest, lookup, uv);
+        if (!s) return std::nullopt;
+        return nearestUv(model, rest, reflect(*s, plane));
+    };
+    const auto centre = mapUv(fp.center);
+    if (!centre) return makeError(ErrorCode::NotFound, where, "center", "the footprint centre lies on no UV chart");
+    Placement out = p;
+    out.id.clear();
+    out.center = {centre->x, centre->y};
+    // The footprint's axes through the same map: steps of a fifth of the footprint.
+    const glm::dvec2 su = fp.toUV({0.7, 0.5}), sv = fp.toUV({0.5, 0.7});
+    const auto mu = mapUv(su), mv = mapUv(sv);
+    if (mu && mv) {
+        const glm::dvec2 du = *mu - *centre, dv = *mv - *centre;
+        const double lu = glm::length(du), lv = glm::length(dv);
+        const double ou = glm::length(su - fp.center), ov = glm::length(sv - fp.center);
+        if (lu > 1e-9 && lv > 1e-9 && ou > 0 && ov > 0) {
+            out.rotation = std::round(glm::degrees(std::atan2(du.y, du.x)) * 100.0) / 100.0;
+            out.scale = {std::clamp(p.scale[0] * lu / ou, 1e-4, kMaxPlacementScaleForMirror),
+                         std::clamp(p.scale[1] * lv / ov, 1e-4, kMaxPlacementScaleForMirror)};
+        }
+    }
+    // Joint: by name, else by reflected rest position.
+    const int j = model.findJoint(p.joint);
+    std::string twin = mirrorJointName(model, p.joint);
+    const auto world = worldMatrices(model, restPose(model));
+    if (twin.empty() && j >= 0) {
+        const glm::vec3 at = reflect(glm::vec3(world[static_cast<std::size_t>(j)][3]), plane);
+        const Bounds b = framingBounds(rest);
+        float best = 0.05f * glm::length(b.max - b.min);
+        for (int n : model.joints) {
+            const float d = glm::length(glm::vec3(world[static_cast<std::size_t>(n)][3]) - at);
+            if (d < best) {
+                best = d;
+                twin = model.nodes[static_cast<std::size_t>(n)].name;
+            }
+        }
+    }
+    if (twin.empty() || j < 0)
+        return makeError(ErrorCode::NotFound, where, "joint",
+                         "joint '" + p.joint + "' has no mirror twin by name or by position");
+    out.joint = twin;
+    const int t = model.findJoint(twin);
+    const glm::dvec3 in(p.axis[0], p.axis[1], p.axis[2]);
+    if (!(glm::length(in) > 0.0)) return makeError(ErrorCode::InvalidArgument, where, "axis", "zero axis");
+    const glm::vec3 a = mirrorAxis(model, j, t, glm::vec3(glm::normalize(in)), plane.axis);
+    out.axis = {a.x, a.y, a.z};
+    out.axisName.clear();
+    for (int k = 0; k < 3; ++k) // a named axis stays named when it maps onto one
+        if (std::abs(std::abs(a[k]) - 1.0f) < 1e-4f && a[k] > 0) {
+            out.axisName = std::string(1, static_cast<char>('x' + k));
+            out.axis = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
+        }
+    return out;
+}
+
+} // namespace dermis

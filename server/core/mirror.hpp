@@ -1,0 +1,65 @@
+// Dermis core — the mirror twin of a placement (SPEC §6 Mirror), by geometry, not only by names.
+//
+//   symmetry plane: of the planes through the centre of the rest-pose bounds perpendicular to x,
+//                   y or z (world space, after the rest pose: CesiumMan's Z-up root included),
+//                   the one whose reflection maps a sample of the rest vertices closest onto the
+//                   mesh;
+//   centre:         the footprint centre's rest surface point (UvLookup), reflected across the
+//                   plane, snapped to the nearest point of the rest mesh, and that point's UV;
+//   footprint:      two short steps along the footprint's own axes go through the same map; the
+//                   twin's rotation is the angle of the mapped first axis, its scale the old one
+//                   times how much each step stretched (a reflection cannot flip an image: the
+//                   twin keeps the same pattern, rotated);
+//   joint:          by name pairs (_l/_r, .l/.r, .L/.R, Left/Right, L_/R_, _L_/_R_ inside, any
+//                   case), else the
+//                   joint nearest the reflected rest position of the joint (within 5% of the
+//                   body's size; none → NotFound);
+//   axis:           an axial vector: world a_w = Q_j·a, mirrored a_w' = −R·a_w (R the
+//                   reflection), twin-local a' = Q_t⁻¹·a_w' (Q the joints' rest world rotations),
+//                   so a pose and its mirror image give both twins the same θ, hence the same t;
+//                   θ range, h, model, target and response are kept.
+//
+// Pure; O(vertices) per mirror for the nearest-point search (no index yet).
+#pragma once
+
+#include "scene.hpp"
+#include "uv_lookup.hpp"
+
+#include <glm/glm.hpp>
+
+#include <string>
+
+namespace dermis {
+
+struct SymmetryPlane {
+    int axis = 0;          ///< 0 = x, 1 = y, 2 = z (world, rest pose)
+    float offset = 0.0f;   ///< the plane is world[axis] = offset
+    float error = 0.0f;    ///< mean distance of reflected sample vertices to the mesh, world units
+};
+
+/// The rest pose's symmetry plane (see above). A model without vertices gets x = 0.
+SymmetryPlane symmetryPlane(const Model& model);
+
+/// The twin joint's name for `joint` by the naming conventions above ("" when none applies or
+/// the model has no such joint).
+std::string mirrorJointName(const Model& model, const std::string& joint);
+
+/// The mirror twin of `p` (id left empty for the caller). Fails: Unsupported ("/uvs") without
+/// UVs; NotFound ("center") when the footprint centre is on no UV chart; NotFound ("joint") when
+/// the joint has no twin by name or position.
+Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
+                                  const SymmetryPlane& plane);
+
+/// The reflection of a local rotation delta for the twin joint, for tests and tools: given the
+/// rest world rotations Q_j, Q_t and a delta Δ of joint j (pose = rest·Δ), the twin's delta Δ'
+/// of the mirror-image pose: Q_t⁻¹·(R·Q_j·Δ·Q_j⁻¹·R)·Q_t, as a quaternion.
+glm::quat mirrorDelta(const glm::quat& restWorldJ, const glm::quat& restWorldT, const glm::quat& delta,
+                      int axis);
+
+/// Rest world rotation of node `n` (rotation part of its rest world matrix, scale removed).
+glm::quat restWorldRotation(const Model& model, int n);
+
+/// The twin-local axis of `axis` (joint j's rest frame) for twin t (see above).
+glm::vec3 mirrorAxis(const Model& model, int j, int t, const glm::vec3& axis, int planeAxis);
+
+} // namespace dermis
