@@ -163,4 +163,62 @@ TEST_F(InspectHttpTest, MirrorAddsTheTwinOnTheOtherSide) {
     ASSERT_EQ(h.del(s).status, 204);
 }
 
+TEST_F(InspectHttpTest, CompareFramesAndDiffs) {
+    Http h = http();
+    Reply created = h.post("/scenes", {{"default_patterns", true}});
+    ASSERT_EQ(created.status, 201) << created;
+    const std::string s = "/scenes/" + created.js()["id"].get<std::string>();
+    const std::string size = "width=128&height=128&msaa=1";
+    Reply normal = h.get(s + "/frame?" + size);
+    Reply off = h.get(s + "/frame?patterns=off&" + size);
+    Reply solo = h.get(s + "/frame?only=elbow_l,knee_l&" + size);
+    ASSERT_EQ(normal.status, 200) << normal;
+    ASSERT_EQ(off.status, 200) << off;
+    ASSERT_EQ(solo.status, 200) << solo;
+    EXPECT_NE(normal.body, off.body) << "the default patterns change the frame";
+
+    // patterns=off equals the document with every placement disabled; only= with the others
+    // disabled; revision=1 the frame as it was (renders are deterministic).
+    json disabled = created.js()["scene"];
+    for (json& p : disabled["placements"]) p["enabled"] = false;
+    ASSERT_EQ(h.put(s, disabled).status, 200);
+    EXPECT_EQ(h.get(s + "/frame?" + size).body, off.body);
+    json soloDoc = created.js()["scene"];
+    for (json& p : soloDoc["placements"]) p["enabled"] = p["id"] == "elbow_l" || p["id"] == "knee_l";
+    ASSERT_EQ(h.put(s, soloDoc).status, 200);
+    EXPECT_EQ(h.get(s + "/frame?" + size).body, solo.body);
+    Reply atOne = h.get(s + "/frame?revision=1&" + size);
+    ASSERT_EQ(atOne.status, 200) << atOne;
+    EXPECT_EQ(atOne.body, normal.body);
+
+    // Diffs: against the patterns off and against a revision; none against itself.
+    Reply diff = h.get(s + "/frame-diff?against=off&revision=1&" + size);
+    ASSERT_EQ(diff.status, 200) << diff;
+    EXPECT_TRUE(isPng(diff.body));
+    const long changed = std::stol(diff.header("X-Dermis-Changed-Pixels"));
+    EXPECT_GT(changed, 20);
+    EXPECT_LT(changed, 128 * 128);
+    auto heat = decodeFrame(diff.bytes());
+    ASSERT_TRUE(heat);
+    std::size_t lit = 0;
+    for (std::size_t k = 0; k < heat->rgba.size(); k += 4) lit += heat->rgba[k] > 0;
+    EXPECT_EQ(static_cast<long>(lit), changed);
+    Reply same = h.get(s + "/frame-diff?against=1&revision=1&" + size);
+    ASSERT_EQ(same.status, 200) << same;
+    EXPECT_EQ(same.header("X-Dermis-Changed-Pixels"), "0");
+    Reply vsOne = h.get(s + "/frame-diff?against=1&" + size);
+    ASSERT_EQ(vsOne.status, 200);
+    EXPECT_GT(std::stol(vsOne.header("X-Dermis-Changed-Pixels")), 0);
+
+    expectError(h.get(s + "/frame?patterns=maybe"), 422, "patterns");
+    expectError(h.get(s + "/frame?only=nope"), 422, "only");
+    expectError(h.get(s + "/frame?only=,"), 422, "only");
+    expectError(h.get(s + "/frame?revision=99"), 404, "revision");
+    expectError(h.get(s + "/frame?revision=0"), 422, "revision");
+    expectError(h.get(s + "/frame-diff?" + size), 422, "against");
+    expectError(h.get(s + "/frame-diff?against=abc"), 422, "against");
+    expectError(h.get(s + "/frame-diff?against=77"), 404, "revision");
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
 } // namespace

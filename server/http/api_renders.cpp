@@ -3,21 +3,72 @@
 // the Service to the renderer's thread (a full queue answers 503 + Retry-After).
 #include "http/api_internal.hpp"
 
+#include <cmath>
+
 #include <memory>
 
 namespace dermis::api_detail {
 
+namespace {
+
+/// The frame query: size, camera, time, format and what to compare (patterns, only, revision).
+/// False (and the 422 sent) when a parameter is malformed.
+bool frameParams(const Req& req, Res& res, FrameParams& p) {
+    if (req.has_param("format")) p.format = req.get_param_value("format");
+    if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
+        !intParam(req, res, "msaa", p.msaa) || !numberParam(req, res, "yaw", p.yaw) ||
+        !numberParam(req, res, "pitch", p.pitch) || !numberParam(req, res, "distance", p.distance) ||
+        !numberParam(req, res, "time", p.time))
+        return false;
+    if (req.has_param("patterns")) {
+        const std::string v = req.get_param_value("patterns");
+        if (v != "on" && v != "off") {
+            sendError(res, 422, "invalid_argument", "dermis::Api: patterns: must be on or off", "patterns");
+            return false;
+        }
+        p.patternsOff = v == "off";
+    }
+    if (req.has_param("only")) {
+        const std::string v = req.get_param_value("only");
+        std::size_t start = 0;
+        while (start <= v.size()) {
+            const std::size_t comma = std::min(v.find(',', start), v.size());
+            if (comma > start) p.only.push_back(v.substr(start, comma - start));
+            start = comma + 1;
+        }
+        if (p.only.empty() || p.only.size() > 1000) {
+            sendError(res, 422, "invalid_argument", "dermis::Api: only: a comma-separated list of placement ids", "only");
+            return false;
+        }
+    }
+    if (req.has_param("revision")) {
+        std::optional<double> r;
+        if (!numberParam(req, res, "revision", r)) return false;
+        if (!r || *r < 1 || *r != std::floor(*r) || *r > 1e15) {
+            sendError(res, 422, "invalid_argument", "dermis::Api: revision: must be a revision number >= 1", "revision");
+            return false;
+        }
+        p.revision = static_cast<std::uint64_t>(*r);
+    }
+    return true;
+}
+
+} // namespace
+
 void installRenderRoutes(RouteTable& t) {
     t.add("GET", "/scenes/{id}/frame", [](Api::Impl& a, const Req& req, Res& res) {
         FrameParams p;
-        if (req.has_param("format")) p.format = req.get_param_value("format");
-        if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
-            !intParam(req, res, "msaa", p.msaa) || !numberParam(req, res, "yaw", p.yaw) ||
-            !numberParam(req, res, "pitch", p.pitch) ||
-            !numberParam(req, res, "distance", p.distance) ||
-            !numberParam(req, res, "time", p.time))
-            return;
+        if (!frameParams(req, res, p)) return;
         auto r = a.svc.frame(req.matches[1], p);
+        if (!r) return sendError(res, r.error());
+        sendImage(res, std::move(*r));
+    });
+    t.add("GET", "/scenes/{id}/frame-diff", [](Api::Impl& a, const Req& req, Res& res) {
+        FrameParams p;
+        if (!frameParams(req, res, p)) return;
+        if (!req.has_param("against"))
+            return sendError(res, 422, "invalid_argument", "dermis::Api: against: off or a revision number is required", "against");
+        auto r = a.svc.frameDiff(req.matches[1], p, req.get_param_value("against"));
         if (!r) return sendError(res, r.error());
         sendImage(res, std::move(*r));
     });

@@ -66,6 +66,7 @@ struct EncodedImage {
     std::vector<std::uint8_t> bytes;
     std::string contentType;
     std::string backend; ///< which GL backend rendered it ("" for CPU-only answers)
+    std::int64_t changedPixels = -1; ///< frame-diff only: pixels that differ (−1: not a diff)
 };
 
 /// One file of a multi-file upload.
@@ -79,6 +80,10 @@ struct FrameParams {
     std::string format = "png"; ///< png | jpeg
     std::optional<int> width, height, msaa;
     std::optional<double> yaw, pitch, distance, time;
+    // Compare (SPEC §6): which version of the scene the frame shows.
+    bool patternsOff = false;          ///< no dynamic patterns (every placement disabled)
+    std::vector<std::string> only;     ///< solo: only these placements (others disabled)
+    std::optional<std::uint64_t> revision; ///< the document as it was at this revision
 };
 
 /// A server-sent-events subscription to one scene: events (whole SSE messages) queue up until
@@ -238,7 +243,16 @@ public:
     Result<nlohmann::json> lint(const std::string& id);
 
     // --- renders
+    /// A frame of scene `id` with `params`' overrides; `patternsOff`, `only` (unknown ids fail,
+    /// field "only") and `revision` (NotFound, field "revision") choose what it shows.
     Result<EncodedImage> frame(const std::string& id, const FrameParams& params);
+    /// PNG heat map of the per-pixel difference between the frame `params` describe and the same
+    /// frame `against` "off" (no dynamic patterns) or a revision number (SPEC §6 Compare): black
+    /// where equal, red → yellow → white as the largest channel difference grows;
+    /// `changedPixels` counts the pixels that differ at all. InvalidArgument ("against") for
+    /// anything else.
+    Result<EncodedImage> frameDiff(const std::string& id, const FrameParams& params,
+                                   const std::string& against);
     /// which: bump | displacement | normal; format: png16 | exr | f32 (normal: png | exr).
     Result<EncodedImage> heightmap(const std::string& id, const std::string& which,
                                    const std::string& format);

@@ -6,6 +6,7 @@
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dermis {
@@ -28,14 +29,59 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     return planned;
 }
 
-Result<EncodedImage> Service::State::render(const Snapshot& snap, const FrameParams& p) {
+Result<Image8> Service::State::renderImage(const Snapshot& snap, const FrameParams& p) {
     auto plan = this->plan(snap, p);
     if (!plan) return plan.error();
     auto result = renderer->renderFrame(frameRequest(*plan, snap.model));
     if (!result) return result.error();
+    return std::move(result->image);
+}
+
+Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string& id,
+                                                              const FrameParams& p) const {
+    Result<Snapshot> snap = makeError(ErrorCode::Internal, "", "", "");
+    if (p.revision) {
+        std::uint64_t current = 0;
+        {
+            std::shared_lock<std::shared_mutex> lock(mutex);
+            auto it = scenes.find(id);
+            if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
+            current = it->second.revision;
+        }
+        if (*p.revision == 0 || *p.revision > current)
+            return notFound("revision", "scene " + id + " has no revision " + std::to_string(*p.revision));
+        auto doc = store->readRevision(id, *p.revision);
+        if (!doc) return doc.error();
+        std::shared_lock<std::shared_mutex> lock(mutex);
+        auto prepared = prepare(*doc, false);
+        if (!prepared)
+            return makeError(ErrorCode::Conflict, "dermis::Service", "revision",
+                             "revision " + std::to_string(*p.revision) +
+                                 " no longer renders: " + prepared.error().message);
+        snap = snapshotOf(prepared->scene, prepared->model);
+    } else {
+        snap = snapshot(id);
+    }
+    if (!snap) return snap;
+    for (const std::string& pid : p.only) {
+        bool known = false;
+        for (const Placement& pl : snap->scene.placements) known = known || pl.id == pid;
+        if (!known) return bad("only", "no placement \"" + pid + "\" in scene " + id);
+    }
+    for (Placement& pl : snap->scene.placements) {
+        if (p.patternsOff) pl.enabled = false;
+        if (!p.only.empty() && std::find(p.only.begin(), p.only.end(), pl.id) == p.only.end())
+            pl.enabled = false;
+    }
+    return snap;
+}
+
+Result<EncodedImage> Service::State::render(const Snapshot& snap, const FrameParams& p) {
+    auto image = renderImage(snap, p);
+    if (!image) return image.error();
     EncodedImage out;
     out.backend = renderer->info().backend;
-    auto bytes = p.format == "jpeg" ? encodeJpeg(result->image, 90) : encodePng(result->image, false);
+    auto bytes = p.format == "jpeg" ? encodeJpeg(*image, 90) : encodePng(*image, false);
     if (!bytes) return bytes.error();
     out.bytes = std::move(*bytes);
     out.contentType = p.format == "jpeg" ? "image/jpeg" : "image/png";
@@ -72,11 +118,63 @@ Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p)
     if (p.format != "png" && p.format != "jpeg") return bad("format", "must be png or jpeg");
     QueueSlot slot(state_->inFlight, limits_.queueLength);
     if (!slot.ok()) return queueFull();
-    auto snap = state_->snapshot(id);
+    auto snap = state_->frameSnapshot(id, p);
     if (!snap) return snap.error();
     auto img = state_->render(*snap, p);
     if (!img) return asParamError(img.error(), p);
     return img;
+}
+
+Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams& p,
+                                        const std::string& against) {
+    FrameParams other = p;
+    if (against == "off") {
+        other.patternsOff = true;
+    } else {
+        std::uint64_t n = 0;
+        bool ok = !against.empty() && against.size() <= 18;
+        for (char c : against) {
+            ok = ok && c >= '0' && c <= '9';
+            if (ok) n = n * 10 + static_cast<std::uint64_t>(c - '0');
+        }
+        if (!ok || n == 0) return bad("against", "must be off or a revision number");
+        other.revision = n;
+        other.patternsOff = false;
+        other.only.clear();
+    }
+    QueueSlot slot(state_->inFlight, limits_.queueLength);
+    if (!slot.ok()) return queueFull();
+    auto a = state_->frameSnapshot(id, p);
+    if (!a) return a.error();
+    auto b = state_->frameSnapshot(id, other);
+    if (!b) return b.error();
+    auto ia = state_->renderImage(*a, p);
+    if (!ia) return asParamError(ia.error(), p);
+    auto ib = state_->renderImage(*b, other);
+    if (!ib) return asParamError(ib.error(), other);
+    Image8 heat;
+    heat.width = ia->width;
+    heat.height = ia->height;
+    heat.rgba.assign(ia->rgba.size(), 0);
+    std::int64_t changed = 0;
+    for (std::size_t k = 0; k + 3 < ia->rgba.size() && k + 3 < ib->rgba.size(); k += 4) {
+        int d = 0;
+        for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(ia->rgba[k + c]) - int(ib->rgba[k + c])));
+        if (d > 0) ++changed;
+        const double t = d / 255.0; // black → red → yellow → white
+        heat.rgba[k + 0] = static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(3.0 * t, 0.0, 1.0)));
+        heat.rgba[k + 1] = static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(3.0 * t - 1.0, 0.0, 1.0)));
+        heat.rgba[k + 2] = static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(3.0 * t - 2.0, 0.0, 1.0)));
+        heat.rgba[k + 3] = 255;
+    }
+    auto bytes = encodePng(heat, false);
+    if (!bytes) return bytes.error();
+    EncodedImage out;
+    out.bytes = std::move(*bytes);
+    out.contentType = "image/png";
+    out.backend = state_->renderer->info().backend;
+    out.changedPixels = changed;
+    return out;
 }
 
 Result<EncodedImage> Service::heightmap(const std::string& id, const std::string& which,

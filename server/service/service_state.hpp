@@ -155,6 +155,11 @@ struct Service::State {
     /// Caller holds presenceMutex.
     json livePresence(const std::string& sceneId);
 
+    /// The snapshot a frame with `p` shows: the current document or p.revision's, with
+    /// p.patternsOff / p.only applied to the placements' `enabled`.
+    Result<Snapshot> frameSnapshot(const std::string& id, const FrameParams& p) const;
+    /// Plans and renders one frame of `snap` with `p`'s overrides (not encoded).
+    Result<Image8> renderImage(const Snapshot& snap, const FrameParams& p);
     /// The frame plan of `snap` with `p`'s overrides (errors name the parameters).
     Result<FramePlan> plan(const Snapshot& snap, const FrameParams& p) const;
     /// Plans and renders one frame of `snap` with `p`'s overrides; encodes it.
