@@ -31,7 +31,7 @@ fi
 # npm packages of the tests (pinned by package-lock.json), installed once per lock change:
 # the Khronos glTF validator and playwright-core (drives Debian's Chromium in the viewer test).
 here="$(cd "$(dirname "$0")/.." && pwd)"
-for dir in "$here/tests/gltf-validator" "$here/tests/web"; do
+for dir in "$here/tests/gltf-validator" "$here/tests/web" "$here/tests/openapi"; do
   if [ -f "$dir/package-lock.json" ] &&
      { [ ! -d "$dir/node_modules" ] ||
        [ "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]; }; then

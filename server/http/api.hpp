@@ -63,5 +63,7 @@ private:
 
 /// The OpenAPI 3 description served at /api/v1/openapi.yaml (embedded at build time).
 std::string_view openapiYaml();
+/// The JSON Schema of dermis.scene/1 (server/http/schemas/scene.json, embedded at build time).
+std::string_view sceneSchemaJson();
 
 } // namespace dermis

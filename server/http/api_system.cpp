@@ -1,5 +1,6 @@
 // Dermis HTTP shell — system routes: liveness (open), server info with the configured limits
-// (the Service's, plus the HTTP layer's own session limits), and the OpenAPI document.
+// (the Service's, plus the HTTP layer's own session limits), the OpenAPI document and the JSON
+// Schema of dermis.scene/1.
 #include "http/api_internal.hpp"
 
 namespace dermis::api_detail {
@@ -16,6 +17,9 @@ void installSystemRoutes(RouteTable& t) {
     });
     t.add("GET", "/openapi.yaml", [](Api::Impl&, const Req&, Res& res) {
         res.set_content(std::string(openapiYaml()), "application/yaml");
+    });
+    t.add("GET", "/schemas/scene.json", [](Api::Impl&, const Req&, Res& res) {
+        res.set_content(std::string(sceneSchemaJson()), "application/schema+json");
     });
 }
 
