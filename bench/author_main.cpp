@@ -15,6 +15,8 @@
 #include "http/api.hpp"
 #include "service/service.hpp"
 
+#include "bench_stats.hpp"
+
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
@@ -33,21 +35,8 @@ using json = nlohmann::json;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms(Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-json percentiles(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    auto at = [&](double q) {
-        const std::size_t i = std::min(
-            v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1);
-        return std::round(v[i] * 1000) / 1000;
-    };
-    return {{"p50_ms", at(0.5)}, {"p99_ms", at(0.99)}, {"requests", v.size()}};
-}
+using bench::Clock;
+using bench::ms;
 
 const json kScene = json::parse(R"({
   "format": "dermis.scene/1", "model": "builtin:default", "heightmap": {"size": [256, 256]},
@@ -125,7 +114,7 @@ int main(int argc, char** argv) {
             if (r > 0) lat.push_back(ms(t0, Clock::now()));
         }
         if (failed) return;
-        json j = percentiles(lat);
+        json j = bench::percentiles(lat, 3);
         j["name"] = name;
         j["revisions"] = revisions;
         results.push_back(j);

@@ -11,6 +11,8 @@
 #include "http/api.hpp"
 #include "service/service.hpp"
 
+#include "bench_stats.hpp"
+
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
@@ -29,20 +31,8 @@ using json = nlohmann::json;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms(Clock::time_point a, Clock::time_point b) {
-    return std::chrono::duration<double, std::milli>(b - a).count();
-}
-
-json percentiles(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    auto at = [&](double q) {
-        const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1);
-        return std::round(v[i] * 100) / 100;
-    };
-    return {{"p50_ms", at(0.5)}, {"p99_ms", at(0.99)}, {"requests", v.size()}};
-}
+using bench::Clock;
+using bench::ms;
 
 } // namespace
 
@@ -110,7 +100,7 @@ int main(int argc, char** argv) {
                     if (!e || !f || e->status != 200 || f->status != 200) return json{{"error", "request failed"}};
                     if (r > 0) lat.push_back(ms(t0, t1));
                 }
-                json j = percentiles(lat);
+                json j = bench::percentiles(lat);
                 j["name"] = "edit_to_frame";
                 j["size"] = size;
                 j["format"] = format;
@@ -157,7 +147,7 @@ int main(int argc, char** argv) {
                     if (r > 0) lat.push_back(ms(t0, Clock::now()));
                 }
                 if (lat.empty()) continue;
-                json j = percentiles(lat);
+                json j = bench::percentiles(lat);
                 j["name"] = "heightmap_fetch";
                 j["map"] = map;
                 j["format"] = format;

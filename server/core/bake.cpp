@@ -6,17 +6,13 @@
 #include <cmath>
 
 namespace dermis {
-namespace {
 
-/// Joint by name first, then any named node (so non-skin nodes can be posed and drive patterns).
 int findPosable(const Model& model, const std::string& name) {
     if (int j = model.findJoint(name); j >= 0) return j;
     for (std::size_t n = 0; n < model.nodes.size(); ++n)
         if (model.nodes[n].name == name) return static_cast<int>(n);
     return -1;
 }
-
-} // namespace
 
 Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
                                std::optional<double> timeOverride) {

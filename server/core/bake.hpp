@@ -17,6 +17,10 @@
 
 namespace dermis {
 
+/// The node a pose override or a placement's `joint` names: the joint of that name first, then
+/// any named node (so non-skin nodes can be posed and drive patterns); −1 when none.
+int findPosable(const Model& model, const std::string& name);
+
 /// The local pose a scene asks for: the clip (`pose.animation`, else the model's first clip, else
 /// rest) sampled at `timeOverride` or `pose.time` (clamped to the clip), then the `pose.joints`
 /// overrides (`rotation` replaces the local rotation; `axis_angles` sets q_rest·Rx·Ry·Rz).

@@ -52,13 +52,6 @@ std::string percent(std::size_t part, std::size_t whole) {
     return std::to_string(static_cast<int>(std::lround(100.0 * ratio))) + "%";
 }
 
-int posable(const Model& m, const std::string& name) {
-    if (int j = m.findJoint(name); j >= 0) return j;
-    for (std::size_t n = 0; n < m.nodes.size(); ++n)
-        if (m.nodes[n].name == name) return static_cast<int>(n);
-    return -1;
-}
-
 /// Per placement: does any clip sample give t > 0? (true when the model has no clips: nothing
 /// to judge by).
 std::vector<bool> reachable(const Scene& scene, const Model& model) {
@@ -103,7 +96,7 @@ std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const
         std::size_t off = 0;
         std::set<int> charts;
         float influence = 0.0f;
-        const int joint = posable(model, p.joint);
+        const int joint = findPosable(model, p.joint);
         for (glm::dvec2 uv : points[i]) {
             const auto hit = lookup.find(uv);
             if (!hit) {

@@ -11,27 +11,14 @@
 import Ajv from "ajv";
 import addFormats from "ajv-formats";
 import yaml from "js-yaml";
-import { spawn } from "node:child_process";
-import { mkdtempSync, readFileSync, readdirSync, rmSync } from "node:fs";
-import { tmpdir } from "node:os";
+import { readFileSync, readdirSync } from "node:fs";
 import { join } from "node:path";
 import assert from "node:assert/strict";
+import { startServer } from "../lib/server.mjs";
 
 const [exe, source] = process.argv.slice(2);
-const data = mkdtempSync(join(tmpdir(), "dermis-openapi-"));
-const server = spawn(exe, ["serve", "--port", "0", "--data", data, "--gl", process.env.DERMIS_TEST_GL || "auto"]);
-let output = "";
-const port = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error("server did not start: " + output)), 60000);
-  server.stdout.on("data", (d) => {
-    output += d;
-    const m = output.match(/serving http:\/\/127\.0\.0\.1:(\d+)\//);
-    if (m) { clearTimeout(timer); resolve(+m[1]); }
-  });
-  server.stderr.on("data", (d) => { output += d; });
-  server.on("exit", (code) => reject(new Error(`server exited ${code}: ${output}`)));
-});
-const base = `http://127.0.0.1:${port}/api/v1`;
+const server = await startServer(exe, [], "dermis-openapi-");
+const base = `${server.base}/api/v1`;
 const call = async (method, path, body) => {
   const r = await fetch(base + path, {
     method, headers: body ? { "Content-Type": "application/json" } : {},
@@ -145,7 +132,6 @@ try {
   failed = true;
   console.error(e);
 } finally {
-  server.kill("SIGTERM");
-  rmSync(data, { recursive: true, force: true });
+  server.stop();
 }
 process.exit(failed ? 1 : 0);

@@ -8,29 +8,13 @@
 // edit made through the API with the bearer token and of one made from the page with the cookie;
 // after DELETE /session the API answers 401 and a reload asks for the token again.
 import { chromium } from "playwright-core";
-import { spawn } from "node:child_process";
-import { mkdtempSync, rmSync } from "node:fs";
-import { tmpdir } from "node:os";
-import { join } from "node:path";
 import assert from "node:assert/strict";
+import { startServer } from "../lib/server.mjs";
 
 const exe = process.argv[2];
 const token = "browser-s3cret-" + Math.random().toString(36).slice(2);
-const data = mkdtempSync(join(tmpdir(), "dermis-session-"));
-const server = spawn(exe, ["serve", "--port", "0", "--data", data, "--token", token,
-                           "--gl", process.env.DERMIS_TEST_GL || "auto"]);
-let output = "";
-const port = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error("server did not start: " + output)), 60000);
-  server.stdout.on("data", (d) => {
-    output += d;
-    const m = output.match(/serving http:\/\/127\.0\.0\.1:(\d+)\//);
-    if (m) { clearTimeout(timer); resolve(+m[1]); }
-  });
-  server.stderr.on("data", (d) => { output += d; });
-  server.on("exit", (code) => reject(new Error(`server exited ${code}: ${output}`)));
-});
-const base = `http://127.0.0.1:${port}`;
+const server = await startServer(exe, ["--token", token], "dermis-session-");
+const base = server.base;
 // Another client: node's fetch with the bearer token.
 const api = async (method, path, body) => {
   const headers = { Authorization: `Bearer ${token}` };
@@ -129,7 +113,6 @@ try {
   console.error("WebSessionBrowserTest: FAILED:", e.message);
 } finally {
   await browser.close();
-  server.kill("SIGTERM");
-  rmSync(data, { recursive: true, force: true });
+  server.stop();
 }
 process.exit(failed ? 1 : 0);

@@ -5,27 +5,12 @@
 // texture-space canvas moves that placement on the server; an edit made through the API by
 // another client reaches the page by server-sent events and a new frame is shown.
 import { chromium } from "playwright-core";
-import { spawn } from "node:child_process";
-import { mkdtempSync, rmSync } from "node:fs";
-import { tmpdir } from "node:os";
-import { join } from "node:path";
 import assert from "node:assert/strict";
+import { startServer } from "../lib/server.mjs";
 
 const exe = process.argv[2];
-const data = mkdtempSync(join(tmpdir(), "dermis-web-"));
-const server = spawn(exe, ["serve", "--port", "0", "--data", data, "--gl", process.env.DERMIS_TEST_GL || "auto"]);
-let output = "";
-const port = await new Promise((resolve, reject) => {
-  const timer = setTimeout(() => reject(new Error("server did not start: " + output)), 60000);
-  server.stdout.on("data", (d) => {
-    output += d;
-    const m = output.match(/serving http:\/\/127\.0\.0\.1:(\d+)\//);
-    if (m) { clearTimeout(timer); resolve(+m[1]); }
-  });
-  server.stderr.on("data", (d) => { output += d; });
-  server.on("exit", (code) => reject(new Error(`server exited ${code}: ${output}`)));
-});
-const base = `http://127.0.0.1:${port}`;
+const server = await startServer(exe, [], "dermis-web-");
+const base = server.base;
 const api = async (method, path, body) => {
   const r = await fetch(base + "/api/v1" + path, {
     method, headers: body ? { "Content-Type": "application/json" } : {}, body: body ? JSON.stringify(body) : undefined,
@@ -75,7 +60,6 @@ try {
   console.error("WebViewerBrowserTest: FAILED:", e.message);
 } finally {
   await browser.close();
-  server.kill("SIGTERM");
-  rmSync(data, { recursive: true, force: true });
+  server.stop();
 }
 process.exit(failed ? 1 : 0);
