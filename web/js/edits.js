@@ -1,0 +1,152 @@
+// Every change this editor makes to the scene goes through here. Each edit carries If-Match with
+// the revision the person saw; the answer's document and revision become the state. A 412 means
+// someone else changed the scene first: the editor shows a notice, reads the scene again and
+// drops the edit (it never overwrites their change). Undo and redo are server reverts to the
+// revisions around this person's own edits.
+//
+// Drags use a Stream: at most one edit in flight, edits at least `interval` ms apart, the newest
+// value wins, and finish() sends the last value so the scene ends where the pointer stopped.
+
+import { store, set, emit } from "./store.js";
+import { notify } from "./notice.js";
+
+let api = null;
+const undoStack = []; // revisions to go back to (the document before one of my edits)
+const redoStack = []; // revisions to go forward to
+let reloadScene = async () => {};
+
+export function initEdits(theApi, reload) {
+  api = theApi;
+  reloadScene = reload;
+}
+
+export const canUndo = () => undoStack.length > 0;
+export const canRedo = () => redoStack.length > 0;
+export function clearUndo() { undoStack.length = 0; redoStack.length = 0; emit("undo"); }
+
+/// Applies an edit answer ({id, revision, scene}) to the state.
+export function accept(answer, topic = "doc") {
+  if (!answer || answer.id !== store.sceneId || answer.revision < store.revision) return;
+  const fields = { doc: answer.scene, revision: answer.revision };
+  if (store.pinnedRevision !== null) fields.pinnedRevision = null;
+  set(fields, topic + " revision");
+}
+
+/// Sends one edit (method, path under the scene, body) with If-Match. Resolves to the answer,
+/// or null when the server refused it (the notice is shown). `undoable` records it for undo.
+export async function edit(method, path, body, { undoable = true, quiet = false } = {}) {
+  const before = store.revision;
+  try {
+    const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, body, before);
+    accept(answer);
+    if (undoable) {
+      undoStack.push(before);
+      redoStack.length = 0;
+      emit("undo");
+    }
+    return answer;
+  } catch (e) {
+    await refused(e, quiet);
+    return null;
+  }
+}
+
+/// Shows why an edit was refused; after a 412, re-reads the scene.
+export async function refused(e, quiet = false) {
+  if (e.code === "stale_revision") {
+    notify(`Someone else changed this scene first (now revision ${e.revision}). Your edit was not applied; the scene is up to date again.`, "warn");
+    await reloadScene();
+  } else if (!quiet) {
+    notify(e.field ? `${e.message}` : e.message, "error");
+  }
+}
+
+export const patchPlacement = (id, fields, opts) => edit("PATCH", `/placements/${encodeURIComponent(id)}`, fields, opts);
+export const deletePlacement = (id) => edit("DELETE", `/placements/${encodeURIComponent(id)}`);
+export const addPlacement = (placement) => edit("POST", "/placements", placement);
+export const mirrorPlacement = (id) => edit("POST", `/placements/${encodeURIComponent(id)}/mirror`, {});
+export const patchPose = (fields, opts) => edit("PATCH", "/pose", fields, opts);
+export const putScene = (doc) => edit("PUT", "", doc);
+
+/// Goes back to `revision` as a new revision (history panel, undo, redo, cancelled drags).
+export async function revert(revision, { undoable = true } = {}) {
+  return edit("POST", "/revert", { revision }, { undoable });
+}
+
+export async function undo() {
+  if (!undoStack.length) return notify("Nothing to undo.", "info");
+  const target = undoStack.pop();
+  const here = store.revision;
+  if (await revert(target, { undoable: false })) redoStack.push(here);
+  else undoStack.push(target);
+  emit("undo");
+}
+
+export async function redo() {
+  if (!redoStack.length) return notify("Nothing to redo.", "info");
+  const target = redoStack.pop();
+  const here = store.revision;
+  if (await revert(target, { undoable: false })) undoStack.push(here);
+  else redoStack.push(target);
+  emit("undo");
+}
+
+/// A stream of edits from one gesture (a drag, a slider). send(value) queues the newest value;
+/// finish() resolves once the last value is on the server. cancel() sends nothing more and, when
+/// edits were already sent, reverts to the revision before the gesture.
+export class Stream {
+  constructor(apply, interval = 70) {
+    this.apply = apply;       // async (value) => answer | null
+    this.interval = interval;
+    this.pending = undefined; // newest value not yet sent
+    this.inFlight = null;
+    this.lastSent = 0;
+    this.sent = 0;
+    this.before = store.revision;
+    this.timer = null;
+    this.done = false;
+  }
+  send(value) {
+    if (this.done) return;
+    this.pending = value;
+    this.pump();
+  }
+  pump() {
+    if (this.inFlight || this.pending === undefined || this.timer) return;
+    const wait = this.lastSent + this.interval - performance.now();
+    if (wait > 0) {
+      this.timer = setTimeout(() => { this.timer = null; this.pump(); }, wait);
+      return;
+    }
+    const value = this.pending;
+    this.pending = undefined;
+    this.lastSent = performance.now();
+    ++this.sent;
+    this.inFlight = this.apply(value).finally(() => { this.inFlight = null; this.pump(); });
+  }
+  async finish() {
+    this.done = true;
+    if (this.timer) { clearTimeout(this.timer); this.timer = null; }
+    while (this.inFlight || this.pending !== undefined) {
+      if (this.inFlight) await this.inFlight;
+      if (this.pending !== undefined) {
+        const value = this.pending;
+        this.pending = undefined;
+        ++this.sent;
+        this.inFlight = this.apply(value).finally(() => { this.inFlight = null; });
+      }
+    }
+    if (this.sent > 0) {
+      undoStack.push(this.before);
+      redoStack.length = 0;
+      emit("undo");
+    }
+  }
+  async cancel() {
+    this.done = true;
+    this.pending = undefined;
+    if (this.timer) { clearTimeout(this.timer); this.timer = null; }
+    if (this.inFlight) await this.inFlight;
+    if (this.sent > 0) await revert(this.before, { undoable: false });
+  }
+}

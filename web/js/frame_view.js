@@ -1,0 +1,301 @@
+// 3D view: the server's frames of the scene. Drag orbits (yaw, pitch), the wheel zooms
+// (distance); click selects the placement under the pointer (pick → UV → footprint), and with the
+// place tool (P, or Alt+click) creates one there with the suggested driver. View modes shaded /
+// bump / displacement / normal; compare with a split slider, flicker, or the diff heat map against
+// "patterns off" or a chosen revision.
+//
+// Frames are coalesced: one request in flight per image, the newest wanted URL wins when it ends,
+// and a frame never replaces a newer one; a frame slower than 500 ms shows a spinner.
+
+import { store, on, set, emit, shownTime } from "./store.js";
+import { API, query } from "./api.js";
+import * as geo from "./geometry.js";
+import { notify } from "./notice.js";
+import { addPlacement } from "./edits.js";
+import { placementFromPattern } from "./placing.js";
+
+let api, stage, img, cmpImg, spinner, splitHandle, sizeSelect;
+let flickerTimer = null;
+let placeTool = false;
+const FRAME_SIZES = [384, 512, 768, 1024];
+export let frameSize = 512;
+let autoDistance = null; // the server's camera distance when the scene says "auto"
+export const frameStats = { shown: 0, requested: 0, times: [] };
+
+/// Loads URLs into one <img>: at most one fetch in flight, the newest wanted URL next; `onShown`
+/// runs after a frame is on screen.
+class FrameLoader {
+  constructor(el, onShown) {
+    this.el = el;
+    this.onShown = onShown;
+    this.inFlight = false;
+    this.wanted = null;   // {url, seq, t0}
+    this.shownSeq = 0;
+    this.seq = 0;
+    this.url = null;
+    this.objectUrl = null;
+    this.slowTimer = null;
+  }
+  load(url) {
+    if (url === this.url && !this.inFlight) return;
+    this.wanted = { url, seq: ++this.seq, t0: performance.now() };
+    this.pump();
+  }
+  async pump() {
+    if (this.inFlight || !this.wanted) return;
+    const job = this.wanted;
+    this.wanted = null;
+    this.inFlight = true;
+    clearTimeout(this.slowTimer);
+    this.slowTimer = setTimeout(() => { spinner.hidden = false; }, 500);
+    try {
+      const r = await api.raw("GET", job.url);
+      const d = r.headers.get("X-Dermis-Camera-Distance");
+      if (d && store.camera.distance === null) autoDistance = +d;
+      const changed = r.headers.get("X-Dermis-Changed-Pixels");
+      const blob = await r.blob();
+      if (job.seq > this.shownSeq) {
+        const objectUrl = URL.createObjectURL(blob);
+        await new Promise((resolve) => { this.el.onload = this.el.onerror = resolve; this.el.src = objectUrl; });
+        if (this.objectUrl) URL.revokeObjectURL(this.objectUrl);
+        this.objectUrl = objectUrl;
+        this.shownSeq = job.seq;
+        this.url = job.url;
+        this.el.dataset.url = job.url;
+        this.el.dataset.changedPixels = changed || "";
+        this.onShown && this.onShown(job, performance.now());
+      }
+    } catch (e) {
+      if (e.status !== 0 || store.online) notify(`Frame: ${e.message}`, "error");
+      this.url = null;
+    } finally {
+      this.inFlight = false;
+      clearTimeout(this.slowTimer);
+      spinner.hidden = true;
+      this.pump();
+    }
+  }
+}
+
+let mainLoader, cmpLoader;
+
+export function initFrameView(section, theApi) {
+  api = theApi;
+  section.innerHTML = `
+    <div class="viewbar">
+      <span class="title">3D</span>
+      <label>View <select id="viewMode" aria-label="view mode">
+        <option value="shaded">shaded</option><option value="bump">bump</option>
+        <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
+      <label>Compare <select id="compareMode" aria-label="compare mode">
+        <option value="off">off</option><option value="split">split</option>
+        <option value="flicker">flicker</option><option value="diff">diff heat map</option></select></label>
+      <label>against <select id="compareAgainst" aria-label="compare against"><option value="off">patterns off</option></select></label>
+      <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
+      <label>Size <select id="frameSize" aria-label="frame size">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
+      <button type="button" id="placeTool" aria-pressed="false" title="Place tool (P): click the model to add a placement there">Place</button>
+      <button type="button" id="resetCamera" title="Reset the camera">Reset</button>
+      <span id="diffText" class="badge" hidden></span>
+    </div>
+    <div class="stage" id="frameStage" tabindex="0" aria-label="3D view: drag to orbit, wheel to zoom, click to select">
+      <img id="frame" alt="" draggable="false">
+      <img id="compareFrame" alt="" draggable="false" hidden>
+      <div class="split-handle" hidden></div>
+      <div class="spinner" hidden></div>
+    </div>`;
+  stage = section.querySelector(".stage");
+  img = section.querySelector("#frame");
+  cmpImg = section.querySelector("#compareFrame");
+  spinner = section.querySelector(".spinner");
+  splitHandle = section.querySelector(".split-handle");
+  sizeSelect = section.querySelector("#frameSize");
+  sizeSelect.value = String(frameSize);
+  mainLoader = new FrameLoader(img, (job, now) => {
+    frameStats.shown++;
+    frameStats.times.push(now - job.t0);
+    if (frameStats.times.length > 1000) frameStats.times.shift();
+    img.alt = "rendered frame";
+    img.dataset.seq = String(job.seq);
+  });
+  cmpLoader = new FrameLoader(cmpImg);
+  const $ = (id) => section.querySelector("#" + id);
+  $("viewMode").onchange = (e) => set({ view: e.target.value });
+  $("compareMode").onchange = (e) => set({ compare: { ...store.compare, mode: e.target.value } });
+  $("compareAgainst").onchange = (e) => set({ compare: { ...store.compare, against: e.target.value } });
+  $("split").oninput = (e) => { store.compare.split = +e.target.value; layoutCompare(); };
+  sizeSelect.onchange = () => { frameSize = +sizeSelect.value; refresh(); };
+  $("placeTool").onclick = () => setPlaceTool(!placeTool);
+  $("resetCamera").onclick = () => set({ camera: { yaw: 0, pitch: 10, distance: null } });
+  orbit(stage);
+  on("doc revision camera view compare solo time pinnedRevision", () => {
+    $("viewMode").value = store.view;
+    $("compareMode").value = store.compare.mode;
+    $("split").hidden = store.compare.mode !== "split";
+    refresh();
+  });
+  on("revision", fillAgainst);
+}
+
+/// Sets the frame size (one of 384, 512, 768, 1024; a permalink's size).
+export function setFrameSize(n) {
+  if (!FRAME_SIZES.includes(n)) return;
+  frameSize = n;
+  if (sizeSelect) sizeSelect.value = String(n);
+  refresh();
+}
+
+export const placeToolOn = () => placeTool;
+
+export function setPlaceTool(onOff) {
+  placeTool = onOff;
+  document.getElementById("placeTool").setAttribute("aria-pressed", String(onOff));
+  stage.style.cursor = onOff ? "copy" : "";
+}
+
+/// The frame parameters this view shows (shared by frame, compare, diff and pick).
+export function frameParams() {
+  const c = store.camera;
+  return {
+    width: frameSize, height: frameSize,
+    yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined,
+    time: shownTime(),
+    view: store.view === "shaded" ? undefined : store.view,
+    only: store.solo.length ? store.solo.join(",") : undefined,
+    revision: store.pinnedRevision ?? store.revision,
+  };
+}
+
+/// The URL (under /api/v1) of the frame this view shows now.
+export function frameUrl() {
+  return `/scenes/${store.sceneId}/frame${query(frameParams())}`;
+}
+
+export function refresh() {
+  if (!store.sceneId || !store.doc) return;
+  const p = frameParams();
+  const cmp = store.compare;
+  const against = cmp.against === "off" ? { patterns: "off" } : { revision: +cmp.against };
+  if (cmp.mode === "diff") {
+    mainLoader.load(`/scenes/${store.sceneId}/frame-diff${query({ ...p, against: cmp.against })}`);
+  } else {
+    mainLoader.load(`/scenes/${store.sceneId}/frame${query(p)}`);
+  }
+  if (cmp.mode === "split" || cmp.mode === "flicker") cmpLoader.load(`/scenes/${store.sceneId}/frame${query({ ...p, ...against })}`);
+  layoutCompare();
+}
+
+function layoutCompare() {
+  const mode = store.compare.mode;
+  cmpImg.hidden = mode !== "split" && mode !== "flicker";
+  splitHandle.hidden = mode !== "split";
+  clearInterval(flickerTimer);
+  flickerTimer = null;
+  if (mode === "split") {
+    const pct = store.compare.split * 100;
+    cmpImg.style.clipPath = `inset(0 0 0 ${pct}%)`;
+    cmpImg.style.visibility = "visible";
+    splitHandle.style.left = `${pct}%`;
+  } else if (mode === "flicker") {
+    cmpImg.style.clipPath = "";
+    flickerTimer = setInterval(() => { cmpImg.style.visibility = cmpImg.style.visibility === "hidden" ? "visible" : "hidden"; }, 450);
+  }
+  const diffText = document.getElementById("diffText");
+  diffText.hidden = mode !== "diff";
+  if (mode === "diff") diffText.textContent = `${img.dataset.changedPixels || "…"} px changed`;
+}
+
+async function fillAgainst() {
+  const sel = document.getElementById("compareAgainst");
+  const keep = sel.value;
+  try {
+    const list = await api.get(`/scenes/${store.sceneId}/revisions?limit=30`);
+    sel.innerHTML = `<option value="off">patterns off</option>` +
+      list.revisions.filter((r) => r.revision !== store.revision)
+        .map((r) => `<option value="${r.revision}">r${r.revision} ${escapeHtml(r.op)}</option>`).join("");
+    sel.value = [...sel.options].some((o) => o.value === keep) ? keep : "off";
+  } catch { /* the history panel shows errors */ }
+}
+
+const escapeHtml = (s) => String(s).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]);
+
+/// The pixel of the frame under a pointer event, or null outside the image.
+function framePixel(e) {
+  const r = img.getBoundingClientRect();
+  const side = Math.min(r.width, r.height); // object-fit: contain, square frames
+  const x0 = r.left + (r.width - side) / 2, y0 = r.top + (r.height - side) / 2;
+  const x = ((e.clientX - x0) / side) * frameSize, y = ((e.clientY - y0) / side) * frameSize;
+  if (x < 0 || y < 0 || x >= frameSize || y >= frameSize) return null;
+  return [Math.floor(x), Math.floor(y)];
+}
+
+function orbit(el) {
+  let start = null;
+  el.addEventListener("pointerdown", (e) => {
+    if (e.button !== 0) return;
+    el.focus();
+    start = { x: e.clientX, y: e.clientY, yaw: store.camera.yaw, pitch: store.camera.pitch, moved: false };
+    el.setPointerCapture(e.pointerId);
+  });
+  el.addEventListener("pointermove", (e) => {
+    if (store.compare.mode === "split" && !start) {
+      const r = el.getBoundingClientRect();
+      if (e.buttons === 0 && e.shiftKey) { store.compare.split = (e.clientX - r.left) / r.width; layoutCompare(); }
+    }
+    if (!start) return;
+    const dx = e.clientX - start.x, dy = e.clientY - start.y;
+    if (!start.moved && Math.hypot(dx, dy) < 4) return;
+    start.moved = true;
+    const yaw = geo.wrapDegrees(start.yaw - dx * 0.5);
+    const pitch = Math.max(-85, Math.min(85, start.pitch + dy * 0.4));
+    set({ camera: { ...store.camera, yaw: Math.round(yaw * 10) / 10, pitch: Math.round(pitch * 10) / 10 } });
+  });
+  el.addEventListener("pointerup", (e) => {
+    const s = start;
+    start = null;
+    if (s && !s.moved) click(e);
+  });
+  el.addEventListener("wheel", (e) => {
+    e.preventDefault();
+    const d = store.camera.distance ?? autoDistance ?? 3;
+    const next = Math.min(Math.max(d * Math.exp(e.deltaY * 0.001), 0.05), 1000);
+    set({ camera: { ...store.camera, distance: Math.round(next * 1000) / 1000 } });
+  }, { passive: false });
+}
+
+/// The pick answer at a frame pixel of this view.
+export function pickAt(x, y) {
+  const p = frameParams();
+  return api.get(`/scenes/${store.sceneId}/pick${query({ x, y, width: p.width, height: p.height, yaw: p.yaw,
+                                                             pitch: p.pitch, distance: p.distance, time: p.time })}`);
+}
+
+async function click(e) {
+  const px = framePixel(e);
+  if (!px || !store.doc) return;
+  let hit;
+  try { hit = await pickAt(px[0], px[1]); } catch (err) { notify(`Pick: ${err.message}`, "error"); return; }
+  if (!hit.hit) { if (!placeTool && !e.altKey) set({ selection: [] }); return; }
+  if (placeTool || e.altKey) {
+    emit("place-at", { uv: hit.uv, suggested: hit.suggested });
+    await placeAt(hit.uv, hit.suggested);
+    return;
+  }
+  const p = geo.hit(store.doc.placements, hit.uv);
+  if (p) set({ selection: [p.id] });
+  else notify(`No placement at UV (${hit.uv[0].toFixed(3)}, ${hit.uv[1].toFixed(3)}); skin of ${hit.joints.map((j) => j.name).join(", ")}. Use the place tool (P) to add one here.`, "info");
+}
+
+let currentPattern = () => null;
+export function setPatternSource(fn) { currentPattern = fn; }
+
+/// Adds a placement of the library's current pattern at `uv` driven by `suggested`.
+export async function placeAt(uv, suggested) {
+  const pattern = currentPattern();
+  if (!pattern) return notify("Choose a pattern in the library first.", "warn");
+  const body = placementFromPattern(pattern, uv);
+  if (suggested) Object.assign(body, { joint: suggested.joint, axis: suggested.axis, theta_min: suggested.theta_min, theta_max: suggested.theta_max });
+  const answer = await addPlacement(body);
+  if (answer) set({ selection: [answer.scene.placements[answer.scene.placements.length - 1].id] });
+}
+
+export { API };

@@ -1,0 +1,151 @@
+// Keyboard shortcuts of the editor (listed by `?`). They act when focus is not in a text field or
+// a select; Tab switches texture/3D inside the views (the paper's switch; Shift+Tab leaves them).
+
+import { store, set, placementById, heightmapSize } from "./store.js";
+import * as geo from "./geometry.js";
+import { patchPlacement, deletePlacement, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
+import { cancelDrag, dragging, viewCentreUV } from "./texture_view.js";
+import { setPlaceTool, placeToolOn } from "./frame_view.js";
+import { currentPattern, choosePattern } from "./panels/library.js";
+import { toggleEnabled, toggleSolo } from "./panels/placements.js";
+import { togglePlay } from "./panels/pose.js";
+import { placementFromPattern } from "./placing.js";
+import { notify } from "./notice.js";
+
+export const SHORTCUTS = [
+  ["1 – 9", "place the library's n-th pattern at the pointer (texture view)"],
+  ["click / Shift+click", "select / add to the selection (either view, or the list)"],
+  ["N / Shift+N", "select the next / previous placement"],
+  ["← ↑ → ↓", "nudge the selection one texel (Shift: 10)"],
+  ["[  ]", "rotate −5° / +5° (Shift: 15°)"],
+  ["+  −", "scale up / down 5%"],
+  ["Delete", "remove the selection"],
+  ["M", "mirror: add the twin on the other side"],
+  ["D", "duplicate"],
+  ["H", "hide / show (enabled)"],
+  ["S", "solo in the 3D view"],
+  ["P", "place tool: click the model in 3D to add a placement there"],
+  ["Tab", "switch texture / 3D (in the views)"],
+  ["Space", "play / pause the clip"],
+  ["Ctrl+Z / Ctrl+Shift+Z", "undo / redo (server reverts)"],
+  ["Esc", "cancel a drag; clear the selection"],
+  ["0", "fit the texture view"],
+  ["?", "this list"],
+];
+
+export function initKeys({ fitTexture }) {
+  const dlg = document.getElementById("help");
+  dlg.innerHTML = `<h2>Keyboard</h2><table>${SHORTCUTS.map(([k, d]) => `<tr><td><kbd>${k}</kbd></td><td>${d}</td></tr>`).join("")}</table>
+    <form method="dialog"><button>Close</button></form>`;
+  document.getElementById("helpButton").onclick = () => dlg.showModal();
+  document.addEventListener("keydown", (e) => onKey(e, { dlg, fitTexture }));
+}
+
+const typing = (el) => el && (el.tagName === "INPUT" && !["range", "checkbox", "button"].includes(el.type) || el.tagName === "TEXTAREA" || el.tagName === "SELECT" || el.isContentEditable);
+
+function onKey(e, { dlg, fitTexture }) {
+  if (e.key === "Escape" && cancelDrag()) { e.preventDefault(); return; }
+  if (dlg.open || document.getElementById("signin").hidden === false) return;
+  const mod = e.ctrlKey || e.metaKey;
+  if (mod && (e.key === "z" || e.key === "Z")) {
+    if (typing(document.activeElement)) return;
+    e.preventDefault();
+    e.shiftKey ? redo() : undo();
+    return;
+  }
+  if (mod && (e.key === "y" || e.key === "Y")) { e.preventDefault(); redo(); return; }
+  if (mod || e.altKey || typing(document.activeElement)) return;
+  const inView = document.activeElement && document.activeElement.closest && document.activeElement.closest(".view");
+  if (e.key === "Tab" && inView && !e.shiftKey) {
+    e.preventDefault();
+    switchView();
+    return;
+  }
+  const sel = store.selection.filter((id) => placementById(id));
+  const each = (fn) => sel.forEach((id) => fn(placementById(id)));
+  const k = e.key;
+  let handled = true;
+  if (k === "?") dlg.showModal();
+  else if (/^[1-9]$/.test(k)) placeNth(+k - 1);
+  else if (k === "Escape") set({ selection: [] });
+  else if (k === "n" || k === "N") selectNext(e.shiftKey ? -1 : 1);
+  else if (k.startsWith("Arrow") && sel.length) {
+    const step = (e.shiftKey ? 10 : 1) / heightmapSize()[0];
+    const d = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, -step], ArrowDown: [0, step] }[k];
+    each((p) => patchPlacement(p.id, { center: [geo.round4(p.center[0] + d[0]), geo.round4(p.center[1] + d[1])] }));
+  } else if ((k === "[" || k === "]" || k === "{" || k === "}") && sel.length) {
+    const step = (e.shiftKey ? 15 : 5) * (k === "[" || k === "{" ? -1 : 1);
+    each((p) => patchPlacement(p.id, { rotation: geo.round4(geo.wrapDegrees(p.rotation + step)) }));
+  } else if ((k === "+" || k === "=" || k === "-" || k === "_") && sel.length) {
+    const f = k === "+" || k === "=" ? 1.05 : 1 / 1.05;
+    each((p) => patchPlacement(p.id, { scale: [geo.round4(p.scale[0] * f), geo.round4(p.scale[1] * f)] }));
+  } else if ((k === "Delete" || k === "Backspace") && sel.length) {
+    sel.forEach((id) => deletePlacement(id));
+    set({ selection: [] });
+  } else if ((k === "m" || k === "M") && sel.length) sel.forEach((id) => mirrorPlacement(id));
+  else if ((k === "d" || k === "D") && sel.length) duplicate(sel);
+  else if ((k === "h" || k === "H") && sel.length) toggleEnabled(sel);
+  else if ((k === "s" || k === "S") && sel.length) toggleSolo(sel);
+  else if (k === "p" || k === "P") setPlaceTool(!placeToolOn());
+  else if (k === " " && !(document.activeElement && document.activeElement.tagName === "BUTTON")) togglePlay();
+  else if (k === "0") fitTexture();
+  else handled = false;
+  if (handled) e.preventDefault();
+}
+
+/// Switches the single view between texture and 3D; side by side, moves focus to the other view.
+export function switchView() {
+  const ws = document.querySelector(".workspace");
+  const layout = store.layoutMode;
+  if (layout === "both") {
+    const inTexture = document.activeElement && document.activeElement.closest("#textureView");
+    (inTexture ? document.getElementById("frameStage") : document.getElementById("uv")).focus();
+    return;
+  }
+  const next = layout === "texture" ? "3d" : "texture";
+  set({ layoutMode: next });
+  ws.dataset.layout = next;
+  (next === "texture" ? document.getElementById("uv") : document.getElementById("frameStage")).focus();
+}
+
+function selectNext(dir) {
+  const ps = store.doc ? store.doc.placements : [];
+  if (!ps.length) return;
+  const i = ps.findIndex((p) => p.id === store.selection[0]);
+  const j = i < 0 ? (dir > 0 ? 0 : ps.length - 1) : (i + dir + ps.length) % ps.length;
+  set({ selection: [ps[j].id] });
+}
+
+/// Places the library's n-th pattern at the pointer in the texture view (or the view's centre).
+async function placeNth(n) {
+  const pattern = store.patterns[n];
+  if (!pattern) return notify(`The library has no pattern ${n + 1}.`, "warn");
+  if (!store.model || !store.model.has_uvs) return notify("This model has no UVs: patterns cannot be placed on it.", "error");
+  choosePattern(pattern.id);
+  const uv = store.cursorUV && store.cursorUV.every((x) => x >= 0 && x <= 1) ? store.cursorUV : viewCentreUV();
+  const body = placementFromPattern(pattern, uv);
+  try {
+    const q = await api.get(`/scenes/${store.sceneId}/pick?u=${uv[0]}&v=${uv[1]}`);
+    if (q.hit && q.suggested) Object.assign(body, { joint: q.suggested.joint, axis: q.suggested.axis, theta_min: q.suggested.theta_min, theta_max: q.suggested.theta_max });
+  } catch { /* no surface there (off the charts): the pattern's defaults stay */ }
+  const answer = await addPlacement(body);
+  if (answer) set({ selection: [answer.scene.placements[answer.scene.placements.length - 1].id] });
+}
+
+let api = null;
+export function setKeysApi(theApi) { api = theApi; }
+
+async function duplicate(ids) {
+  const added = [];
+  for (const id of ids) {
+    const p = placementById(id);
+    if (!p) continue;
+    const { id: _omit, ...copy } = p;
+    copy.center = [geo.round4(p.center[0] + p.scale[0] * 0.25), geo.round4(p.center[1] + p.scale[1] * 0.25)];
+    const answer = await addPlacement(copy);
+    if (answer) added.push(answer.scene.placements[answer.scene.placements.length - 1].id);
+  }
+  if (added.length) set({ selection: added });
+}
+
+export { currentPattern };

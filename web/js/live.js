@@ -1,0 +1,87 @@
+// Live updates: the scene's server-sent events. A change by anyone else re-reads the document
+// (this editor's own edits are already applied from their answers); presence events show who has
+// what selected (our own selection is announced on change and every 10 s; entries lapse after
+// 30 s); `resync` re-reads. When the stream drops, the offline banner shows; EventSource
+// reconnects by itself and the editor re-reads the scene when it is back.
+
+import { store, on, set, emit } from "./store.js";
+import { setOffline } from "./notice.js";
+import { API } from "./api.js";
+
+let api, source = null, reload = async () => {}, presenceTimer = null, color = null, everOpen = false;
+
+export function initLive(theApi, reloadScene) {
+  api = theApi;
+  reload = reloadScene;
+  color = `hsl(${Math.floor(Math.random() * 360)}, 75%, 62%)`;
+  on("selection", announce);
+  setInterval(expirePresence, 2000);
+}
+
+export const myColor = () => color;
+
+/// Opens the event stream of the current scene (closing any other).
+export function connect() {
+  if (source) source.close();
+  everOpen = false;
+  const id = store.sceneId;
+  const es = (source = new EventSource(`${API}/scenes/${id}/events`));
+  es.addEventListener("hello", (e) => {
+    const wasOffline = !store.online;
+    set({ online: true });
+    setOffline(false);
+    const ev = JSON.parse(e.data);
+    if ((wasOffline || everOpen) && ev.revision !== store.revision) reload();
+    else if (wasOffline) reload();
+    everOpen = true;
+    announce();
+    api.get(`/scenes/${id}/presence`).then((answer) => {
+      for (const who of answer.presence || [])
+        if (who.client !== api.client)
+          store.presence.set(who.client, { selection: who.selection, color: who.color, until: Date.now() + 1000 * who.expires_in });
+      emit("presence");
+    }).catch(() => {});
+  });
+  es.addEventListener("change", (e) => {
+    const ev = JSON.parse(e.data);
+    emit("event");
+    if (ev.scene !== store.sceneId) return;
+    if (ev.revision <= store.revision) return; // ours (applied from the answer) or older
+    reload();
+  });
+  es.addEventListener("resync", () => reload());
+  es.addEventListener("presence", (e) => {
+    const ev = JSON.parse(e.data);
+    if (!ev.client || ev.client === api.client) return;
+    if (ev.left) { store.presence.delete(ev.client); emit("presence"); return; }
+    const until = Date.now() + 1000 * (ev.expires_in || 30);
+    store.presence.set(ev.client, { selection: ev.selection || [], color: ev.color, until });
+    emit("presence");
+  });
+  es.onerror = () => {
+    if (es !== source) return;
+    set({ online: false });
+    setOffline(true);
+    if (es.readyState === EventSource.CLOSED) setTimeout(() => { if (es === source) connect(); }, 1500);
+  };
+  clearInterval(presenceTimer);
+  presenceTimer = setInterval(announce, 10000);
+}
+
+/// Closes the stream (tests: a dropped connection).
+export function disconnect() { if (source) source.close(); source = null; }
+
+async function announce() {
+  if (!store.sceneId || !store.online) return;
+  const body = { client: api.client, selection: store.selection.slice(0, 100), color };
+  try {
+    await api.send("POST", `/scenes/${store.sceneId}/presence`, body);
+  } catch { /* presence is best effort: the next announcement tries again */ }
+}
+
+function expirePresence() {
+  const now = Date.now();
+  let changed = false;
+  for (const [k, v] of store.presence) if (v.until < now) { store.presence.delete(k); changed = true; }
+  if (changed) emit("presence");
+}

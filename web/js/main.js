@@ -1,0 +1,182 @@
+// Dermis editor entry: builds the API client, the views and the panels, loads the scene the URL
+// (or the first scene) names, and wires the toolbar: scene switch, undo/redo, layout, new scene
+// from a dropped or chosen .glb, download / load of the scene document, copying another scene's
+// placements, and "Copy link".
+
+import { Api, makeClientName, ApiError } from "./api.js";
+import { store, set, on, emit } from "./store.js";
+import { signIn } from "./signin.js";
+import { notify } from "./notice.js";
+import { initImages, forget } from "./images.js";
+import { initEdits, accept, clearUndo, canUndo, canRedo, putScene, undo, redo, revert } from "./edits.js";
+import { initTextureView, fit } from "./texture_view.js";
+import { initFrameView, setPatternSource, setFrameSize, frameStats, frameUrl, pickAt } from "./frame_view.js";
+import { initLibrary, currentPattern, uploadPattern } from "./panels/library.js";
+import { initPlacements } from "./panels/placements.js";
+import { initParams } from "./panels/params.js";
+import { initHistory } from "./panels/history.js";
+import { initPose } from "./panels/pose.js";
+import { initActivation } from "./panels/activation.js";
+import { initKeys, setKeysApi } from "./keys.js";
+import { initLive, connect, disconnect } from "./live.js";
+import { initPermalink, readLink, copyLink } from "./permalink.js";
+import { openCopyDialog } from "./copy_placements.js";
+
+const $ = (id) => document.getElementById(id);
+const api = new Api({ client: makeClientName(), signIn });
+
+/// Reads the current scene again (after a 412, another person's edit, a reconnect).
+async function reloadScene() {
+  if (!store.sceneId) return;
+  try {
+    const answer = await api.get(`/scenes/${store.sceneId}`);
+    if (answer.revision !== store.revision || JSON.stringify(answer.scene) !== JSON.stringify(store.doc)) {
+      set({ doc: answer.scene, revision: answer.revision }, "doc revision");
+    }
+  } catch (e) { notify(`Reading the scene: ${e.message}`, "error"); }
+}
+
+async function loadLint() {
+  try { set({ lint: await api.get(`/scenes/${store.sceneId}/lint`) }); } catch { set({ lint: [] }); }
+}
+
+/// Opens scene `id`; `link` (a permalink's fields) sets revision, time, camera and selection.
+async function openScene(id, link = {}) {
+  const answer = await api.get(`/scenes/${id}`);
+  const model = await api.get(`/models/${encodeURIComponent(answer.scene.model)}`);
+  const layout = model.has_uvs ? await api.get(`/models/${encodeURIComponent(model.id)}/uv-layout`) : null;
+  clearUndo();
+  store.presence.clear();
+  const camera = { yaw: link.yaw ?? 0, pitch: link.pitch ?? 10, distance: link.distance ?? null };
+  if (link.yaw === undefined && answer.scene.render && answer.scene.render.camera) {
+    const c = answer.scene.render.camera;
+    if (typeof c.yaw === "number") camera.yaw = c.yaw;
+    if (typeof c.pitch === "number") camera.pitch = c.pitch;
+    if (typeof c.distance === "number") camera.distance = c.distance;
+  }
+  if (link.size) setFrameSize(link.size);
+  const pinned = link.revision !== undefined && link.revision !== answer.revision ? link.revision : null;
+  set({
+    sceneId: id, doc: answer.scene, revision: answer.revision, model, layout, camera,
+    time: link.time ?? null, view: link.view || "shaded", pinnedRevision: pinned,
+    selection: (link.selection || []).filter((s) => answer.scene.placements.some((p) => p.id === s)), solo: [],
+  }, "scene doc revision model layout camera time view pinnedRevision selection solo presence");
+  $("scene").value = id;
+  connect();
+  fit();
+}
+
+async function refreshSceneList(select) {
+  const scenes = (await api.get("/scenes")).scenes;
+  $("scene").innerHTML = scenes.map((s) => `<option value="${s.id}">${s.id} — ${s.model} (${s.placements})</option>`).join("");
+  if (select) $("scene").value = select;
+  return scenes;
+}
+
+function wireToolbar() {
+  $("me").textContent = api.client;
+  $("scene").onchange = () => openScene($("scene").value).catch((e) => notify(e.message, "error"));
+  $("undo").onclick = () => undo();
+  $("redo").onclick = () => redo();
+  on("undo revision", () => { $("undo").disabled = !canUndo(); $("redo").disabled = !canRedo(); });
+  on("revision", () => { $("revision").textContent = `r${store.revision}`; });
+  for (const b of document.querySelectorAll("[data-layout]"))
+    b.onclick = () => set({ layoutMode: b.dataset.layout });
+  on("layoutMode", () => {
+    document.querySelector(".workspace").dataset.layout = store.layoutMode;
+    for (const b of document.querySelectorAll("[data-layout]")) b.classList.toggle("on", b.dataset.layout === store.layoutMode);
+  });
+  $("newScene").onclick = () => $("newSceneFile").click();
+  $("newSceneFile").onchange = () => { const f = $("newSceneFile").files[0]; if (f) newSceneFromModel(f); $("newSceneFile").value = ""; };
+  $("download").onclick = downloadScene;
+  $("load").onclick = () => $("loadFile").click();
+  $("loadFile").onchange = () => { const f = $("loadFile").files[0]; if (f) loadSceneFile(f); $("loadFile").value = ""; };
+  $("copyFrom").onclick = () => openCopyDialog(api);
+  $("copyLink").onclick = async () => { await copyLink(); notify("Link copied: it opens this exact view.", "info"); };
+  on("pinnedRevision revision", () => {
+    const b = $("pinned");
+    b.hidden = store.pinnedRevision === null;
+    if (b.hidden) return;
+    b.innerHTML = `Showing revision ${store.pinnedRevision} from a link (the scene is at ${store.revision}).
+      <button type="button" id="unpin">Show the latest</button><button type="button" id="revertPinned">Revert to revision ${store.pinnedRevision}</button>`;
+    $("unpin").onclick = () => set({ pinnedRevision: null });
+    $("revertPinned").onclick = () => revert(store.pinnedRevision);
+  });
+  on("revision", () => { forget(`/scenes/${store.sceneId}/heightmaps/`); loadLint(); });
+  // Files dropped anywhere: a .glb makes a new scene, an image becomes a pattern, anything else is refused.
+  document.addEventListener("dragover", (e) => { if ([...e.dataTransfer.types].includes("Files")) e.preventDefault(); });
+  document.addEventListener("drop", (e) => {
+    const f = e.dataTransfer.files[0];
+    if (!f) return;
+    e.preventDefault();
+    if (/\.glb$/i.test(f.name)) newSceneFromModel(f);
+    else if (/\.json$/i.test(f.name)) loadSceneFile(f);
+    else uploadPattern(f);
+  });
+}
+
+async function newSceneFromModel(f) {
+  try {
+    notify(`Uploading ${f.name}…`, "info");
+    const model = await api.json("POST", `/models?name=${encodeURIComponent(f.name.replace(/\.glb$/i, ""))}`,
+                                 { body: f, headers: { "Content-Type": "model/gltf-binary" } });
+    const scene = await api.send("POST", "/scenes", { model: model.id });
+    await refreshSceneList(scene.id);
+    await openScene(scene.id);
+    notify(`New scene ${scene.id} on ${model.name || model.id} (${model.triangles} triangles, ${model.joint_count} joints).`, "info");
+  } catch (e) { notify(`New scene from ${f.name}: ${e.message}`, "error"); }
+}
+
+function downloadScene() {
+  const blob = new Blob([JSON.stringify(store.doc, null, 2) + "\n"], { type: "application/json" });
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(blob);
+  a.download = `${store.sceneId}-r${store.revision}.scene.json`;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}
+
+async function loadSceneFile(f) {
+  let doc;
+  try { doc = JSON.parse(await f.text()); } catch (e) { return notify(`${f.name} is not JSON: ${e.message}`, "error"); }
+  if (await putScene(doc)) notify(`Loaded ${f.name} as revision ${store.revision}.`, "info");
+}
+
+async function start() {
+  initImages(api);
+  initEdits(api, reloadScene);
+  setKeysApi(api);
+  initTextureView($("textureView"));
+  initFrameView($("frameView"), api);
+  setPatternSource(currentPattern);
+  initLibrary($("libraryPanel"), api);
+  initPlacements($("placementsPanel"));
+  initParams($("paramsPanel"), api);
+  initHistory($("historyPanel"), api);
+  initPose($("posePanel"));
+  initActivation($("activationPanel"), api);
+  initKeys({ fitTexture: fit });
+  initLive(api, reloadScene);
+  initPermalink();
+  wireToolbar();
+  set({ layoutMode: window.innerWidth < 900 ? "texture" : "both" });
+  try {
+    set({ patterns: (await api.get("/patterns")).patterns });
+    const link = readLink();
+    let scenes = await refreshSceneList();
+    if (!scenes.length) {
+      const created = await api.send("POST", "/scenes", { default_patterns: true });
+      scenes = await refreshSceneList(created.id);
+    }
+    const id = link.scene && scenes.some((s) => s.id === link.scene) ? link.scene : scenes[0].id;
+    if (link.scene && id !== link.scene) notify(`The link's scene ${link.scene} does not exist here; showing ${id}.`, "warn");
+    await openScene(id, id === link.scene ? link : {});
+  } catch (e) {
+    notify(e instanceof ApiError ? e.message : String(e), "error");
+  }
+}
+
+// For tests and benchmarks: a read-only look at the editor's state and its frame statistics.
+window.dermisEditor = { store, frameStats, frameUrl, pickAt, disconnect, connect, api };
+
+start();

@@ -1,0 +1,32 @@
+// Notices: short messages in words at the bottom of the window (errors stay until dismissed or
+// replaced by more; others fade after a few seconds), and the offline banner. Every server error
+// the editor meets is shown here. Screen readers hear them (role=alert / status).
+
+const box = () => document.getElementById("notices");
+
+/// Shows `message`; kind: info | warn | error.
+export function notify(message, kind = "info") {
+  const list = box();
+  if (!list) return;
+  const item = document.createElement("div");
+  item.className = `notice ${kind}`;
+  item.setAttribute("role", kind === "error" || kind === "warn" ? "alert" : "status");
+  const text = document.createElement("span");
+  text.textContent = message;
+  const close = document.createElement("button");
+  close.type = "button";
+  close.textContent = "×";
+  close.setAttribute("aria-label", "dismiss");
+  close.onclick = () => item.remove();
+  item.append(text, close);
+  list.append(item);
+  while (list.children.length > 4) list.firstElementChild.remove();
+  if (kind === "info") setTimeout(() => item.remove(), 4000);
+  else setTimeout(() => item.remove(), 15000);
+}
+
+/// Shows or hides the offline banner.
+export function setOffline(offline) {
+  const b = document.getElementById("offline");
+  if (b) b.hidden = !offline;
+}

@@ -1,0 +1,192 @@
+// Parameters panel of the primary selection: label, pattern, joint (searchable list of the model's
+// joints), axis, θmin/θmax with the joint's current angle on a dial, h, model, target, response,
+// footprint numbers; a plot of peak height (L = 1) against θ with the current θ and t marked;
+// "go to pose" buttons (pose the driver at θmin / θmax) and the sweep contact sheet. Each field
+// is sent when it changes (Enter or leaving it).
+
+import { store, on, primary, shownTime } from "../store.js";
+import { patchPlacement, patchPose, mirrorPlacement } from "../edits.js";
+import { height, normalizedT } from "../deform.js";
+import { escapeHtml } from "./library.js";
+import { query } from "../api.js";
+import { notify } from "../notice.js";
+
+let api, box, drivers = new Map(), driversKey = "";
+
+export function initParams(section, theApi) {
+  api = theApi;
+  section.innerHTML = `<h2>Parameters <span class="grow"></span><span id="paramsId" class="badge"></span></h2><div id="paramsBody"></div>`;
+  box = section.querySelector("#paramsBody");
+  on("selection doc model patterns", render);
+  on("selection doc time revision", loadDrivers);
+  on("drivers", drawLive);
+}
+
+/// Each placement's current θ and t at the shown time (GET /scenes/{id}/drivers).
+async function loadDrivers() {
+  if (!store.sceneId || !store.doc) return;
+  const key = `${store.sceneId}/${store.revision}/${shownTime()}`;
+  if (key === driversKey) return;
+  driversKey = key;
+  try {
+    const answer = await api.get(`/scenes/${store.sceneId}/drivers${query({ time: shownTime(), revision: store.revision })}`);
+    if (key !== driversKey) return;
+    drivers = new Map(answer.placements.map((d) => [d.placement, d]));
+    drawLive();
+  } catch (e) { drivers = new Map(); }
+}
+export const driverOf = (id) => drivers.get(id);
+
+function field(label, html) { return `<label>${label}</label>${html}`; }
+const opt = (values, cur) => values.map((v) => `<option${v === cur ? " selected" : ""}>${v}</option>`).join("");
+
+function render() {
+  const p = primary();
+  document.getElementById("paramsId").textContent = p ? p.id : "";
+  if (!p) {
+    box.innerHTML = `<p class="hint">Select a placement (click it in either view or in the list), or place a new one: choose a pattern and press 1–9 over the texture view, or use the place tool on the 3D view.</p>`;
+    return;
+  }
+  const joints = store.model ? store.model.joints.map((j) => j.name) : [];
+  box.innerHTML = `
+    <div class="params">
+      ${field("Label", `<input type="text" id="pLabel" maxlength="120" value="${escapeHtml(p.label || "")}" aria-label="label">`)}
+      ${field("Pattern", `<select id="pPattern" aria-label="pattern">${store.patterns.map((q) => `<option value="${escapeHtml(q.id)}"${q.id === p.pattern ? " selected" : ""}>${escapeHtml(q.name || q.id)}</option>`).join("")}</select>`)}
+      ${field("Joint", `<input type="search" id="pJoint" list="jointList" value="${escapeHtml(p.joint)}" aria-label="driver joint" autocomplete="off"><datalist id="jointList">${joints.map((j) => `<option value="${escapeHtml(j)}">`).join("")}</datalist>`)}
+      ${field("Axis", `<select id="pAxis" aria-label="axis">${opt(["x", "y", "z"], p.axis)}</select>`)}
+      ${field("θ min / max", `<span class="pair"><input type="number" id="pMin" step="1" value="${p.theta_min}" aria-label="theta min"><input type="number" id="pMax" step="1" value="${p.theta_max}" aria-label="theta max"></span>`)}
+      ${field("h", `<input type="number" id="pH" step="0.05" value="${p.h}" aria-label="h (gain)">`)}
+      ${field("Model", `<select id="pModel" aria-label="deformation model">${opt(["scale", "bias"], p.model)}</select>`)}
+      ${field("Target", `<select id="pTarget" aria-label="target map">${opt(["bump", "displacement"], p.target)}</select>`)}
+      ${field("Response", `<select id="pResponse" aria-label="response">${opt(["log2", "ln", "linear", "smoothstep"], p.response)}</select>`)}
+      ${field("Centre", `<span class="pair"><input type="number" id="pU" step="0.001" value="${p.center[0]}" aria-label="centre u"><input type="number" id="pV" step="0.001" value="${p.center[1]}" aria-label="centre v"></span>`)}
+      ${field("Scale", `<span class="pair"><input type="number" id="pSX" step="0.005" value="${p.scale[0]}" aria-label="scale u"><input type="number" id="pSY" step="0.005" value="${p.scale[1]}" aria-label="scale v"></span>`)}
+      ${field("Rotation", `<input type="number" id="pRot" step="1" value="${p.rotation}" aria-label="rotation (degrees)">`)}
+      ${field("Enabled", `<input type="checkbox" id="pEnabled"${p.enabled ? " checked" : ""} aria-label="enabled">`)}
+      <div class="wide pair"><canvas class="dial" id="dial" width="192" height="192" aria-label="current joint angle"></canvas>
+        <div><div id="liveText" aria-live="polite"></div>
+          <div class="pair" style="margin-top:6px"><button type="button" id="goMin" title="Pose the driver joint at θmin">Go to θmin</button><button type="button" id="goMax" title="Pose the driver joint at θmax">Go to θmax</button></div>
+          <div class="pair" style="margin-top:4px"><button type="button" id="clearPose" title="Remove this joint's pose override">Release joint</button><button type="button" id="sweep" title="Contact sheet of the driver's range">Sweep…</button></div>
+          <div class="pair" style="margin-top:4px"><button type="button" id="mirror" title="Add the mirror twin (M)">Mirror</button></div>
+        </div></div>
+      <canvas class="plot wide" id="plot" width="520" height="240" aria-label="height against theta"></canvas>
+    </div>`;
+  const $ = (id) => box.querySelector("#" + id);
+  const send = (fields) => patchPlacement(p.id, fields);
+  const num = (el) => { const v = +el.value; return Number.isFinite(v) && el.value !== "" ? v : null; };
+  $("pLabel").onchange = (e) => send({ label: e.target.value });
+  $("pPattern").onchange = (e) => send({ pattern: e.target.value });
+  $("pJoint").onchange = (e) => {
+    if (!joints.includes(e.target.value)) { notify(`The model has no joint named "${e.target.value}".`, "error"); e.target.value = p.joint; return; }
+    send({ joint: e.target.value });
+  };
+  $("pAxis").onchange = (e) => send({ axis: e.target.value });
+  for (const [id, key] of [["pMin", "theta_min"], ["pMax", "theta_max"], ["pH", "h"], ["pRot", "rotation"]])
+    $(id).onchange = (e) => { const v = num(e.target); if (v !== null) send({ [key]: v }); };
+  $("pModel").onchange = (e) => send({ model: e.target.value });
+  $("pTarget").onchange = (e) => send({ target: e.target.value });
+  $("pResponse").onchange = (e) => send({ response: e.target.value });
+  $("pEnabled").onchange = (e) => send({ enabled: e.target.checked });
+  const pairSend = (a, b, key) => () => { const x = num($(a)), y = num($(b)); if (x !== null && y !== null) send({ [key]: [x, y] }); };
+  $("pU").onchange = $("pV").onchange = pairSend("pU", "pV", "center");
+  $("pSX").onchange = $("pSY").onchange = pairSend("pSX", "pSY", "scale");
+  $("goMin").onclick = () => goToPose(p, p.theta_min);
+  $("goMax").onclick = () => goToPose(p, p.theta_max);
+  $("clearPose").onclick = () => patchPose({ joints: { [p.joint]: null } });
+  $("sweep").onclick = () => openSweep(p);
+  $("mirror").onclick = () => mirrorPlacement(p.id);
+  drawLive();
+}
+
+/// Poses the placement's driver joint at `theta` about its axis (other axes of that joint kept).
+export function goToPose(p, theta) {
+  const cur = (store.doc.pose.joints || {})[p.joint];
+  const angles = cur && cur.axis_angles ? { ...cur.axis_angles } : {};
+  angles[p.axis] = theta;
+  return patchPose({ joints: { [p.joint]: { axis_angles: angles } } });
+}
+
+/// The current θ and t of placement p: from the server's drivers answer when it has one.
+function live(p) {
+  const d = drivers.get(p.id);
+  if (d) return { theta: d.theta, t: d.t };
+  return { theta: null, t: null };
+}
+
+function drawLive() {
+  const p = primary();
+  if (!p || !box.querySelector("#plot")) return;
+  const { theta, t } = live(p);
+  box.querySelector("#liveText").textContent = theta === null ? "θ —" :
+    `θ = ${theta.toFixed(1)}°  t = ${t.toFixed(3)}  height = ${height(p, 1, t).toFixed(3)}`;
+  drawDial(box.querySelector("#dial"), p, theta);
+  drawPlot(box.querySelector("#plot"), p, theta);
+}
+
+function drawDial(c, p, theta) {
+  const g = c.getContext("2d"), w = c.width, r = w * 0.42, cx = w / 2, cy = w / 2;
+  g.clearRect(0, 0, w, w);
+  const ang = (deg) => ((deg - 90) * Math.PI) / 180; // 0° up, clockwise positive
+  g.lineWidth = 10;
+  g.strokeStyle = "#2a323d";
+  g.beginPath(); g.arc(cx, cy, r, 0, Math.PI * 2); g.stroke();
+  const lo = Math.min(p.theta_min, p.theta_max), hi = Math.max(p.theta_min, p.theta_max);
+  g.strokeStyle = "#2d6fa8";
+  g.beginPath(); g.arc(cx, cy, r, ang(lo), ang(hi)); g.stroke();
+  g.lineWidth = 2;
+  for (const [deg, col] of [[p.theta_min, "#8d99a8"], [p.theta_max, "#5fb3ff"]]) {
+    g.strokeStyle = col;
+    g.beginPath(); g.moveTo(cx, cy); g.lineTo(cx + Math.cos(ang(deg)) * (r + 6), cy + Math.sin(ang(deg)) * (r + 6)); g.stroke();
+  }
+  if (theta !== null) {
+    g.strokeStyle = "#ffb454";
+    g.lineWidth = 4;
+    g.beginPath(); g.moveTo(cx, cy); g.lineTo(cx + Math.cos(ang(theta)) * r, cy + Math.sin(ang(theta)) * r); g.stroke();
+  }
+  g.fillStyle = "#dde3ea";
+  g.font = "bold 22px system-ui, sans-serif";
+  g.textAlign = "center";
+  g.fillText(theta === null ? "—" : `${theta.toFixed(0)}°`, cx, cy + 8);
+}
+
+function drawPlot(c, p, theta) {
+  const g = c.getContext("2d"), W = c.width, H = c.height, pad = 28;
+  g.clearRect(0, 0, W, H);
+  const span = Math.abs(p.theta_max - p.theta_min) || 1;
+  const a = Math.min(p.theta_min, p.theta_max) - span * 0.25, b = Math.max(p.theta_min, p.theta_max) + span * 0.25;
+  const top = Math.max(Math.abs(p.h), 1e-6);
+  const X = (th) => pad + ((th - a) / (b - a)) * (W - 2 * pad);
+  const Y = (v) => H - pad - (v / top) * (H - 2 * pad) * (p.h < 0 ? -1 : 1);
+  g.strokeStyle = "#343c48";
+  g.lineWidth = 1;
+  g.beginPath(); g.moveTo(pad, H - pad); g.lineTo(W - pad, H - pad); g.moveTo(pad, pad); g.lineTo(pad, H - pad); g.stroke();
+  g.fillStyle = "#8d99a8";
+  g.font = "18px system-ui, sans-serif";
+  g.fillText(`θ ${a.toFixed(0)}°…${b.toFixed(0)}°`, pad + 4, H - 6);
+  g.fillText(`height (L = 1), h = ${p.h}`, pad + 4, pad - 8);
+  g.strokeStyle = "#5fb3ff";
+  g.lineWidth = 3;
+  g.beginPath();
+  for (let i = 0; i <= 200; ++i) {
+    const th = a + ((b - a) * i) / 200;
+    const v = height(p, 1, normalizedT(th, p.theta_min, p.theta_max));
+    i ? g.lineTo(X(th), Y(v)) : g.moveTo(X(th), Y(v));
+  }
+  g.stroke();
+  c.dataset.curve = [0, 0.25, 0.5, 0.75, 1].map((f) => height(p, 1, f).toFixed(4)).join(",");
+  if (theta !== null) {
+    const t = normalizedT(theta, p.theta_min, p.theta_max);
+    g.fillStyle = "#ffb454";
+    g.beginPath(); g.arc(X(Math.min(Math.max(theta, a), b)), Y(height(p, 1, t)), 6, 0, Math.PI * 2); g.fill();
+  }
+}
+
+/// The sweep contact sheet of p's driver range in a dialog.
+export async function openSweep(p) {
+  const dlg = document.getElementById("sweepDialog");
+  const url = `/api/v1/scenes/${store.sceneId}/sweep${query({ placement: p.id, steps: 8, size: 192 })}`;
+  dlg.innerHTML = `<h2>Sweep of ${escapeHtml(p.id)}: ${escapeHtml(p.joint)} ${p.axis} from ${p.theta_min}° to ${p.theta_max}°</h2>
+    <img alt="sweep contact sheet of ${escapeHtml(p.id)}" src="${url}"><form method="dialog"><button>Close</button></form>`;
+  dlg.querySelector("img").onerror = () => notify("The sweep could not be rendered.", "error");
+  dlg.showModal();
+}

@@ -1,0 +1,98 @@
+// Placements panel: one row per placement — pattern thumbnail, label (or id), lint badge, enabled
+// toggle (H), solo (S) — in document order; drag a row to reorder (PUT of the document with the
+// new order); click selects in both views (Shift adds). Rows are buttons: Tab reaches them, Enter
+// selects, Alt+↑/↓ moves the selection in the list.
+
+import { store, on, set } from "../store.js";
+import { patternImagePath } from "../images.js";
+import { patchPlacement, putScene } from "../edits.js";
+import { escapeHtml } from "./library.js";
+
+let list, count;
+
+export function initPlacements(section) {
+  section.innerHTML = `<h2>Placements <span class="badge" id="placementCount">0</span></h2>
+    <ul class="list" id="placementList" aria-label="placements"></ul>`;
+  list = section.querySelector("#placementList");
+  count = section.querySelector("#placementCount");
+  on("doc selection lint solo", render);
+}
+
+export function toggleEnabled(ids) {
+  for (const id of ids) {
+    const p = store.doc.placements.find((q) => q.id === id);
+    if (p) patchPlacement(id, { enabled: !p.enabled });
+  }
+}
+
+export function toggleSolo(ids) {
+  const solo = new Set(store.solo);
+  const all = ids.every((id) => solo.has(id));
+  for (const id of ids) all ? solo.delete(id) : solo.add(id);
+  set({ solo: [...solo] });
+}
+
+/// Moves placement `id` before `beforeId` (end when null): the document with the new order.
+export async function reorder(id, beforeId) {
+  const ps = [...store.doc.placements];
+  const from = ps.findIndex((p) => p.id === id);
+  if (from < 0) return;
+  const [moved] = ps.splice(from, 1);
+  const to = beforeId === null ? ps.length : ps.findIndex((p) => p.id === beforeId);
+  ps.splice(to < 0 ? ps.length : to, 0, moved);
+  await putScene({ ...store.doc, placements: ps });
+}
+
+function render() {
+  if (!store.doc) return;
+  const lintCount = new Map();
+  for (const f of store.lint) if (f.placement) lintCount.set(f.placement, (lintCount.get(f.placement) || 0) + 1);
+  count.textContent = String(store.doc.placements.length);
+  list.innerHTML = "";
+  for (const p of store.doc.placements) {
+    const li = document.createElement("li");
+    li.dataset.placement = p.id;
+    li.draggable = true;
+    li.className = (store.selection.includes(p.id) ? "selected " : "") + (p.enabled ? "" : "disabled");
+    const lint = lintCount.get(p.id);
+    const findings = store.lint.filter((f) => f.placement === p.id).map((f) => f.message).join("\n");
+    li.innerHTML = `<img class="thumb" alt="" src="/api/v1${patternImagePath(p.pattern)}?size=64">
+      <button type="button" class="name" aria-pressed="${store.selection.includes(p.id)}" title="${escapeHtml(p.id)} — ${escapeHtml(p.pattern)} on ${escapeHtml(p.joint)} ${p.axis}">${escapeHtml(p.label || p.id)}</button>
+      ${lint ? `<span class="lintbadge" title="${escapeHtml(findings)}" aria-label="${lint} lint findings">${lint}</span>` : ""}
+      <button type="button" class="mini enabled" aria-pressed="${p.enabled}" aria-label="enabled ${escapeHtml(p.id)}" title="Enabled (H)">${p.enabled ? "◉" : "○"}</button>
+      <button type="button" class="mini solo" aria-pressed="${store.solo.includes(p.id)}" aria-label="solo ${escapeHtml(p.id)}" title="Solo in the 3D view (S)">S</button>`;
+    li.querySelector(".name").onclick = (e) => {
+      const sel = e.shiftKey ? (store.selection.includes(p.id) ? store.selection.filter((i) => i !== p.id) : [p.id, ...store.selection]) : [p.id];
+      set({ selection: sel });
+    };
+    li.querySelector(".enabled").onclick = () => toggleEnabled([p.id]);
+    li.querySelector(".solo").onclick = () => toggleSolo([p.id]);
+    li.addEventListener("dragstart", (e) => { e.dataTransfer.setData("text/x-dermis-placement", p.id); e.dataTransfer.effectAllowed = "move"; });
+    li.addEventListener("dragover", (e) => {
+      if (![...e.dataTransfer.types].includes("text/x-dermis-placement")) return;
+      e.preventDefault();
+      li.classList.add("dragover");
+    });
+    li.addEventListener("dragleave", () => li.classList.remove("dragover"));
+    li.addEventListener("drop", (e) => {
+      const id = e.dataTransfer.getData("text/x-dermis-placement");
+      li.classList.remove("dragover");
+      if (!id) return;
+      e.preventDefault();
+      e.stopPropagation();
+      if (id !== p.id) reorder(id, p.id);
+    });
+    li.addEventListener("keydown", (e) => {
+      if (!e.altKey || (e.key !== "ArrowUp" && e.key !== "ArrowDown")) return;
+      e.preventDefault();
+      e.stopPropagation();
+      const ps = store.doc.placements, i = ps.findIndex((q) => q.id === p.id);
+      const j = e.key === "ArrowUp" ? i - 1 : i + 2;
+      if (j < 0 || j > ps.length) return;
+      reorder(p.id, j === ps.length ? null : ps[j].id);
+    });
+    list.append(li);
+  }
+  const sel = list.querySelector("li.selected");
+  if (sel) sel.scrollIntoView({ block: "nearest" });
+}

@@ -1,0 +1,353 @@
+// Texture view: the model's UV layout over its base-colour texture, the current bump or
+// displacement map as an optional overlay, and every placement as its pattern image inside its
+// rotated footprint, with handles on the selection (drag inside: move; corners: scale, Shift keeps
+// aspect; the round handle: rotate, Shift snaps to 15°; Esc during a drag cancels it). Wheel zooms
+// about the pointer; dragging empty space (or with the middle button) pans. Lint findings are
+// drawn on the footprints they concern, other people's selections in their colour.
+//
+// Draws from the store; edits go through edits.js (a Stream per drag).
+
+import { store, on, emit, set, placementById, heightmapSize } from "./store.js";
+import * as geo from "./geometry.js";
+import { image, onImageLoaded, patternImagePath } from "./images.js";
+import { Stream, patchPlacement } from "./edits.js";
+
+const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26;
+
+let canvas, ctx, stage, overlaySelect, zoomText;
+let zoom = 1, ox = 0, oy = 0, fitted = false; // uv → css px: x = ox + u·zoom·S
+let drag = null;  // {kind: move|scale|rotate|pan, id, start, orig, value, stream, corner}
+let hover = null; // id under the pointer
+let dirty = false;
+
+const S = () => Math.min(stage.clientWidth, stage.clientHeight) || 512;
+const toScreen = (uv) => [ox + uv[0] * zoom * S(), oy + uv[1] * zoom * S()];
+const toUV = (x, y) => [(x - ox) / (zoom * S()), (y - oy) / (zoom * S())];
+const pxToUV = (px) => px / (zoom * S());
+
+/// The placement as drawn: the document's, with a running drag's value on top.
+function shown(p) {
+  return drag && drag.id === p.id && drag.value ? { ...p, ...drag.value } : p;
+}
+
+export function initTextureView(section) {
+  section.innerHTML = `
+    <div class="viewbar">
+      <span class="title">Texture</span>
+      <label>Overlay <select id="overlay" aria-label="height-map overlay">
+        <option value="none">none</option><option value="bump">bump map</option><option value="displacement">displacement map</option>
+      </select></label>
+      <button type="button" id="fitTexture" title="Fit the UV square (0)">Fit</button>
+      <span id="zoomText" class="badge">100%</span>
+      <span class="grow"></span>
+      <span class="hint">1–9 place · drag move · corners scale · ◯ rotate · ? keys</span>
+    </div>
+    <div class="stage"><canvas id="uv" tabindex="0" aria-label="texture space: placements on the UV layout; arrow keys nudge the selection"></canvas></div>`;
+  stage = section.querySelector(".stage");
+  canvas = section.querySelector("#uv");
+  ctx = canvas.getContext("2d");
+  overlaySelect = section.querySelector("#overlay");
+  zoomText = section.querySelector("#zoomText");
+  overlaySelect.onchange = () => set({ overlay: overlaySelect.value });
+  section.querySelector("#fitTexture").onclick = fit;
+  new ResizeObserver(() => { if (!fitted) fit(); else redraw(); }).observe(stage);
+  canvas.addEventListener("pointerdown", pointerDown);
+  canvas.addEventListener("pointermove", pointerMove);
+  canvas.addEventListener("pointerup", pointerUp);
+  canvas.addEventListener("pointercancel", () => cancelDrag());
+  canvas.addEventListener("wheel", wheel, { passive: false });
+  canvas.addEventListener("contextmenu", (e) => e.preventDefault());
+  on("doc selection lint presence overlay layout model revision solo", redraw);
+  onImageLoaded(redraw);
+}
+
+/// Fits the UV square into the stage.
+export function fit() {
+  fitted = true;
+  zoom = 0.94;
+  const w = stage.clientWidth, h = stage.clientHeight, s = S();
+  ox = (w - s * zoom) / 2;
+  oy = (h - s * zoom) / 2;
+  redraw();
+}
+
+export function redraw() {
+  if (dirty) return;
+  dirty = true;
+  requestAnimationFrame(draw);
+}
+
+/// True while a drag runs (Esc cancels it; see cancelDrag).
+export const dragging = () => drag !== null && drag.kind !== "pan";
+
+/// Centre of the visible part of the UV square (where keys place patterns when the pointer is away).
+export function viewCentreUV() {
+  return toUV(stage.clientWidth / 2, stage.clientHeight / 2).map((x) => Math.min(Math.max(x, 0), 1));
+}
+
+function draw() {
+  dirty = false;
+  if (!canvas) return;
+  const dpr = window.devicePixelRatio || 1;
+  const w = stage.clientWidth, h = stage.clientHeight;
+  if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+    canvas.width = Math.round(w * dpr);
+    canvas.height = Math.round(h * dpr);
+  }
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.fillStyle = "#0d1014";
+  ctx.fillRect(0, 0, w, h);
+  zoomText.textContent = `${Math.round(zoom * 100)}%`;
+  if (!store.doc || !store.model) return;
+  const s = zoom * S();
+  // The UV square, its texture and the overlay.
+  ctx.fillStyle = "#1a1f26";
+  ctx.fillRect(ox, oy, s, s);
+  const tex = store.model.has_uvs ? image(`/models/${encodeURIComponent(store.model.id)}/texture?size=1024`) : null;
+  if (tex) {
+    ctx.globalAlpha = 0.55;
+    ctx.drawImage(tex, ox, oy, s, s);
+    ctx.globalAlpha = 1;
+  }
+  if (store.overlay !== "none") {
+    const ov = image(`/scenes/${store.sceneId}/heightmaps/${store.overlay}?format=png&size=512&revision=${store.revision}`);
+    if (ov) {
+      ctx.globalAlpha = 0.8;
+      ctx.globalCompositeOperation = "screen";
+      ctx.drawImage(ov, ox, oy, s, s);
+      ctx.globalCompositeOperation = "source-over";
+      ctx.globalAlpha = 1;
+    }
+  }
+  if (store.layout) {
+    ctx.strokeStyle = "rgba(140, 160, 185, 0.35)";
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    const e = store.layout.edges;
+    for (let i = 0; i + 3 < e.length; i += 4) {
+      ctx.moveTo(ox + e[i] * s, oy + e[i + 1] * s);
+      ctx.lineTo(ox + e[i + 2] * s, oy + e[i + 3] * s);
+    }
+    ctx.stroke();
+  } else {
+    ctx.fillStyle = "#ffb454";
+    ctx.fillText("This model has no UVs: patterns cannot be placed on it.", ox + 10, oy + 20);
+  }
+  ctx.strokeStyle = "#3a4350";
+  ctx.strokeRect(ox, oy, s, s);
+
+  const lintBy = new Map();
+  for (const f of store.lint) if (f.placement) lintBy.set(f.placement, [...(lintBy.get(f.placement) || []), f]);
+  const soloed = new Set(store.solo);
+  for (const raw of store.doc.placements) {
+    const p = shown(raw);
+    const selected = store.selection.includes(p.id);
+    const dim = !p.enabled || (soloed.size && !soloed.has(p.id));
+    drawFootprint(p, { selected, dim, lint: lintBy.get(p.id) || [], hover: hover === p.id });
+  }
+  // Other people's selections, in their colour.
+  for (const [client, who] of store.presence) {
+    for (const id of who.selection || []) {
+      const p = placementById(id);
+      if (!p) continue;
+      outline(p, who.color || "#f0f", 3, [6, 4]);
+      const [x, y] = toScreen(geo.toUV(p, [0, 1]));
+      ctx.fillStyle = who.color || "#f0f";
+      ctx.fillText(client, x, y + 12);
+    }
+  }
+  const prim = store.selection.length ? placementById(store.selection[0]) : null;
+  if (prim) drawHandles(shown(prim));
+}
+
+function outline(p, color, width, dash = []) {
+  const c = geo.corners(p).map(toScreen);
+  ctx.strokeStyle = color;
+  ctx.lineWidth = width;
+  ctx.setLineDash(dash);
+  ctx.beginPath();
+  ctx.moveTo(...c[0]);
+  for (let i = 1; i < 4; ++i) ctx.lineTo(...c[i]);
+  ctx.closePath();
+  ctx.stroke();
+  ctx.setLineDash([]);
+}
+
+function drawFootprint(p, { selected, dim, lint, hover: hovered }) {
+  const s = zoom * S();
+  const [cx, cy] = toScreen(p.center);
+  const img = image(patternImagePath(p.pattern));
+  ctx.save();
+  ctx.translate(cx, cy);
+  ctx.rotate((p.rotation * Math.PI) / 180);
+  const w = p.scale[0] * s, h = p.scale[1] * s;
+  if (img) {
+    ctx.globalAlpha = dim ? 0.18 : 0.62;
+    ctx.drawImage(img, -w / 2, -h / 2, w, h);
+    ctx.globalAlpha = 1;
+  }
+  ctx.restore();
+  const color = p.target === "displacement" ? "#ff9a7a" : "#7fd0ff";
+  outline(p, selected ? "#ffffff" : color, selected ? 2 : hovered ? 2 : 1.2, p.enabled ? [] : [4, 3]);
+  const [lx, ly] = toScreen(geo.toUV(p, [0, 0]));
+  ctx.font = "11px system-ui, sans-serif";
+  ctx.fillStyle = dim ? "#8d99a8" : color;
+  ctx.fillText(p.label || p.id, lx + 2, ly - 3);
+  if (lint.length) {
+    const [tx, ty] = toScreen(geo.toUV(p, [1, 0]));
+    ctx.fillStyle = "#ffb454";
+    ctx.beginPath();
+    ctx.moveTo(tx, ty - 16);
+    ctx.lineTo(tx + 9, ty - 1);
+    ctx.lineTo(tx - 9, ty - 1);
+    ctx.closePath();
+    ctx.fill();
+    ctx.fillStyle = "#111";
+    ctx.font = "bold 10px system-ui, sans-serif";
+    ctx.fillText(lint.length > 1 ? String(lint.length) : "!", tx - 3, ty - 3);
+  }
+}
+
+function handlePoints(p) {
+  const c = geo.corners(p).map(toScreen);
+  const r = toScreen(geo.rotationHandle(p, pxToUV(ROTATE_OFFSET_PX)));
+  const top = toScreen(geo.toUV(p, [0.5, 0]));
+  return { corners: c, rotate: r, top };
+}
+
+function drawHandles(p) {
+  const hp = handlePoints(p);
+  ctx.strokeStyle = "#ffffff";
+  ctx.lineWidth = 1;
+  ctx.beginPath();
+  ctx.moveTo(...hp.top);
+  ctx.lineTo(...hp.rotate);
+  ctx.stroke();
+  ctx.fillStyle = "#5fb3ff";
+  for (const [x, y] of hp.corners) {
+    ctx.fillRect(x - HANDLE_PX / 2, y - HANDLE_PX / 2, HANDLE_PX, HANDLE_PX);
+    ctx.strokeRect(x - HANDLE_PX / 2, y - HANDLE_PX / 2, HANDLE_PX, HANDLE_PX);
+  }
+  ctx.beginPath();
+  ctx.arc(hp.rotate[0], hp.rotate[1], HANDLE_PX / 2 + 1, 0, Math.PI * 2);
+  ctx.fill();
+  ctx.stroke();
+}
+
+/// What is under css pixel (x, y): {kind: scale, corner} | {kind: rotate} on the primary
+/// selection's handles, {kind: move, id} on a footprint, or null.
+function under(x, y) {
+  const prim = store.selection.length ? placementById(store.selection[0]) : null;
+  if (prim) {
+    const hp = handlePoints(shown(prim));
+    const near = (pt, r) => Math.hypot(pt[0] - x, pt[1] - y) <= r;
+    if (near(hp.rotate, HANDLE_PX)) return { kind: "rotate", id: prim.id };
+    for (let k = 0; k < 4; ++k) if (near(hp.corners[k], HANDLE_PX)) return { kind: "scale", id: prim.id, corner: k };
+  }
+  const p = geo.hit(store.doc.placements.map(shown), toUV(x, y));
+  return p ? { kind: "move", id: p.id } : null;
+}
+
+function local(e) {
+  const r = canvas.getBoundingClientRect();
+  return [e.clientX - r.left, e.clientY - r.top];
+}
+
+function pointerDown(e) {
+  if (!store.doc) return;
+  canvas.focus();
+  const [x, y] = local(e);
+  const uv = toUV(x, y);
+  if (e.button === 1 || e.button === 2) {
+    drag = { kind: "pan", start: [x, y], orig: [ox, oy] };
+    canvas.setPointerCapture(e.pointerId);
+    return;
+  }
+  if (e.button !== 0) return;
+  const what = under(x, y);
+  if (!what) {
+    if (!e.shiftKey) set({ selection: [] });
+    drag = { kind: "pan", start: [x, y], orig: [ox, oy] };
+    canvas.classList.add("grab");
+    canvas.setPointerCapture(e.pointerId);
+    return;
+  }
+  if (what.kind === "move") {
+    if (e.shiftKey) {
+      const sel = store.selection.includes(what.id) ? store.selection.filter((i) => i !== what.id) : [what.id, ...store.selection];
+      set({ selection: sel });
+      return;
+    }
+    if (store.selection[0] !== what.id) set({ selection: [what.id, ...store.selection.filter((i) => i !== what.id)] });
+  }
+  if (store.pinnedRevision !== null) return; // an old revision is shown: no edits until the person leaves it
+  const orig = { ...placementById(what.id) };
+  drag = { ...what, start: uv, orig, value: null,
+           stream: new Stream((fields) => patchPlacement(what.id, fields, { undoable: false })) };
+  canvas.setPointerCapture(e.pointerId);
+}
+
+function pointerMove(e) {
+  const [x, y] = local(e);
+  const uv = toUV(x, y);
+  store.cursorUV = uv;
+  if (!drag) {
+    const what = store.doc ? under(x, y) : null;
+    const id = what ? what.id : null;
+    canvas.style.cursor = !what ? "crosshair" : what.kind === "move" ? "move" : what.kind === "rotate" ? "alias" : "nwse-resize";
+    if (id !== hover) { hover = id; redraw(); }
+    if (what && what.kind === "move") {
+      const lint = store.lint.filter((f) => f.placement === what.id).map((f) => f.message);
+      canvas.title = [what.id, ...lint].join("\n");
+    } else canvas.title = "";
+    return;
+  }
+  if (drag.kind === "pan") {
+    ox = drag.orig[0] + x - drag.start[0];
+    oy = drag.orig[1] + y - drag.start[1];
+    redraw();
+    return;
+  }
+  const o = drag.orig;
+  if (drag.kind === "move") drag.value = geo.moved(o, drag.start, uv);
+  else if (drag.kind === "rotate") drag.value = geo.rotated(o, uv, e.shiftKey);
+  else drag.value = geo.scaled(o, drag.corner, uv, e.shiftKey);
+  drag.stream.send(drag.value);
+  emit("drag");
+  redraw();
+}
+
+async function pointerUp(e) {
+  canvas.classList.remove("grab");
+  if (!drag) return;
+  const d = drag;
+  drag = null;
+  if (d.kind === "pan") return;
+  if (!d.value) { d.stream.done = true; return; }
+  await d.stream.finish();
+  redraw();
+}
+
+/// Cancels a running drag: restores the placement (see Stream.cancel). True when one ran.
+export function cancelDrag() {
+  if (!drag || drag.kind === "pan") return false;
+  const d = drag;
+  drag = null;
+  d.stream.cancel().then(redraw);
+  redraw();
+  return true;
+}
+
+function wheel(e) {
+  e.preventDefault();
+  const [x, y] = local(e);
+  const before = toUV(x, y);
+  zoom = Math.min(Math.max(zoom * Math.exp(-e.deltaY * 0.0015), 0.2), 40);
+  ox = x - before[0] * zoom * S();
+  oy = y - before[1] * zoom * S();
+  fitted = true;
+  redraw();
+}
+
+/// One texel of the height map in UV units (for nudges).
+export const texelUV = () => 1 / heightmapSize()[0];
