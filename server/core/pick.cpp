@@ -2,6 +2,7 @@
 #include "pick.hpp"
 
 #include "camera.hpp"
+#include "uv_lookup.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -54,6 +55,32 @@ std::vector<std::pair<int, float>> weightsAt(const MeshPart& p, std::size_t base
 
 } // namespace
 
+static FrameCamera cameraOf(const FramePlan& plan, const Model& model, const std::vector<SkinnedPart>& posed) {
+    const Bounds bounds = framingBounds(posed);
+    const double disp = plan.render.displacementScale ? *plan.render.displacementScale
+                                                      : autoDisplacementScale(model);
+    return frameCamera(bounds.min, bounds.max, disp, plan.render.camera, plan.render.size[0],
+                       plan.render.size[1]);
+}
+
+FrameCamera planCamera(const FramePlan& plan, const Model& model) {
+    return cameraOf(plan, model, skin(model, plan.world));
+}
+
+std::optional<PickHit> pickUv(const Model& model, const UvLookup& lookup, glm::dvec2 uv) {
+    const auto h = lookup.find(uv);
+    if (!h) return std::nullopt;
+    const MeshPart& part = model.parts[static_cast<std::size_t>(h->part)];
+    PickHit hit;
+    hit.part = h->part;
+    hit.triangle = h->triangle;
+    hit.bary = h->bary;
+    hit.uv = glm::vec2(uv);
+    hit.position = lookup.position(*h);
+    hit.joints = weightsAt(part, 3 * static_cast<std::size_t>(h->triangle), h->bary);
+    return hit;
+}
+
 Result<std::optional<PickHit>> pickFrame(const FramePlan& plan, const Model& model, double x, double y) {
     const char* where = "dermis::pickFrame";
     const int W = plan.render.size[0], H = plan.render.size[1];
@@ -62,10 +89,7 @@ Result<std::optional<PickHit>> pickFrame(const FramePlan& plan, const Model& mod
     if (!std::isfinite(y) || y < 0.0 || y >= H)
         return makeError(ErrorCode::InvalidArgument, where, "y", "must be in [0, " + std::to_string(H) + ")");
     const std::vector<SkinnedPart> posed = skin(model, plan.world);
-    const Bounds bounds = framingBounds(posed);
-    const double disp = plan.render.displacementScale ? *plan.render.displacementScale
-                                                      : autoDisplacementScale(model);
-    const FrameCamera cam = frameCamera(bounds.min, bounds.max, disp, plan.render.camera, W, H);
+    const FrameCamera cam = cameraOf(plan, model, posed);
     const Ray ray = pixelRay(cam, {x, y});
     std::optional<PickHit> best;
     for (std::size_t pi = 0; pi < posed.size() && pi < model.parts.size(); ++pi) {

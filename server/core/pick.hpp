@@ -8,6 +8,7 @@
 // fraction of a millisecond).
 #pragma once
 
+#include "camera.hpp"
 #include "frame_plan.hpp"
 
 #include <optional>
@@ -29,6 +30,16 @@ struct PickHit {
 /// The nearest posed triangle under pixel (x, y) (pixel coordinates of core/camera: the centre
 /// of pixel (col, row) is (col + 0.5, row + 0.5)) of the frame `plan` renders; nullopt on the
 /// background. Fails (InvalidArgument, field "x"/"y") when the pixel is outside the frame.
+/// The camera the renderer uses for `plan` (core/camera frameCamera on the posed bounds, with the
+/// plan's displacement scale): "auto" distance resolved. Pure; never fails.
+FrameCamera planCamera(const FramePlan& plan, const Model& model);
+
+class UvLookup;
+/// The skin at texture point `uv` (SPEC §6 pick by UV, for the texture view): the rest-mesh
+/// triangle there (`position` in bind space, `distance` 0) and its top-4 skin weights; nullopt
+/// where no UV chart is. `lookup` must index `model`.
+std::optional<PickHit> pickUv(const Model& model, const UvLookup& lookup, glm::dvec2 uv);
+
 Result<std::optional<PickHit>> pickFrame(const FramePlan& plan, const Model& model, double x, double y);
 
 struct SuggestedDriver {

@@ -1,11 +1,27 @@
 // Dermis HTTP shell — inspection routes (SPEC §6, CPU only): probe (why a texel has its height)
-// activation (each placement's t over a clip, with flags) and lint.
+// activation (each placement's t over a clip, with flags), lint, pick (a frame pixel or a texture
+// point) and drivers (each placement's θ and t now).
 #include "http/api_internal.hpp"
+
+#include <cmath>
 
 namespace dermis::api_detail {
 
 void installInspectRoutes(RouteTable& t) {
     t.add("GET", "/scenes/{id}/pick", [](Api::Impl& a, const Req& req, Res& res) {
+        if (req.has_param("u") || req.has_param("v")) { // texture point (the texture view)
+            std::optional<double> u, v;
+            if (!numberParam(req, res, "u", u) || !numberParam(req, res, "v", v)) return;
+            if (!u || !v)
+                return sendError(res, 422, "invalid_argument", "dermis::Api: u and v are both required",
+                                 !u ? "u" : "v");
+            if (req.has_param("x") || req.has_param("y"))
+                return sendError(res, 422, "invalid_argument",
+                                 "dermis::Api: pick takes a frame pixel (x, y) or a texture point (u, v), not both", "u");
+            auto r = a.svc.pickUv(req.matches[1], *u, *v);
+            if (!r) return sendError(res, r.error());
+            return sendJson(res, 200, *r);
+        }
         FrameParams p;
         std::optional<double> x, y;
         if (!numberParam(req, res, "x", x) || !numberParam(req, res, "y", y) ||
@@ -38,6 +54,23 @@ void installInspectRoutes(RouteTable& t) {
         if (!req.has_param("clip"))
             return sendError(res, 422, "invalid_argument", "dermis::Api: clip is required", "clip");
         auto r = a.svc.activation(req.matches[1], req.get_param_value("clip"), fps.value_or(30.0));
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
+    t.add("GET", "/scenes/{id}/drivers", [](Api::Impl& a, const Req& req, Res& res) {
+        FrameParams p;
+        std::optional<double> revision;
+        if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
+            !numberParam(req, res, "yaw", p.yaw) || !numberParam(req, res, "pitch", p.pitch) ||
+            !numberParam(req, res, "distance", p.distance) || !numberParam(req, res, "time", p.time) ||
+            !numberParam(req, res, "revision", revision))
+            return;
+        if (revision) {
+            if (*revision < 1 || *revision != std::floor(*revision) || *revision > 1e15)
+                return sendError(res, 422, "invalid_argument", "dermis::Api: revision: must be a revision number >= 1", "revision");
+            p.revision = static_cast<std::uint64_t>(*revision);
+        }
+        auto r = a.svc.drivers(req.matches[1], p);
         if (!r) return sendError(res, r.error());
         sendJson(res, 200, *r);
     });

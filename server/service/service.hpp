@@ -228,6 +228,16 @@ public:
     /// suggested: {joint, axis, theta_min, theta_max}} (core pickFrame, suggestDriver). Fails
     /// on a pixel outside the frame (field "x"/"y") and like frame() on bad parameters.
     Result<nlohmann::json> pick(const std::string& id, const FrameParams& params, double x, double y);
+    /// The same answer for texture point (u, v) (the texture view's pick; core pickUv): the rest
+    /// mesh there, `position` in bind space. {hit: false} where no UV chart is; fails on u, v
+    /// outside [0, 1] (field "u"/"v") and on a model without UVs (field "u").
+    Result<nlohmann::json> pickUv(const std::string& id, double u, double v);
+    /// What drives each placement at the frame `params` describe (time, revision, camera):
+    /// {scene, revision, time, camera: {yaw, pitch, distance} (the renderer's, "auto" resolved),
+    /// placements: [{placement, joint, axis, theta, t, enabled}]} — θ in degrees (SPEC §2) and t
+    /// = clamp((θ − θmin)/(θmax − θmin), 0, 1), for the editor's dial and sliders. Fails like
+    /// frame() on bad parameters.
+    Result<nlohmann::json> drivers(const std::string& id, const FrameParams& params);
     /// Why a texel has its height (SPEC §6 Probe): {u, v, texel: [x, y], map_size, base, bump,
     /// displacement, contributions: [{placement, pattern, target, t, L, height}]} at the texel of
     /// the scene's maps containing (u, v), at `time` (default the scene's pose time). Fails on u

@@ -5,6 +5,8 @@
 #include "service/service_state.hpp"
 
 #include "core/activation.hpp"
+#include "core/deform.hpp"
+#include "core/uv_lookup.hpp"
 #include "core/lint.hpp"
 #include "core/pick.hpp"
 #include "core/probe.hpp"
@@ -20,7 +22,23 @@ namespace {
 
 /// Seconds and t values rounded to 1e-6 (keeps the JSON short; far below what a person reads).
 double rounded(double x) {
-    return std::round(x * 1e6) / 1e6;
+    return std::round(x * 1e6) / 1e6 + 0.0; // + 0.0: no "-0" in the JSON
+}
+
+/// The pick answer of a hit (shared by the frame and texture picks).
+json pickAnswer(const Model& m, const PickHit& h) {
+    json joints = json::array();
+    for (auto [node, weight] : h.joints)
+        joints.push_back({{"name", m.nodes[static_cast<std::size_t>(node)].name}, {"weight", weight}});
+    const SuggestedDriver d = suggestDriver(m, h.joints);
+    return json{{"hit", true},
+                {"uv", {h.uv.x, h.uv.y}},
+                {"position", {h.position.x, h.position.y, h.position.z}},
+                {"part", h.part},
+                {"triangle", h.triangle},
+                {"joints", std::move(joints)},
+                {"suggested", {{"joint", d.joint}, {"axis", d.axis}, {"theta_min", d.thetaMin},
+                               {"theta_max", d.thetaMax}}}};
 }
 
 } // namespace
@@ -120,20 +138,46 @@ Result<json> Service::pick(const std::string& id, const FrameParams& params, dou
     auto hit = pickFrame(*plan, *snap->model, x, y);
     if (!hit) return hit.error();
     if (!*hit) return json{{"hit", false}};
+    return pickAnswer(*snap->model, **hit);
+}
+
+
+Result<json> Service::pickUv(const std::string& id, double u, double v) {
+    if (!std::isfinite(u) || u < 0.0 || u > 1.0) return bad("u", "must be in [0, 1]");
+    if (!std::isfinite(v) || v < 0.0 || v > 1.0) return bad("v", "must be in [0, 1]");
+    auto snap = state_->snapshot(id);
+    if (!snap) return snap.error();
+    if (!snap->model->hasUVs()) return bad("u", "the model has no UVs: nothing lies at a texture point");
+    const UvLookup lookup(*snap->model);
+    const auto hit = dermis::pickUv(*snap->model, lookup, {u, v});
+    if (!hit) return json{{"hit", false}};
+    return pickAnswer(*snap->model, *hit);
+}
+
+Result<json> Service::drivers(const std::string& id, const FrameParams& params) {
+    auto snap = state_->frameSnapshot(id, params);
+    if (!snap) return snap.error();
+    auto plan = state_->plan(*snap, params);
+    if (!plan) return asParamError(plan.error(), params);
     const Model& m = *snap->model;
-    json joints = json::array();
-    for (auto [node, weight] : (*hit)->joints)
-        joints.push_back({{"name", m.nodes[static_cast<std::size_t>(node)].name}, {"weight", weight}});
-    const SuggestedDriver d = suggestDriver(m, (*hit)->joints);
-    const PickHit& h = **hit;
-    return json{{"hit", true},
-                {"uv", {h.uv.x, h.uv.y}},
-                {"position", {h.position.x, h.position.y, h.position.z}},
-                {"part", h.part},
-                {"triangle", h.triangle},
-                {"joints", std::move(joints)},
-                {"suggested", {{"joint", d.joint}, {"axis", d.axis}, {"theta_min", d.thetaMin},
-                               {"theta_max", d.thetaMax}}}};
+    json placements = json::array();
+    for (std::size_t i = 0; i < snap->scene.placements.size(); ++i) {
+        const Placement& p = snap->scene.placements[i];
+        auto theta = placementAngle(m, plan->pose, p, i);
+        if (!theta) return theta.error();
+        placements.push_back({{"placement", p.id},
+                              {"joint", p.joint},
+                              {"axis", p.axisName.empty() ? json(p.axis) : json(p.axisName)},
+                              {"theta", rounded(*theta)},
+                              {"t", rounded(normalizedT(*theta, p.thetaMin, p.thetaMax))},
+                              {"enabled", p.enabled}});
+    }
+    const FrameCamera cam = planCamera(*plan, m);
+    const Camera& c = plan->render.camera;
+    return json{{"scene", id},
+                {"time", params.time.value_or(snap->scene.pose.time)},
+                {"camera", {{"yaw", c.yaw}, {"pitch", c.pitch}, {"distance", rounded(cam.distance)}}},
+                {"placements", std::move(placements)}};
 }
 
 } // namespace dermis

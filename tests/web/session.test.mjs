@@ -88,7 +88,7 @@ try {
   assert.equal(edited.status, 200);
   await page.waitForFunction((rev) => window.heard.some((e) => e.revision === rev), edited.body.revision, { timeout: 10000 });
   // …and the page's own stream shows it too.
-  await page.waitForFunction((rev) => document.getElementById("status").textContent.includes(`revision ${rev}`), edited.body.revision, { timeout: 30000 });
+  await page.waitForFunction((rev) => document.getElementById("revision").textContent === `r${rev}`, edited.body.revision, { timeout: 30000 });
 
   // An edit from the page with the cookie alone.
   const fromPage = await page.evaluate(async (id) => {

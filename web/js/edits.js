@@ -32,12 +32,26 @@ export function accept(answer, topic = "doc") {
   set(fields, topic + " revision");
 }
 
-/// Sends one edit (method, path under the scene, body) with If-Match. Resolves to the answer,
-/// or null when the server refused it (the notice is shown). `undoable` records it for undo.
-export async function edit(method, path, body, { undoable = true, quiet = false } = {}) {
+let queue = Promise.resolve(); // this editor's edits, one at a time, in order
+
+/// Sends one edit (method, path under the scene, body) with If-Match. Edits run one at a time in
+/// the order asked, each with the revision its predecessor left; `body` may be a function of the
+/// current document, called when the edit's turn comes (so quick key repeats add up). Resolves to
+/// the answer, or null when the server refused it (the notice is shown) or `body` gave null.
+/// `undoable` records it for undo.
+export function edit(method, path, body, opts = {}) {
+  ++store.busy;
+  const run = queue.then(() => send(method, path, body, opts)).finally(() => { --store.busy; });
+  queue = run.catch(() => {});
+  return run;
+}
+
+async function send(method, path, body, { undoable = true, quiet = false } = {}) {
   const before = store.revision;
+  const payload = typeof body === "function" ? body(store.doc) : body;
+  if (payload === null) return null;
   try {
-    const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, body, before);
+    const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, payload, before);
     accept(answer);
     if (undoable) {
       undoStack.push(before);
@@ -91,7 +105,9 @@ export async function redo() {
   emit("undo");
 }
 
-/// A stream of edits from one gesture (a drag, a slider). send(value) queues the newest value;
+/// A stream of edits from one gesture (a drag, a slider). send(value) queues the newest value
+/// (the first leaves one interval after the stream starts, so a gesture cancelled at once sends
+/// nothing);
 /// finish() resolves once the last value is on the server. cancel() sends nothing more and, when
 /// edits were already sent, reverts to the revision before the gesture.
 export class Stream {
@@ -100,7 +116,7 @@ export class Stream {
     this.interval = interval;
     this.pending = undefined; // newest value not yet sent
     this.inFlight = null;
-    this.lastSent = 0;
+    this.lastSent = performance.now(); // the first edit leaves one interval after the gesture starts
     this.sent = 0;
     this.before = store.revision;
     this.timer = null;

@@ -13,13 +13,13 @@ import * as geo from "./geometry.js";
 import { notify } from "./notice.js";
 import { addPlacement } from "./edits.js";
 import { placementFromPattern } from "./placing.js";
+import { trace } from "./trace.js";
 
 let api, stage, img, cmpImg, spinner, splitHandle, sizeSelect;
 let flickerTimer = null;
 let placeTool = false;
 const FRAME_SIZES = [384, 512, 768, 1024];
 export let frameSize = 512;
-let autoDistance = null; // the server's camera distance when the scene says "auto"
 export const frameStats = { shown: 0, requested: 0, times: [] };
 
 /// Loads URLs into one <img>: at most one fetch in flight, the newest wanted URL next; `onShown`
@@ -50,8 +50,6 @@ class FrameLoader {
     this.slowTimer = setTimeout(() => { spinner.hidden = false; }, 500);
     try {
       const r = await api.raw("GET", job.url);
-      const d = r.headers.get("X-Dermis-Camera-Distance");
-      if (d && store.camera.distance === null) autoDistance = +d;
       const changed = r.headers.get("X-Dermis-Changed-Pixels");
       const blob = await r.blob();
       if (job.seq > this.shownSeq) {
@@ -112,6 +110,7 @@ export function initFrameView(section, theApi) {
   sizeSelect.value = String(frameSize);
   mainLoader = new FrameLoader(img, (job, now) => {
     frameStats.shown++;
+    if (trace.on) trace.frames.push({ t0: job.t0, shownAt: now });
     frameStats.times.push(now - job.t0);
     if (frameStats.times.length > 1000) frameStats.times.shift();
     img.alt = "rendered frame";
@@ -256,7 +255,7 @@ function orbit(el) {
   });
   el.addEventListener("wheel", (e) => {
     e.preventDefault();
-    const d = store.camera.distance ?? autoDistance ?? 3;
+    const d = store.camera.distance ?? (store.liveCamera && store.liveCamera.distance) ?? 3;
     const next = Math.min(Math.max(d * Math.exp(e.deltaY * 0.001), 0.05), 1000);
     set({ camera: { ...store.camera, distance: Math.round(next * 1000) / 1000 } });
   }, { passive: false });

@@ -72,13 +72,13 @@ function onKey(e, { dlg, fitTexture }) {
   else if (k.startsWith("Arrow") && sel.length) {
     const step = (e.shiftKey ? 10 : 1) / heightmapSize()[0];
     const d = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, -step], ArrowDown: [0, step] }[k];
-    each((p) => patchPlacement(p.id, { center: [geo.round4(p.center[0] + d[0]), geo.round4(p.center[1] + d[1])] }));
+    each((p) => patchPlacement(p.id, now(p.id, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }))));
   } else if ((k === "[" || k === "]" || k === "{" || k === "}") && sel.length) {
     const step = (e.shiftKey ? 15 : 5) * (k === "[" || k === "{" ? -1 : 1);
-    each((p) => patchPlacement(p.id, { rotation: geo.round4(geo.wrapDegrees(p.rotation + step)) }));
+    each((p) => patchPlacement(p.id, now(p.id, (q) => ({ rotation: geo.round4(geo.wrapDegrees(q.rotation + step)) }))));
   } else if ((k === "+" || k === "=" || k === "-" || k === "_") && sel.length) {
     const f = k === "+" || k === "=" ? 1.05 : 1 / 1.05;
-    each((p) => patchPlacement(p.id, { scale: [geo.round4(p.scale[0] * f), geo.round4(p.scale[1] * f)] }));
+    each((p) => patchPlacement(p.id, now(p.id, (q) => ({ scale: [geo.round4(q.scale[0] * f), geo.round4(q.scale[1] * f)] }))));
   } else if ((k === "Delete" || k === "Backspace") && sel.length) {
     sel.forEach((id) => deletePlacement(id));
     set({ selection: [] });
@@ -92,6 +92,12 @@ function onKey(e, { dlg, fitTexture }) {
   else handled = false;
   if (handled) e.preventDefault();
 }
+
+/// An edit body computed from placement `id` as it is when the edit's turn comes (null: gone).
+const now = (id, fn) => (doc) => {
+  const q = doc && doc.placements.find((p) => p.id === id);
+  return q ? fn(q) : null;
+};
 
 /// Switches the single view between texture and 3D; side by side, moves focus to the other view.
 export function switchView() {

@@ -9,7 +9,7 @@ import { signIn } from "./signin.js";
 import { notify } from "./notice.js";
 import { initImages, forget } from "./images.js";
 import { initEdits, accept, clearUndo, canUndo, canRedo, putScene, undo, redo, revert } from "./edits.js";
-import { initTextureView, fit } from "./texture_view.js";
+import { initTextureView, fit, screenGeometry } from "./texture_view.js";
 import { initFrameView, setPatternSource, setFrameSize, frameStats, frameUrl, pickAt } from "./frame_view.js";
 import { initLibrary, currentPattern, uploadPattern } from "./panels/library.js";
 import { initPlacements } from "./panels/placements.js";
@@ -21,6 +21,7 @@ import { initKeys, setKeysApi } from "./keys.js";
 import { initLive, connect, disconnect } from "./live.js";
 import { initPermalink, readLink, copyLink } from "./permalink.js";
 import { openCopyDialog } from "./copy_placements.js";
+import { trace, clearTrace } from "./trace.js";
 
 const $ = (id) => document.getElementById(id);
 const api = new Api({ client: makeClientName(), signIn });
@@ -177,6 +178,6 @@ async function start() {
 }
 
 // For tests and benchmarks: a read-only look at the editor's state and its frame statistics.
-window.dermisEditor = { store, frameStats, frameUrl, pickAt, disconnect, connect, api };
+window.dermisEditor = { store, frameStats, frameUrl, pickAt, disconnect, connect, api, screenGeometry, trace, clearTrace };
 
 start();

@@ -23,6 +23,7 @@ export const store = {
   compare: { mode: "off", against: "off", split: 0.5 },
   overlay: "none",      // texture view: none | bump | displacement
   cursorUV: [0.5, 0.5], // last pointer position in the texture view
+  liveCamera: null,     // the camera the server used (GET drivers: "auto" distance resolved)
   online: true,
   busy: 0,
 };

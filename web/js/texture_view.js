@@ -11,6 +11,7 @@ import { store, on, emit, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
 import { image, onImageLoaded, patternImagePath } from "./images.js";
 import { Stream, patchPlacement } from "./edits.js";
+import { trace } from "./trace.js";
 
 const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26;
 
@@ -253,6 +254,10 @@ function local(e) {
   return [e.clientX - r.left, e.clientY - r.top];
 }
 
+function capture(e) {
+  try { canvas.setPointerCapture(e.pointerId); } catch { /* a synthetic pointer (scripts, tests) */ }
+}
+
 function pointerDown(e) {
   if (!store.doc) return;
   canvas.focus();
@@ -260,7 +265,7 @@ function pointerDown(e) {
   const uv = toUV(x, y);
   if (e.button === 1 || e.button === 2) {
     drag = { kind: "pan", start: [x, y], orig: [ox, oy] };
-    canvas.setPointerCapture(e.pointerId);
+    capture(e);
     return;
   }
   if (e.button !== 0) return;
@@ -269,7 +274,7 @@ function pointerDown(e) {
     if (!e.shiftKey) set({ selection: [] });
     drag = { kind: "pan", start: [x, y], orig: [ox, oy] };
     canvas.classList.add("grab");
-    canvas.setPointerCapture(e.pointerId);
+    capture(e);
     return;
   }
   if (what.kind === "move") {
@@ -283,8 +288,13 @@ function pointerDown(e) {
   if (store.pinnedRevision !== null) return; // an old revision is shown: no edits until the person leaves it
   const orig = { ...placementById(what.id) };
   drag = { ...what, start: uv, orig, value: null,
-           stream: new Stream((fields) => patchPlacement(what.id, fields, { undoable: false })) };
-  canvas.setPointerCapture(e.pointerId);
+           stream: new Stream(async (fields) => {
+             const sentAt = performance.now();
+             const answer = await patchPlacement(what.id, fields, { undoable: false });
+             if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
+             return answer;
+           }) };
+  capture(e);
 }
 
 function pointerMove(e) {
@@ -312,6 +322,7 @@ function pointerMove(e) {
   if (drag.kind === "move") drag.value = geo.moved(o, drag.start, uv);
   else if (drag.kind === "rotate") drag.value = geo.rotated(o, uv, e.shiftKey);
   else drag.value = geo.scaled(o, drag.corner, uv, e.shiftKey);
+  if (trace.on) trace.moves.push(performance.now());
   drag.stream.send(drag.value);
   emit("drag");
   redraw();
@@ -347,6 +358,19 @@ function wheel(e) {
   oy = y - before[1] * zoom * S();
   fitted = true;
   redraw();
+}
+
+/// Where placement `id` is on screen (client px): centre, corners, rotation handle — for tests
+/// and for scripted use; null when it is not drawn.
+export function screenGeometry(id) {
+  const p0 = placementById(id);
+  if (!p0 || !canvas) return null;
+  const p = shown(p0);
+  const r = canvas.getBoundingClientRect();
+  const abs = ([x, y]) => [r.left + x, r.top + y];
+  const hp = handlePoints(p);
+  return { center: abs(toScreen(p.center)), corners: hp.corners.map(abs), rotate: abs(hp.rotate),
+           pxPerUV: zoom * S(), uvAt: (x, y) => toUV(x - r.left, y - r.top) };
 }
 
 /// One texel of the height map in UV units (for nudges).

@@ -32,6 +32,7 @@ async function loadDrivers() {
     const answer = await api.get(`/scenes/${store.sceneId}/drivers${query({ time: shownTime(), revision: store.revision })}`);
     if (key !== driversKey) return;
     drivers = new Map(answer.placements.map((d) => [d.placement, d]));
+    store.liveCamera = answer.camera;
     drawLive();
   } catch (e) { drivers = new Map(); }
 }

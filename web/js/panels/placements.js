@@ -20,8 +20,10 @@ export function initPlacements(section) {
 
 export function toggleEnabled(ids) {
   for (const id of ids) {
-    const p = store.doc.placements.find((q) => q.id === id);
-    if (p) patchPlacement(id, { enabled: !p.enabled });
+    patchPlacement(id, (doc) => {
+      const p = doc.placements.find((q) => q.id === id);
+      return p ? { enabled: !p.enabled } : null;
+    });
   }
 }
 
