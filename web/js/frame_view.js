@@ -114,6 +114,7 @@ export function initFrameView(section, theApi) {
     frameStats.times.push(now - job.t0);
     if (frameStats.times.length > 1000) frameStats.times.shift();
     img.alt = "rendered frame";
+    if (store.compare.mode === "diff") document.getElementById("diffText").textContent = `${img.dataset.changedPixels || "?"} px changed`;
     img.dataset.seq = String(job.seq);
   });
   cmpLoader = new FrameLoader(cmpImg);

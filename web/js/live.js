@@ -15,10 +15,27 @@ export function initLive(theApi, reloadScene) {
   reload = reloadScene;
   color = `hsl(${Math.floor(Math.random() * 360)}, 75%, 62%)`;
   on("selection", announce);
+  on("presence", renderPeople);
   setInterval(expirePresence, 2000);
 }
 
 export const myColor = () => color;
+
+/// The people on this scene, as chips in their colour (title: what they have selected).
+function renderPeople() {
+  const box = document.getElementById("people");
+  if (!box) return;
+  box.innerHTML = "";
+  for (const [client, who] of store.presence) {
+    const chip = document.createElement("span");
+    chip.className = "person";
+    chip.dataset.client = client;
+    chip.style.background = who.color || "#ccc";
+    chip.textContent = client;
+    chip.title = who.selection.length ? `${client} has ${who.selection.join(", ")} selected` : `${client} is here`;
+    box.append(chip);
+  }
+}
 
 /// Opens the event stream of the current scene (closing any other).
 export function connect() {

@@ -1,0 +1,110 @@
+// WebEditorCollabBrowserTest — several people, links and a dropped connection, in Debian's
+// Chromium (playwright-core) against a real dermis-server on 127.0.0.1.
+// Usage: node editor_collab.test.mjs <dermis-server executable>   (exit 0 = pass)
+// Checks: an edit in one browser context appears in another within 1 s; the other's selection
+// shows as presence; a stale edit (its sender had not heard of the first change) shows the 412
+// notice and leaves the first person's change intact; a permalink opened in a fresh context gives
+// the identical frame (SHA-256 of the bytes); killing the server shows the offline banner, which
+// clears when it is back (same port, same data) and the editor re-syncs.
+import assert from "node:assert/strict";
+import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, until, sleep } from "./editor_lib.mjs";
+
+const exe = process.argv[2];
+let server = await startServer(exe, [], "dermis-editor-collab-");
+const api = apiClient(server.base);
+const browser = await launch();
+let failures = 1;
+try {
+  const ctxA = await browser.newContext(), ctxB = await browser.newContext();
+  const a = await openEditor(ctxA, server.base + "/");
+  const sceneId = (await state(a)).sceneId;
+  const b = await openEditor(ctxB, `${server.base}/?scene=${sceneId}`);
+  const serverPlacement = async (id) => (await api("GET", `/scenes/${sceneId}`)).body.scene.placements.find((p) => p.id === id);
+  const select = async (page, id) => { await page.click(`#placementList li[data-placement="${id}"] .name`); await page.focus("#uv"); };
+
+  failures = await runChecks("WebEditorCollabBrowserTest", [
+    ["an edit in one context appears in the other within 1 s", async () => {
+      assert.equal((await state(b)).sceneId, sceneId);
+      await select(a, "stomach");
+      const before = (await state(b)).doc.placements.find((p) => p.id === "stomach");
+      const t0 = Date.now();
+      await a.keyboard.press("Shift+ArrowRight");
+      await b.waitForFunction((x) => window.dermisEditor.store.doc.placements.find((p) => p.id === "stomach").center[0] > x + 0.005, before.center[0], { timeout: 1000 });
+      console.log(`    seen by the other context after ${Date.now() - t0} ms`);
+    }],
+    ["the other person's selection shows as presence", async () => {
+      const meA = await a.$eval("#me", (e) => e.textContent);
+      await b.waitForFunction((who) => { const p = window.dermisEditor.store.presence.get(who); return p && p.selection.includes("stomach"); }, meA, { timeout: 5000 });
+      const chip = await b.$eval(`#people .person[data-client="${meA}"]`, (e) => e.title);
+      assert.match(chip, /stomach/);
+    }],
+    ["a stale edit shows the 412 notice and leaves the first change intact", async () => {
+      // B stops hearing events, so it edits an old revision.
+      await b.evaluate(() => window.dermisEditor.disconnect());
+      await select(b, "neck");
+      await select(a, "neck");
+      const neck0 = await serverPlacement("neck");
+      await a.keyboard.press("Shift+ArrowDown");
+      const afterA = await until(async () => { const p = await serverPlacement("neck"); return p.center[1] > neck0.center[1] && p; }, "A's nudge on the server");
+      await b.keyboard.press("Shift+ArrowLeft");
+      await b.waitForFunction(() => [...document.querySelectorAll("#notices .notice")].some((n) => /Someone else changed this scene/.test(n.textContent)), null, { timeout: 5000 });
+      await sleep(300);
+      assert.deepEqual(await serverPlacement("neck"), afterA, "A's change is intact");
+      // B re-read the scene: it shows A's change now.
+      await until(async () => JSON.stringify((await state(b)).doc.placements.find((p) => p.id === "neck")) === JSON.stringify(afterA), "B re-synced");
+      await screenshot(b, "editor-stale-notice.png");
+      await b.evaluate(() => window.dermisEditor.connect());
+    }],
+    ["a permalink opened in a fresh context shows the identical frame", async () => {
+      // A orbits, scrubs the time and selects; then copies the link.
+      const stage = await a.$eval("#frameStage", (e) => { const r = e.getBoundingClientRect(); return [r.left + r.width / 2, r.top + r.height / 2]; });
+      await a.mouse.move(stage[0], stage[1]);
+      await a.mouse.down();
+      await a.mouse.move(stage[0] + 60, stage[1] + 20, { steps: 5 });
+      await a.mouse.up();
+      await a.$eval("#time", (el) => { el.value = "0.8"; el.dispatchEvent(new Event("input", { bubbles: true })); });
+      await select(a, "elbow_l");
+      await a.click("#copyLink");
+      await sleep(300);
+      const link = await a.evaluate(() => location.href);
+      assert.match(link, /scene=s_[0-9a-f]+/);
+      assert.match(link, /revision=\d+/);
+      assert.match(link, /time=0\.8/);
+      assert.match(link, /sel=elbow_l/);
+      const s = await state(a);
+      assert.notEqual(s.camera.yaw, 0);
+      const hashA = await settledFrameHash(a);
+      // Someone edits after the link was made: the link still shows its revision.
+      await api("PATCH", `/scenes/${sceneId}/placements/elbow_l`, { h: 0.3 });
+      const fresh = await browser.newContext();
+      const c = await openEditor(fresh, link);
+      const hashC = await settledFrameHash(c);
+      assert.equal(hashC, hashA);
+      const sc = await state(c);
+      assert.deepEqual(sc.selection, ["elbow_l"]);
+      assert.equal(sc.pinnedRevision, s.revision);
+      assert.ok(await c.$eval("#pinned", (e) => !e.hidden));
+      await fresh.close();
+    }],
+    ["killing the event stream shows the offline banner; it clears on reconnect", async () => {
+      const port = server.port, data = server.data;
+      await server.kill();
+      await a.waitForFunction(() => !document.getElementById("offline").hidden, null, { timeout: 10000 });
+      await screenshot(a, "editor-offline.png");
+      server = await startServer(exe, [], "dermis-editor-collab-", { port, data });
+      // An edit made while A was away: A re-syncs when it is back.
+      const edited = await api("PATCH", `/scenes/${sceneId}/placements/neck`, { h: 0.7 });
+      assert.equal(edited.status, 200);
+      await a.waitForFunction(() => document.getElementById("offline").hidden, null, { timeout: 20000 });
+      await until(async () => (await state(a)).revision === edited.body.revision, "A re-synced", 10000);
+    }],
+    ["no script errors", async () => { assert.deepEqual(a.errors, []); assert.deepEqual(b.errors, []); }],
+  ]);
+} catch (e) {
+  console.error("WebEditorCollabBrowserTest: FAILED:", e.stack || e.message);
+  failures = Math.max(failures, 1);
+} finally {
+  await browser.close();
+  server.stop();
+}
+process.exit(failures ? 1 : 0);

@@ -1,0 +1,190 @@
+// WebEditorPanelsBrowserTest — the editor's panels and 3D view in Debian's Chromium
+// (playwright-core) against a real dermis-server on 127.0.0.1, and the drag-to-frame benchmark.
+// Usage: node editor_panels.test.mjs <dermis-server executable>   (exit 0 = pass)
+// Checks: dropping a PNG uploads it, dropping a text file shows an error and posts nothing;
+// parameter edits change the server document and the response plot; a joint slider and the clip
+// scrubber change the frame; view modes; compare split / flicker / diff; the place tool adds a
+// placement at the clicked skin with the suggested driver; the activation strip jumps in time;
+// the sweep dialog; a server error appears on screen. Then 100 pointer moves of a drag are timed
+// to the frame on screen (p50/p95, JSON on stdout and in $DERMIS_TEST_OUT/editor-drag-bench.json).
+import assert from "node:assert/strict";
+import { writeFileSync } from "node:fs";
+import { join } from "node:path";
+import { startServer, launch, apiClient, openEditor, settledFrameHash, state, footprint, screenshot, runChecks, until, sleep, shotDir } from "./editor_lib.mjs";
+
+const server = await startServer(process.argv[2], [], "dermis-editor-panels-");
+const api = apiClient(server.base);
+const browser = await launch();
+let failures = 1;
+try {
+  const context = await browser.newContext();
+  const page = await openEditor(context, server.base + "/");
+  const sceneId = (await state(page)).sceneId;
+  const doc = async () => (await api("GET", `/scenes/${sceneId}`)).body.scene;
+  const select = async (id) => { await page.click(`#placementList li[data-placement="${id}"] .name`); };
+  const settle = async () => until(async () => (await state(page)).revision === (await api("GET", `/scenes/${sceneId}`)).body.revision, "the editor has the server's revision");
+  const uploads = [];
+  page.on("request", (r) => { if (r.method() === "POST" && new URL(r.url()).pathname === "/api/v1/patterns") uploads.push(r.url()); });
+  /// Drops a file (name, MIME type, bytes from `fromUrl` or the text `text`) on `selector`.
+  const dropFile = (selector, name, type, { fromUrl, text }) => page.evaluate(async ([sel, n, t, u, txt]) => {
+    const bytes = u ? await (await fetch(u)).arrayBuffer() : new TextEncoder().encode(txt);
+    const dt = new DataTransfer();
+    dt.items.add(new File([bytes], n, { type: t }));
+    const target = document.querySelector(sel);
+    target.dispatchEvent(new DragEvent("dragover", { dataTransfer: dt, bubbles: true, cancelable: true }));
+    target.dispatchEvent(new DragEvent("drop", { dataTransfer: dt, bubbles: true, cancelable: true }));
+  }, [selector, name, type, fromUrl, text]);
+  const noticeMatching = (re) => page.waitForFunction((src) => [...document.querySelectorAll("#notices .notice")].some((n) => new RegExp(src).test(n.textContent)), re.source, { timeout: 10000 });
+
+  failures = await runChecks("WebEditorPanelsBrowserTest", [
+    ["dropping a PNG on the library uploads it", async () => {
+      const n0 = (await api("GET", "/patterns")).body.patterns.length;
+      await dropFile("#patternDrop", "my_wrinkle.png", "image/png", { fromUrl: "/api/v1/patterns/crease/image?size=128" });
+      const list = await until(async () => { const l = (await api("GET", "/patterns")).body.patterns; return l.length === n0 + 1 && l; }, "one more pattern on the server");
+      const added = list.find((p) => !p.builtin);
+      assert.ok(added && /my_wrinkle/.test(added.name), JSON.stringify(added));
+      await page.waitForSelector(`#libraryList button[data-pattern="${added.id}"]`, { timeout: 5000 });
+      assert.equal(uploads.length, 1);
+    }],
+    ["dropping a text file shows an error and posts nothing", async () => {
+      uploads.length = 0;
+      await dropFile("#patternDrop", "notes.txt", "text/plain", { text: "not an image" });
+      await noticeMatching(/not an image/);
+      await sleep(300);
+      assert.equal(uploads.length, 0);
+    }],
+    ["parameter edits change the response plot and the server document", async () => {
+      await select("elbow_l");
+      const curve0 = await page.$eval("#plot", (c) => c.dataset.curve);
+      await page.fill("#pH", "0.5");
+      await page.press("#pH", "Enter");
+      await until(async () => (await doc()).placements.find((p) => p.id === "elbow_l").h === 0.5, "h = 0.5 on the server");
+      await until(async () => (await page.$eval("#plot", (c) => c.dataset.curve)) !== curve0, "the plot changed");
+      const curve1 = await page.$eval("#plot", (c) => c.dataset.curve);
+      await page.selectOption("#pResponse", "linear");
+      await until(async () => (await doc()).placements.find((p) => p.id === "elbow_l").response === "linear", "linear response on the server");
+      await until(async () => (await page.$eval("#plot", (c) => c.dataset.curve)) !== curve1, "the plot changed again");
+      assert.equal(await page.$eval("#plot", (c) => c.dataset.curve), "0.0000,0.1250,0.2500,0.3750,0.5000");
+      await page.fill("#pMax", "100");
+      await page.press("#pMax", "Enter");
+      await until(async () => (await doc()).placements.find((p) => p.id === "elbow_l").theta_max === 100, "θmax on the server");
+      await screenshot(page, "editor-parameters.png");
+    }],
+    ["a joint slider changes the pose and the frame", async () => {
+      await settle();
+      const hash0 = await settledFrameHash(page);
+      const slider = await page.$('#jointSliders input[data-joint="forearm.l"]');
+      assert.ok(slider, "a slider for forearm.l (it drives elbow_l)");
+      await slider.evaluate((el) => { el.value = "60"; el.dispatchEvent(new Event("input", { bubbles: true })); el.dispatchEvent(new Event("change", { bubbles: true })); });
+      await until(async () => { const j = (await doc()).pose.joints["forearm.l"]; return j && j.axis_angles && j.axis_angles.x === 60; }, "the pose override on the server");
+      await settle();
+      assert.notEqual(await settledFrameHash(page), hash0);
+    }],
+    ["the clip scrubber changes the frame", async () => {
+      const hash0 = await settledFrameHash(page);
+      await page.$eval("#time", (el) => { el.value = "0.4"; el.dispatchEvent(new Event("input", { bubbles: true })); });
+      assert.equal((await state(page)).time, 0.4);
+      await until(() => page.$eval("#frame", (i) => /time=0\.4(&|$)/.test(i.dataset.url || "")), "a frame at t = 0.4");
+      assert.notEqual(await settledFrameHash(page), hash0);
+    }],
+    ["compare: split, flicker and the diff heat map", async () => {
+      await page.selectOption("#compareMode", "split");
+      await page.waitForFunction(() => { const c = document.getElementById("compareFrame"); return !c.hidden && c.complete && c.naturalWidth > 0 && /patterns=off/.test(c.dataset.url || ""); }, null, { timeout: 20000 });
+      assert.match(await page.$eval("#compareFrame", (c) => c.style.clipPath), /inset/);
+      await page.$eval("#split", (el) => { el.value = "0.25"; el.dispatchEvent(new Event("input", { bubbles: true })); });
+      assert.match(await page.$eval("#compareFrame", (c) => c.style.clipPath), /25%/);
+      await screenshot(page, "editor-compare-split.png");
+      await page.selectOption("#compareMode", "flicker");
+      const seen = new Set();
+      for (let i = 0; i < 12; ++i) { seen.add(await page.$eval("#compareFrame", (c) => c.style.visibility)); await sleep(100); }
+      assert.ok(seen.has("hidden") && seen.has("visible"), [...seen].join(","));
+      await page.selectOption("#compareMode", "diff");
+      await until(() => page.$eval("#frame", (i) => /frame-diff/.test(i.dataset.url || "") && i.complete), "the diff heat map");
+      await until(() => page.$eval("#diffText", (e) => /^\d+ px changed$/.test(e.textContent)), "changed pixels shown");
+      await page.selectOption("#compareMode", "off");
+    }],
+    ["view modes: bump view", async () => {
+      const hash0 = await settledFrameHash(page);
+      await page.selectOption("#viewMode", "bump");
+      await until(() => page.$eval("#frame", (i) => /view=bump/.test(i.dataset.url || "")), "a bump-view frame");
+      assert.notEqual(await settledFrameHash(page), hash0);
+      await page.selectOption("#viewMode", "shaded");
+    }],
+    ["the place tool adds a placement at the clicked skin with the suggested driver", async () => {
+      await settle();
+      const n0 = (await doc()).placements.length;
+      await page.click("#placeTool");
+      const box = await page.$eval("#frame", (i) => { const r = i.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
+      const side = Math.min(box[2], box[3]);
+      const at = [box[0] + (box[2] - side) / 2 + side * 0.5, box[1] + (box[3] - side) / 2 + side * 0.42]; // the torso
+      await page.mouse.click(at[0], at[1]);
+      const d = await until(async () => { const x = await doc(); return x.placements.length === n0 + 1 && x; }, "a new placement");
+      const added = d.placements[d.placements.length - 1];
+      const pick = await page.evaluate(([x, y]) => window.dermisEditor.pickAt(x, y), [Math.floor(512 * 0.5), Math.floor(512 * 0.42)]);
+      assert.ok(pick.hit);
+      assert.equal(added.joint, pick.suggested.joint);
+      assert.ok(Math.abs(added.center[0] - pick.uv[0]) < 0.002 && Math.abs(added.center[1] - pick.uv[1]) < 0.002);
+      await page.click("#placeTool");
+    }],
+    ["the activation strip jumps to the clicked time", async () => {
+      const box = await page.$eval("#activation", (c) => { const r = c.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
+      await page.mouse.click(box[0] + box[2] * 0.9, box[1] + box[3] / 2);
+      const t = (await state(page)).time;
+      assert.ok(t > 1.5, `time ${t}`);
+    }],
+    ["the sweep contact sheet opens", async () => {
+      await select("elbow_l");
+      await page.click("#sweep");
+      await page.waitForFunction(() => { const i = document.querySelector("#sweepDialog img"); return i && i.complete && i.naturalWidth > 0; }, null, { timeout: 30000 });
+      await screenshot(page, "editor-sweep.png");
+      await page.keyboard.press("Escape");
+    }],
+    ["a server error appears on screen", async () => {
+      await page.setInputFiles("#loadFile", { name: "broken.scene.json", mimeType: "application/json", buffer: Buffer.from(JSON.stringify({ format: "dermis.scene/1", model: "builtin:default", placements: [{ id: "x", pattern: "crease", joint: "no_such_joint" }] })) });
+      await noticeMatching(/no joint named 'no_such_joint'/);
+      assert.ok((await doc()).placements.length > 5, "nothing changed");
+    }],
+  ]);
+
+  // Benchmark: pointer move → new frame on screen while dragging, 512², 100 moves.
+  await page.selectOption("#compareMode", "off");
+  await page.evaluate(() => { window.dermisEditor.clearTrace(); window.dermisEditor.trace.on = true; });
+  await settle();
+  const g = await footprint(page, "stomach");
+  await page.evaluate(([x0, y0]) => new Promise((resolve) => {
+    const c = document.getElementById("uv");
+    const ev = (type, x, y) => c.dispatchEvent(new PointerEvent(type, { clientX: x, clientY: y, button: 0, buttons: 1, pointerId: 9, bubbles: true }));
+    ev("pointerdown", x0, y0);
+    let i = 0;
+    const timer = setInterval(() => {
+      ++i;
+      ev("pointermove", x0 + (i % 30) - 15, y0 + ((i * 7) % 20) - 10);
+      if (i >= 100) { clearInterval(timer); setTimeout(() => { ev("pointerup", x0, y0); resolve(); }, 1500); }
+    }, 50);
+  }), g.center);
+  await sleep(1500);
+  const tr = await page.evaluate(() => JSON.parse(JSON.stringify(window.dermisEditor.trace)));
+  const lat = [];
+  for (const m of tr.moves) {
+    const ack = tr.acks.find((a) => a.sentAt >= m);
+    if (!ack) continue;
+    const f = tr.frames.find((fr) => fr.t0 >= ack.ackAt);
+    if (f) lat.push(f.shownAt - m);
+  }
+  lat.sort((x, y) => x - y);
+  const q = (p) => lat[Math.min(lat.length - 1, Math.floor(p * lat.length))];
+  const figures = { benchmark: "editor_drag_to_frame", frame: "512x512", moves: tr.moves.length, measured: lat.length,
+                    edits: tr.acks.length, frames: tr.frames.length, p50_ms: +q(0.5).toFixed(1), p95_ms: +q(0.95).toFixed(1),
+                    gl: process.env.DERMIS_TEST_GL || "auto" };
+  console.log(JSON.stringify(figures));
+  writeFileSync(join(shotDir, "editor-drag-bench.json"), JSON.stringify(figures, null, 2) + "\n");
+  if (lat.length < 50) { console.log("benchmark: too few moves reached a frame"); ++failures; }
+  if (page.errors.length) { console.log("script errors:", page.errors); ++failures; }
+} catch (e) {
+  console.error("WebEditorPanelsBrowserTest: FAILED:", e.stack || e.message);
+  failures = Math.max(failures, 1);
+} finally {
+  await browser.close();
+  server.stop();
+}
+process.exit(failures ? 1 : 0);
