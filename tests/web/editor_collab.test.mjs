@@ -5,8 +5,11 @@
 // shows as presence; a stale edit (its sender had not heard of the first change) shows the 412
 // notice and leaves the first person's change intact; a permalink opened in a fresh context gives
 // the identical frame (SHA-256 of the bytes); killing the server shows the offline banner, which
-// clears when it is back (same port, same data) and the editor re-syncs.
+// clears when it is back (same port, same data) and the editor re-syncs; the scene document
+// downloads; a dropped .glb makes a new scene; copying another scene's placements lists those
+// whose joints the model lacks.
 import assert from "node:assert/strict";
+import { readFileSync } from "node:fs";
 import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, until, sleep } from "./editor_lib.mjs";
 
 const exe = process.argv[2];
@@ -97,6 +100,47 @@ try {
       assert.equal(edited.status, 200);
       await a.waitForFunction(() => document.getElementById("offline").hidden, null, { timeout: 20000 });
       await until(async () => (await state(a)).revision === edited.body.revision, "A re-synced", 10000);
+    }],
+    ["download the scene document", async () => {
+      const [download] = await Promise.all([a.waitForEvent("download"), a.click("#download")]);
+      const text = await (await download.createReadStream()).toArray();
+      const saved = JSON.parse(Buffer.concat(text).toString("utf8"));
+      assert.deepEqual(saved, (await api("GET", `/scenes/${sceneId}`)).body.scene);
+      assert.match(download.suggestedFilename(), /^s_[0-9a-f]+-r\d+\.scene\.json$/);
+    }],
+    ["dropping a .glb makes a new scene on that model", async () => {
+      const glb = readFileSync(new URL("../../../shared/models/CesiumMan/CesiumMan.glb", import.meta.url));
+      await a.evaluate(async (bytes) => {
+        const dt = new DataTransfer();
+        dt.items.add(new File([new Uint8Array(bytes)], "CesiumMan.glb", { type: "model/gltf-binary" }));
+        document.body.dispatchEvent(new DragEvent("drop", { dataTransfer: dt, bubbles: true, cancelable: true }));
+      }, [...glb]);
+      await a.waitForFunction((first) => { const s = window.dermisEditor.store; return s.sceneId !== first && s.model && s.model.id !== "builtin:default"; }, sceneId, { timeout: 30000 });
+      const s = await state(a);
+      assert.equal(s.doc.placements.length, 0);
+      assert.equal((await api("GET", `/scenes/${s.sceneId}`)).status, 200);
+    }],
+    ["copy another scene's placements: those whose joints this model lacks are listed", async () => {
+      await a.click("#copyFrom");
+      await a.selectOption("#copySource", sceneId);
+      await a.click("#copyGo");
+      await a.waitForFunction(() => /Copied 0\./.test(document.getElementById("copyResult").textContent), null, { timeout: 10000 });
+      const listed = await a.$$eval("#copyResult li", (l) => l.map((e) => e.textContent));
+      const source = (await api("GET", `/scenes/${sceneId}`)).body.scene.placements;
+      assert.equal(listed.length, source.length);
+      await a.keyboard.press("Escape");
+      // Onto a new scene of the default character every placement maps.
+      const empty = await api("POST", "/scenes", { format: "dermis.scene/1", model: "builtin:default", placements: [] });
+      assert.equal(empty.status, 201);
+      await a.goto(`${server.base}/?scene=${empty.body.id}`);
+      await a.waitForFunction((id) => window.dermisEditor && window.dermisEditor.store.sceneId === id, empty.body.id, { timeout: 30000 });
+      await a.click("#copyFrom");
+      await a.selectOption("#copySource", sceneId);
+      await a.click("#copyGo");
+      await a.waitForFunction((n) => document.getElementById("copyResult").textContent.startsWith(`Copied ${n}.`), source.length, { timeout: 10000 });
+      const copied = (await api("GET", `/scenes/${empty.body.id}`)).body.scene.placements;
+      assert.deepEqual(copied.map((p) => p.id), source.map((p) => p.id));
+      await a.keyboard.press("Escape");
     }],
     ["no script errors", async () => { assert.deepEqual(a.errors, []); assert.deepEqual(b.errors, []); }],
   ]);

@@ -121,7 +121,7 @@ async function newSceneFromModel(f) {
     notify(`Uploading ${f.name}…`, "info");
     const model = await api.json("POST", `/models?name=${encodeURIComponent(f.name.replace(/\.glb$/i, ""))}`,
                                  { body: f, headers: { "Content-Type": "model/gltf-binary" } });
-    const scene = await api.send("POST", "/scenes", { model: model.id });
+    const scene = await api.send("POST", "/scenes", { format: "dermis.scene/1", model: model.id, placements: [] });
     await refreshSceneList(scene.id);
     await openScene(scene.id);
     notify(`New scene ${scene.id} on ${model.name || model.id} (${model.triangles} triangles, ${model.joint_count} joints).`, "info");
