@@ -77,9 +77,10 @@ function draw() {
       g.fillStyle = `rgba(${selected ? "255,180,84" : "95,179,255"},${0.08 + 0.92 * t})`;
       g.fillRect(X(i), y, (W - lw) / n + 1, lane - 1);
     }
-    if (lane >= 8) {
+    if (lane >= 6) {
+      g.font = `${Math.min(10, Math.floor(lane))}px system-ui, sans-serif`;
       g.fillStyle = selected ? "#ffb454" : "#8d99a8";
-      g.fillText(id, 4, y + Math.min(lane - 1, 10));
+      g.fillText(id, 4, y + Math.min(lane - 1, 9));
     }
   });
   for (const f of data.flags) {

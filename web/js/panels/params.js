@@ -64,11 +64,11 @@ function render() {
       ${field("Scale", `<span class="pair"><input type="number" id="pSX" step="0.005" value="${p.scale[0]}" aria-label="scale u"><input type="number" id="pSY" step="0.005" value="${p.scale[1]}" aria-label="scale v"></span>`)}
       ${field("Rotation", `<input type="number" id="pRot" step="1" value="${p.rotation}" aria-label="rotation (degrees)">`)}
       ${field("Enabled", `<input type="checkbox" id="pEnabled"${p.enabled ? " checked" : ""} aria-label="enabled">`)}
-      <div class="wide pair"><canvas class="dial" id="dial" width="192" height="192" aria-label="current joint angle"></canvas>
-        <div><div id="liveText" aria-live="polite"></div>
-          <div class="pair" style="margin-top:6px"><button type="button" id="goMin" title="Pose the driver joint at θmin">Go to θmin</button><button type="button" id="goMax" title="Pose the driver joint at θmax">Go to θmax</button></div>
-          <div class="pair" style="margin-top:4px"><button type="button" id="clearPose" title="Remove this joint's pose override">Release joint</button><button type="button" id="sweep" title="Contact sheet of the driver's range">Sweep…</button></div>
-          <div class="pair" style="margin-top:4px"><button type="button" id="mirror" title="Add the mirror twin (M)">Mirror</button></div>
+      <div class="wide live"><canvas class="dial" id="dial" width="176" height="176" aria-label="current joint angle"></canvas>
+        <div class="buttons"><div id="liveText" aria-live="polite"></div>
+          <button type="button" id="goMin" title="Pose the driver joint at θmin">Go to θmin</button><button type="button" id="goMax" title="Pose the driver joint at θmax">Go to θmax</button>
+          <button type="button" id="clearPose" title="Remove this joint's pose override">Release joint</button><button type="button" id="sweep" title="Contact sheet of the driver's range">Sweep…</button>
+          <button type="button" id="mirror" title="Add the mirror twin (M)">Mirror</button>
         </div></div>
       <canvas class="plot wide" id="plot" width="520" height="240" aria-label="height against theta"></canvas>
     </div>`;
