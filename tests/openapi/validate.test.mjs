@@ -296,6 +296,12 @@ try {
   await api("GET", "/scenes/{id}/lint", { params: { id }, expect: 200 });
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "x=128&y=100&width=256&height=256", expect: 200 });
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "x=1&y=1&width=256&height=256", expect: 200 });
+  const byUv = await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=0.29&v=0.737", expect: 200 });
+  assert.equal(byUv.json().hit, true);
+  await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=1.5&v=0.5", expect: 422 });
+  const drivers = await api("GET", "/scenes/{id}/drivers", { params: { id }, query: "time=0.5", expect: 200 });
+  assert.ok(drivers.json().placements.length > 0 && drivers.json().camera.distance > 0);
+  await api("GET", "/scenes/{id}/drivers", { params: { id }, query: "revision=99999", expect: 404 });
 
   // renders
   assert.ok(isPng((await api("GET", "/scenes/{id}/frame", { params: S, expect: 200 })).bytes));
