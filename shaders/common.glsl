@@ -24,5 +24,7 @@ layout(std140, binding = 1) uniform FrameBlock {
 // Per-part constants of the skin pass.
 layout(std140, binding = 2) uniform PartBlock {
     vec4 u_baseColor;  // material base colour factor (linear)
-    ivec4 u_part;      // first palette matrix of the part, has base-colour texture, has UVs, 0
+    ivec4 u_part;      // first palette matrix of the part, has base-colour texture, has UVs,
+                       // view (0 shaded, 1 bump, 2 displacement, 3 normal: FrameView in
+                       // server/core/render_settings.hpp; the same for every part of a frame)
 };

@@ -2,6 +2,11 @@
 // (Mikkelsen, "Bump Mapping Unparametrized Surfaces on the GPU", 2010: the surface gradient from
 // screen-space derivatives), base colour, simple lighting. Writes linear colour; the sRGB render
 // target encodes it.
+//
+// Views (u_part.w, FrameView in server/core/render_settings.hpp): 0 shaded; unlit pictures of the
+// maps on the surface for authoring: 1 bump / 2 displacement height as grey byte 128 + 127·height
+// (clamped to [−1, 1]), 3 the perturbed world normal as bytes 255·(n·0.5 + 0.5). Those are
+// picture values: written through the sRGB EOTF so that the target's encoding gives them back.
 
 layout(binding = 0) uniform sampler2D u_heightMap;        // RG32F: bump, displacement
 layout(binding = 2) uniform sampler2D u_baseColorTexture; // sRGB8_A8, decoded to linear by the sampler
@@ -36,11 +41,28 @@ vec3 perturbedNormal(vec3 n) {
     return normalize(abs(det) * n - grad);
 }
 
+// The linear value the sRGB target encodes to picture value c (exact sRGB EOTF).
+vec3 pictureValue(vec3 c) {
+    c = clamp(c, 0.0, 1.0);
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+
 void main() {
     vec3 n = normalize(v_normal);
     vec3 toCamera = normalize(u_cameraPos.xyz - v_position);
     if (dot(n, toCamera) < 0.0) n = -n; // two-sided: back faces are lit like front faces
     if (u_part.z != 0) n = perturbedNormal(n);
+
+    if (u_part.w == 1 || u_part.w == 2) { // bump or displacement height as grey
+        vec2 heights = u_part.z != 0 ? textureLod(u_heightMap, v_uv, 0.0).rg : vec2(0.0);
+        float height = clamp(u_part.w == 1 ? heights.r : heights.g, -1.0, 1.0);
+        o_color = vec4(pictureValue(vec3((128.0 + 127.0 * height) / 255.0)), 1.0);
+        return;
+    }
+    if (u_part.w == 3) { // the perturbed world normal
+        o_color = vec4(pictureValue(n * 0.5 + 0.5), 1.0);
+        return;
+    }
 
     vec4 base = u_baseColor;
     if (u_part.y != 0 && u_part.z != 0) base *= texture(u_baseColorTexture, v_uv);

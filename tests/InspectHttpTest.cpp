@@ -1,6 +1,7 @@
 // InspectHttpTest — probe and activation over real HTTP (HttpTestFixture.hpp): the probe's
 // bump value equals the served f32 map at that texel, contributions name the placement;
-// activation of the scene's clip lists every placement; bad parameters are clear 4xx errors.
+// activation of the scene's clip lists every placement; bad parameters are clear 4xx errors;
+// frame views (view=shaded|bump|displacement|normal) on frames and frame diffs.
 #include "HttpTestFixture.hpp"
 
 #include <cmath>
@@ -218,6 +219,37 @@ TEST_F(InspectHttpTest, CompareFramesAndDiffs) {
     expectError(h.get(s + "/frame-diff?" + size), 422, "against");
     expectError(h.get(s + "/frame-diff?against=abc"), 422, "against");
     expectError(h.get(s + "/frame-diff?against=77"), 404, "revision");
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
+TEST_F(InspectHttpTest, FrameViews) {
+    Http h = http();
+    Reply created = h.post("/scenes", {{"default_patterns", true}});
+    ASSERT_EQ(created.status, 201) << created;
+    const std::string s = "/scenes/" + created.js()["id"].get<std::string>();
+    const std::string size = "width=96&height=96&msaa=1";
+    Reply shaded = h.get(s + "/frame?" + size);
+    ASSERT_EQ(shaded.status, 200) << shaded;
+    EXPECT_EQ(h.get(s + "/frame?view=shaded&" + size).body, shaded.body) << "shaded is the default";
+    std::set<std::string> bodies = {shaded.body};
+    for (const char* view : {"bump", "displacement", "normal"}) {
+        Reply r = h.get(s + "/frame?view=" + view + "&" + size);
+        ASSERT_EQ(r.status, 200) << view << ": " << r;
+        EXPECT_EQ(r.header("Content-Type"), "image/png");
+        auto img = decodeFrame(r.bytes());
+        ASSERT_TRUE(img) << view;
+        EXPECT_EQ(img->width, 96);
+        bodies.insert(r.body);
+    }
+    EXPECT_EQ(bodies.size(), 4u) << "four different pictures";
+    // frame-diff takes the view for both frames: the bump view against no patterns lights the
+    // pixels where the patterns are.
+    Reply diff = h.get(s + "/frame-diff?against=off&view=bump&" + size);
+    ASSERT_EQ(diff.status, 200) << diff;
+    EXPECT_GT(std::stol(diff.header("X-Dermis-Changed-Pixels")), 0);
+    expectError(h.get(s + "/frame?view=nope"), 422, "view");
+    expectError(h.get(s + "/frame?view=Bump"), 422, "view");
+    expectError(h.get(s + "/frame-diff?against=off&view="), 422, "view");
     ASSERT_EQ(h.del(s).status, 204);
 }
 

@@ -3,9 +3,12 @@
 // over loopback). It checks:
 //   * models: built-in details, .glb uploads of the shared models (CesiumMan, KayKit Barbarian,
 //     RiggedFigure without UVs), UV layouts as JSON and PNG, deletion (409 while a scene uses it);
+//   * base-colour textures as PNG (CesiumMan's at its size and downsized; none on the default
+//     character or RiggedFigure: 404 no_texture);
 //   * a multipart .gltf with its external buffer, and multipart uploads that are refused (missing
 //     buffer, a URI outside the folder, a folder in a part name, no .gltf part, not JSON).
 #include "HttpTestFixture.hpp"
+#include "io/gltf_loader.hpp"
 
 using namespace dermis;
 using namespace dermis::test;
@@ -113,6 +116,58 @@ TEST_F(ModelsHttpTest, CesiumManUploadsInspectsAndDeletes) {
     EXPECT_EQ(h.del("/models/" + id).status, 204);
     expectError(h.get("/models/" + id), 404, "id");
     expectError(h.del("/models/" + id), 404, "id");
+}
+
+TEST_F(ModelsHttpTest, BaseColourTextureAsPng) {
+    Http h = http();
+    // The texture as the loader decodes it: what the route must answer.
+    auto cesium = loadGltfFile(kCesiumMan);
+    ASSERT_TRUE(cesium) << cesium.error().message;
+    const int image = cesium->dominantBaseColorImage();
+    ASSERT_GE(image, 0);
+    const Image8& tex = cesium->images[static_cast<std::size_t>(image)];
+    ASSERT_GT(tex.width, 256);
+
+    Reply up = h.upload("/models", readBytes(kCesiumMan), "model/gltf-binary");
+    ASSERT_EQ(up.status, 201) << up;
+    const std::string id = up.js()["id"];
+    Reply full = h.get("/models/" + id + "/texture");
+    ASSERT_EQ(full.status, 200) << full;
+    EXPECT_EQ(full.header("Content-Type"), "image/png");
+    auto img = decodeFrame(full.bytes());
+    ASSERT_TRUE(img) << img.error().message;
+    EXPECT_EQ(img->width, tex.width);
+    EXPECT_EQ(img->height, tex.height);
+    EXPECT_EQ(img->rgba, tex.rgba) << "the decoded texture, byte for byte";
+
+    // ?size= fits the longer side into N, keeping the aspect; never enlarges.
+    Reply small = h.get("/models/" + id + "/texture?size=64");
+    ASSERT_EQ(small.status, 200) << small;
+    auto s = decodeFrame(small.bytes());
+    ASSERT_TRUE(s);
+    EXPECT_EQ(std::max(s->width, s->height), 64);
+    EXPECT_EQ(s->width, static_cast<int>(std::lround(64.0 * tex.width / std::max(tex.width, tex.height))));
+    auto big = decodeFrame(h.get("/models/" + id + "/texture?size=4096").bytes());
+    ASSERT_TRUE(big);
+    EXPECT_EQ(big->width, tex.width);
+
+    for (const char* bad : {"size=8", "size=5000", "size=abc", "size=-1"})
+        expectError(h.get("/models/" + id + "/texture?" + bad), 422, "size");
+    EXPECT_EQ(h.del("/models/" + id).status, 204);
+    expectError(h.get("/models/" + id + "/texture"), 404, "id");
+
+    // No base-colour texture: the default character (a base colour factor only), RiggedFigure.
+    Reply none = h.get("/models/builtin:default/texture");
+    expectError(none, 404, "texture");
+    EXPECT_EQ(none.js()["error"]["code"], "no_texture") << none;
+    Reply fig = h.upload("/models", readBytes(kRiggedFigure), "model/gltf-binary");
+    ASSERT_EQ(fig.status, 201) << fig;
+    const std::string figId = fig.js()["id"];
+    Reply figTex = h.get("/models/" + figId + "/texture");
+    expectError(figTex, 404, "texture");
+    EXPECT_EQ(figTex.js()["error"]["code"], "no_texture") << figTex;
+    EXPECT_EQ(h.del("/models/" + figId).status, 204);
+    expectError(h.get("/models/m_nope/texture"), 404, "id");
 }
 
 TEST_F(ModelsHttpTest, GltfWithExternalFilesUploadsAsMultipart) {

@@ -2,7 +2,8 @@
 // $DERMIS_TEST_GL (ctest runs it for osmesa and egl-surfaceless): `info` prints JSON,
 // `bake --gpu` writes maps equal to the CPU bake away from footprint edges, `bake --normals`
 // writes a normal map, `render` writes PNG/JPEG/EXR frames, animation ranges and height maps,
-// and bad scenes, models and options exit non-zero with a message.
+// `--view` chooses what a frame shows, and bad scenes, models and options exit non-zero with a
+// message.
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
 #include "TestFiles.hpp"
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
+#include <map>
 #include <sys/wait.h>
 
 using namespace dermis;
@@ -111,6 +113,25 @@ TEST(RenderCliGLTest, RendersOneFrameInEachFormat) {
     ASSERT_GT(exr.size(), 4u);
     EXPECT_EQ(exr[0], 0x76); // OpenEXR magic 76 2f 31 01
     EXPECT_EQ(exr[1], 0x2f);
+}
+
+TEST(RenderCliGLTest, ViewChoosesWhatTheFrameShows) {
+    TempDir dir;
+    std::map<std::string, std::vector<std::uint8_t>> frames;
+    for (const char* view : {"shaded", "bump", "normal"}) {
+        const std::string out = dir / (std::string(view) + ".png");
+        CliRun r = runServer(dir, "render --scene " + kDefaultScene + " --out " + out +
+                                      " --size 96x96 --view " + view + gl());
+        ASSERT_EQ(r.code, 0) << view << ": " << r.err;
+        frames[view] = readBytes(out);
+        ASSERT_TRUE(decodeFrame(frames[view])) << view;
+    }
+    EXPECT_NE(frames["shaded"], frames["bump"]);
+    EXPECT_NE(frames["bump"], frames["normal"]);
+    CliRun r = runServer(dir, "render --scene " + kDefaultScene + " --out " + (dir / "x.png") +
+                                  " --view nope" + gl());
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--view"), std::string::npos) << r.err;
 }
 
 TEST(RenderCliGLTest, RendersAnAnimationRangeWithHeightMaps) {

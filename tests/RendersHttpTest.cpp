@@ -2,7 +2,7 @@
 // a real dermis::Service + dermis::Api on 127.0.0.1, a GL context on $DERMIS_TEST_GL, cpp-httplib
 // clients over loopback). It checks:
 //   * the stateless batch (POST /render): multipart/mixed with one decodable image part per frame,
-//     PNG and JPEG;
+//     PNG and JPEG, and a view other than shaded;
 //   * back-pressure: with a render queue of 1 (a second server), concurrent frames answer 200 or
 //     503 + Retry-After, and renders go through again once the burst is over.
 #include "HttpTestFixture.hpp"
@@ -63,6 +63,22 @@ TEST_F(RendersHttpTest, BatchStreamsOneImagePartPerFrame) {
     ASSERT_EQ(jparts.size(), 1u);
     EXPECT_NE(jparts[0].headers.find("image/jpeg"), std::string::npos);
     EXPECT_TRUE(decodeFrame({jparts[0].content.begin(), jparts[0].content.end()}));
+
+    // A view for every frame of the batch; an unknown one is refused before any render.
+    body["format"] = "png";
+    body["view"] = "bump";
+    Reply br = h.post("/render", body);
+    ASSERT_EQ(br.status, 200) << br;
+    std::smatch bm;
+    const std::string bct = br.header("Content-Type");
+    ASSERT_TRUE(std::regex_search(bct, bm, std::regex("boundary=\"?([^\";]+)\"?")));
+    const auto bparts = multipartParts(br.body, bm[1]);
+    ASSERT_EQ(bparts.size(), 1u);
+    auto bump = decodeFrame({bparts[0].content.begin(), bparts[0].content.end()});
+    ASSERT_TRUE(bump);
+    EXPECT_GT(pixelsDiffering(*bump, frames[0]), 20u);
+    body["view"] = "nope";
+    expectError(h.post("/render", body), 422, "/view");
 }
 
 // ================================================================================================

@@ -1,10 +1,13 @@
 // UvLayoutTest — pictures for people and model queries in the core: UV edges and their raster,
-// height previews, the joint-parent walk. Pure.
+// height previews, downsized textures, the joint-parent walk, the dominant base-colour image.
+// Pure.
 #include "core/model.hpp"
 #include "core/preview.hpp"
 #include "core/uv_layout.hpp"
 
 #include <gtest/gtest.h>
+
+#include <cstdint>
 
 using namespace dermis;
 
@@ -55,6 +58,77 @@ TEST(PreviewTest, HeightsMapToGreyWithTheAspectKept) {
     EXPECT_EQ(img.rgba[3], 255);                      // opaque
     const Image8 flat = heightPreview(HeightImage(3, 3, 0.0f), 1);
     EXPECT_EQ(flat.rgba[0], 128);                     // L = 0: mid grey
+}
+
+TEST(PreviewTest, DownsizeAveragesBoxesAndKeepsTheAspect) {
+    Image8 src;
+    src.width = 8;
+    src.height = 4;
+    src.rgba.resize(8 * 4 * 4);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 8; ++x) {
+            std::uint8_t* px = &src.rgba[(y * 8 + x) * 4];
+            px[0] = x < 4 ? 0 : 200;        // left half black, right half 200
+            px[1] = (x + y) % 2 ? 255 : 0;  // checkerboard: averages to mid
+            px[2] = static_cast<std::uint8_t>(10 * y);
+            px[3] = 255;
+        }
+    const Image8 half = downsizeImage(src, 4);
+    ASSERT_EQ(half.width, 4);
+    ASSERT_EQ(half.height, 2);
+    ASSERT_EQ(half.rgba.size(), 4u * 2 * 4);
+    EXPECT_EQ(half.rgba[0], 0);              // (0, 0): black half
+    EXPECT_EQ(half.rgba[3 * 4], 200);        // (3, 0): the 200 half
+    EXPECT_EQ(half.rgba[1], 128);            // 2×2 of the checkerboard: (0+255+255+0)/4 rounded
+    EXPECT_EQ(half.rgba[2], 5);              // rows 0 and 1: (0+10)/2
+    EXPECT_EQ(half.rgba[(4 + 0) * 4 + 2], 25); // rows 2 and 3
+    EXPECT_EQ(half.rgba[3], 255);
+    // Odd ratios keep the aspect, every output pixel averaging at least one source pixel.
+    const Image8 odd = downsizeImage(src, 3);
+    EXPECT_EQ(odd.width, 3);
+    EXPECT_EQ(odd.height, 2); // round(4·3/8) = 2 (1.5 rounds up)
+    const Image8 one = downsizeImage(src, 1);
+    EXPECT_EQ(one.width, 1);
+    EXPECT_EQ(one.height, 1);
+    EXPECT_EQ(one.rgba[0], 100); // (4·0 + 4·200)/8
+    // Never enlarged: a maxSide at or above the longer side is a copy.
+    const Image8 same = downsizeImage(src, 8);
+    EXPECT_EQ(same.width, 8);
+    EXPECT_EQ(same.rgba, src.rgba);
+    EXPECT_EQ(downsizeImage(src, 4096).rgba, src.rgba);
+}
+
+TEST(ModelQueriesTest, DominantBaseColorImageCountsTrianglesPerImage) {
+    Model m = quad();                 // part 0: 2 triangles, no material
+    EXPECT_EQ(m.dominantBaseColorImage(), -1);
+    Image8 tex;
+    tex.width = tex.height = 2;
+    tex.rgba.assign(16, 255);
+    m.images = {tex, tex};
+    m.materials = {{"plain"}, {"a"}, {"b"}, {"b too"}};
+    m.materials[1].baseColorTexture = 0;
+    m.materials[2].baseColorTexture = 1;
+    m.materials[3].baseColorTexture = 1;
+    m.parts[0].material = 0; // untextured: counts for nothing
+    EXPECT_EQ(m.dominantBaseColorImage(), -1);
+    MeshPart three = m.parts[0];
+    three.indices = {0, 1, 2, 0, 2, 3, 0, 1, 3};
+    three.material = 1; // image 0: 3 triangles
+    MeshPart two = m.parts[0];
+    two.material = 2; // image 1: 2 triangles …
+    m.parts.push_back(three);
+    m.parts.push_back(two);
+    EXPECT_EQ(m.dominantBaseColorImage(), 0);
+    two.material = 3; // … plus 2 through another material naming the same image
+    m.parts.push_back(two);
+    EXPECT_EQ(m.dominantBaseColorImage(), 1);
+    m.parts.pop_back();
+    m.parts.back().indices = {0, 1, 2, 0, 2, 3, 1, 2, 3};
+    EXPECT_EQ(m.dominantBaseColorImage(), 0); // a tie goes to the lower image index
+    m.materials[1].baseColorTexture = 7;      // out of range: ignored
+    EXPECT_EQ(m.dominantBaseColorImage(), 1);
+    m.images[1] = Image8{};                   // empty: ignored
+    EXPECT_EQ(m.dominantBaseColorImage(), -1);
 }
 
 TEST(ModelQueriesTest, ParentJointSkipsNonJointNodes) {

@@ -1,7 +1,7 @@
 // dermis-server — command line entry point. The offline commands:
 //   dermis-server bake   --scene S.json --out DIR [--time T] [--threads N] [--png] [--gpu] [--normals] [--gl B]
 //   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH]
-//                        [--heightmaps] [--gl B]
+//                        [--view V] [--heightmaps] [--gl B]
 //   dermis-server info   [--gl B]
 //   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B] [limits]
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
@@ -117,7 +117,7 @@ int runBake(const BakeArgs& a) {
 // --- render ----------------------------------------------------------------------------------
 
 struct RenderArgs {
-    std::string scene, out, gl = "auto", frames, size, content;
+    std::string scene, out, gl = "auto", frames, size, content, view = "shaded";
     double time = 0.0;
     bool hasTime = false, heightmaps = false;
 };
@@ -183,6 +183,7 @@ int runRender(const RenderArgs& a) {
                                   "a frame range needs a %04d-style field in the file name"));
     }
     FrameOverrides overrides;
+    overrides.view = frameViewFromString(a.view).value_or(FrameView::Shaded); // checked by CLI11
     if (!a.size.empty()) {
         int w = 0, h = 0;
         char tail = 0;
@@ -396,6 +397,9 @@ int main(int argc, char** argv) {
                           "Animation range A:B:STEP in seconds (frame k at A + k·STEP)")
         ->excludes(timeOpt);
     renderCmd->add_option("--size", render.size, "Frame size WxH (overrides render.size)");
+    renderCmd->add_option("--view", render.view,
+                          "shaded (default), or unlit: bump / displacement height as grey, normal")
+        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
     renderCmd->add_flag("--heightmaps", render.heightmaps,
                         "Also write <frame>.bump.exr and <frame>.displacement.exr");
     renderCmd->add_option("--content", render.content, "Built-in content directory (builtin: names)");

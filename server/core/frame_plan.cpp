@@ -24,6 +24,7 @@ Result<FramePlan> planFrame(const Scene& scene, const Model& model, const Patter
     auto pose = evaluatePose(model, scene.pose, o.time);
     if (!pose) return pose.error();
     plan.world = worldMatrices(model, *pose);
+    plan.view = o.view;
     if (!scene.placements.empty()) {
         auto placements = resolvePlacements(scene, model, *pose, images);
         if (!placements) return placements.error();

@@ -37,6 +37,7 @@ struct FrameOverrides {
     std::optional<double> time; ///< overrides pose.time
     std::optional<int> width, height, msaa;
     std::optional<double> yaw, pitch, distance;
+    FrameView view = FrameView::Shaded; ///< what the frame shows (never in the scene)
 };
 
 struct FramePlan {
@@ -44,6 +45,7 @@ struct FramePlan {
     std::vector<glm::mat4> world; ///< worldMatrices(model, pose): one per node
     HeightMapInput heights;
     RenderSettings render;        ///< the scene's, overrides applied, validated
+    FrameView view = FrameView::Shaded; ///< FrameOverrides::view
     /// Keep-alive of the images `heights` points to.
     std::vector<std::shared_ptr<const PatternImage>> images;
 };

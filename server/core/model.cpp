@@ -31,6 +31,23 @@ int Model::findClip(const std::string& name) const {
     return -1;
 }
 
+int Model::dominantBaseColorImage() const {
+    std::vector<std::size_t> covered(images.size(), 0);
+    for (const MeshPart& part : parts) {
+        if (part.material < 0 || static_cast<std::size_t>(part.material) >= materials.size()) continue;
+        const int image = materials[static_cast<std::size_t>(part.material)].baseColorTexture;
+        if (image < 0 || static_cast<std::size_t>(image) >= images.size()) continue;
+        const Image8& img = images[static_cast<std::size_t>(image)];
+        if (img.width <= 0 || img.height <= 0) continue;
+        covered[static_cast<std::size_t>(image)] += part.indices.size() / 3;
+    }
+    int best = -1;
+    for (std::size_t i = 0; i < covered.size(); ++i)
+        if (covered[i] > 0 && (best < 0 || covered[i] > covered[static_cast<std::size_t>(best)]))
+            best = static_cast<int>(i);
+    return best;
+}
+
 int Model::parentJoint(int node) const {
     if (node < 0 || static_cast<std::size_t>(node) >= nodes.size()) return -1;
     int parent = nodes[static_cast<std::size_t>(node)].parent;

@@ -94,6 +94,12 @@ struct Model {
     /// The nearest ancestor of node `node` that is a joint (skipping non-joint nodes between
     /// them), −1 for none or an index out of range.
     int parentJoint(int node) const;
+    /// The base-colour image of the model, for pictures of its texture space: the index into
+    /// `images` that covers the most triangles, counting each part's triangles for the image its
+    /// material names as baseColorTexture (two materials sharing an image add up; parts without a
+    /// material or texture count for none); ties go to the lower image index. −1 when no triangle
+    /// has a base-colour texture (none named, an index out of range or an empty image).
+    int dominantBaseColorImage() const;
 };
 
 /// Area-weighted vertex normals of a triangle list: each triangle adds its unnormalised face

@@ -14,6 +14,22 @@ std::string fmt(double d) {
 
 } // namespace
 
+std::string_view toString(FrameView v) {
+    switch (v) {
+    case FrameView::Shaded: return "shaded";
+    case FrameView::Bump: return "bump";
+    case FrameView::Displacement: return "displacement";
+    case FrameView::Normal: return "normal";
+    }
+    return "shaded";
+}
+
+std::optional<FrameView> frameViewFromString(std::string_view s) {
+    for (FrameView v : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal})
+        if (toString(v) == s) return v;
+    return std::nullopt;
+}
+
 Status validateRenderSettings(const RenderSettings& r, const RenderLimits& limits, const char* where) {
     auto bad = [&](const std::string& field, const std::string& what) {
         return makeError(ErrorCode::InvalidArgument, where, field, what);

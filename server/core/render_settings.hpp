@@ -10,7 +10,24 @@
 #include "result.hpp"
 #include "scene.hpp"
 
+#include <optional>
+#include <string_view>
+
 namespace dermis {
+
+/// What a frame shows of the posed, displaced character (a frame's choice, like its camera
+/// overrides: not part of scene documents). Shaded is the picture; the others are unlit
+/// pictures of the maps on the surface for authoring: Bump and Displacement the height map's
+/// channel as grey, byte = 128 + 127·clamp(height, −1, 1) (the inverse of SPEC §2's 8-bit
+/// pattern mapping: height 0 is 128, ±1 is 255 / 1); Normal the bump-mapped world normal as
+/// rgb, byte = 255·(n·0.5 + 0.5). Sizes, camera, MSAA and displacement are the same in every
+/// view; the background is the shaded view's.
+enum class FrameView { Shaded, Bump, Displacement, Normal };
+
+/// "shaded", "bump", "displacement", "normal".
+std::string_view toString(FrameView v);
+/// The view spelled `s` as toString writes it; nullopt for any other string (case-sensitive).
+std::optional<FrameView> frameViewFromString(std::string_view s);
 
 /// Limits a caller may tighten below the format's own (kMaxRenderSize).
 struct RenderLimits {

@@ -79,7 +79,7 @@ Status Renderer::Impl::ensureFrameTargets(int w, int h, int samples) {
 // --- one frame ----------------------------------------------------------------------------------
 
 /// Render settings by the core's one check (validateRenderSettings), then the GL's renderbuffer
-/// limit; a model must be given.
+/// limit; a model must be given, and a view that FrameView names.
 Status Renderer::Impl::checkFrameRequest(const FrameRequest& req) const {
     const RenderSettings& rs = req.render;
     if (auto s = validateRenderSettings(rs, {}, kWhere); !s) return s;
@@ -88,6 +88,9 @@ Status Renderer::Impl::checkFrameRequest(const FrameRequest& req) const {
                          "each side must be at most the GL's renderbuffer limit " +
                              std::to_string(maxRenderbufferSize));
     if (!req.model) return makeError(ErrorCode::InvalidArgument, kWhere, "model", "no model");
+    if (static_cast<int>(req.view) < static_cast<int>(FrameView::Shaded) ||
+        static_cast<int>(req.view) > static_cast<int>(FrameView::Normal))
+        return makeError(ErrorCode::InvalidArgument, kWhere, "view", "not a FrameView");
     return Ok{};
 }
 
@@ -121,7 +124,7 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     out.boundsMax = bounds.max;
     const FrameCamera camera = frameCamera(bounds.min, bounds.max, dispScale, rs.camera, W, H);
     uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
-    const std::size_t partStride = uploadPartBlocks(model, **gm);
+    const std::size_t partStride = uploadPartBlocks(model, **gm, req.view);
     const GLuint readFbo = drawSkinPass(model, **gm, rs, heightSource->texture, partStride, samples);
     if (auto s = checkGl("skin pass"); !s) return s.error();
     if (req.profile) glFinish();
@@ -169,8 +172,9 @@ void Renderer::Impl::uploadFrameBlock(const FrameCamera& camera, double dispScal
     glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBinding, frameUbo);
 }
 
-/// One PartBlock per part in partUbo (bound by range per draw); returns the stride.
-std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm) {
+/// One PartBlock per part in partUbo (bound by range per draw), each with the frame's view in
+/// part.w (shaders/skin.frag); returns the stride.
+std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm, FrameView view) {
     const std::size_t stride = uboStride(sizeof(PartBlock));
     std::vector<std::uint8_t> partBlocks(stride * std::max<std::size_t>(1, gm.parts.size()), 0);
     for (std::size_t pi = 0; pi < gm.parts.size(); ++pi) {
@@ -180,7 +184,8 @@ std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel&
         if (gp.material >= 0 && static_cast<std::size_t>(gp.material) < model.materials.size())
             pb.baseColor = model.materials[static_cast<std::size_t>(gp.material)].baseColorFactor;
         const bool textured = gm.baseColorTexture(model, gp) != 0;
-        pb.part = glm::ivec4(gp.paletteOffset, textured ? 1 : 0, gp.hasUVs ? 1 : 0, 0);
+        pb.part = glm::ivec4(gp.paletteOffset, textured ? 1 : 0, gp.hasUVs ? 1 : 0,
+                             static_cast<int>(view));
         std::memcpy(partBlocks.data() + stride * pi, &pb, sizeof pb);
     }
     glBindBuffer(GL_UNIFORM_BUFFER, partUbo);

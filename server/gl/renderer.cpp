@@ -187,6 +187,7 @@ FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> mo
     req.model = std::move(model);
     req.world = plan.world;
     req.render = plan.render;
+    req.view = plan.view;
     req.heights = plan.heights;
     return req;
 }

@@ -69,6 +69,7 @@ struct FrameRequest {
     std::shared_ptr<const Model> model;
     std::vector<glm::mat4> world; ///< worldMatrices(model, pose): one per node
     RenderSettings render;        ///< size, camera, displacement scale/mode, bump strength, MSAA
+    FrameView view = FrameView::Shaded; ///< shaded, or an unlit view of the maps (render_settings.hpp)
     /// Height maps from the GPU height pass when set; else `cpuMaps` (uploaded); else flat.
     std::optional<HeightPassInput> heights;
     const HeightMaps* cpuMaps = nullptr;
@@ -146,7 +147,8 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-/// A frame request for `plan` (world matrices, render settings, GPU height pass on its heights).
+/// A frame request for `plan` (world matrices, render settings, view, GPU height pass on its
+/// heights).
 /// The request points into the plan's images: keep `plan` alive while the request is used.
 FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> model);
 

@@ -211,7 +211,7 @@ struct Renderer::Impl {
     Status ensureFrameTargets(int w, int h, int samples);
     void uploadFrameBlock(const FrameCamera& camera, double dispScale, double bumpScale,
                           glm::vec2 heightmapSize);
-    std::size_t uploadPartBlocks(const Model& model, const gl::GpuModel& gm);
+    std::size_t uploadPartBlocks(const Model& model, const gl::GpuModel& gm, FrameView view);
     GLuint drawSkinPass(const Model& model, const gl::GpuModel& gm, const RenderSettings& rs,
                         GLuint heightTexture, std::size_t partStride, int samples);
     Status readFrame(GLuint readFbo, Image8& image);

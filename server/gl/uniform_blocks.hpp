@@ -34,7 +34,7 @@ struct FrameBlock {
 /// PartBlock, binding 2: per-part constants of the skin pass.
 struct PartBlock {
     glm::vec4 baseColor;
-    glm::ivec4 part; ///< first palette matrix, has texture, has UVs, 0
+    glm::ivec4 part; ///< first palette matrix, has texture, has UVs, view (FrameView as int)
 };
 
 /// GLSL binding points of the blocks above and of the palette storage buffer.

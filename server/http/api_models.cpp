@@ -1,5 +1,5 @@
 // Dermis HTTP shell — model routes: list, upload (.glb body, or a .gltf with its external files
-// as multipart parts), details, delete, UV layout (JSON or PNG).
+// as multipart parts), details, delete, UV layout (JSON or PNG), base-colour texture (PNG).
 #include "http/api_internal.hpp"
 
 namespace dermis::api_detail {
@@ -62,6 +62,19 @@ void installModelRoutes(RouteTable& t) {
         if (!intParam(req, res, "size", size)) return;
         auto r = a.svc.uvLayoutPng(req.matches[1], size.value_or(1024));
         if (!r) return sendError(res, r.error());
+        sendImage(res, std::move(*r));
+    });
+    t.add("GET", "/models/{id}/texture", [](Api::Impl& a, const Req& req, Res& res) {
+        std::optional<int> size;
+        if (!intParam(req, res, "size", size)) return;
+        auto r = a.svc.modelTexture(req.matches[1], size);
+        if (!r) {
+            // A model without a texture is a 404 of its own kind, so the editor can tell it from
+            // an unknown model.
+            if (r.error().code == ErrorCode::NotFound && r.error().field == "texture")
+                return sendError(res, 404, "no_texture", r.error().message, "texture");
+            return sendError(res, r.error());
+        }
         sendImage(res, std::move(*r));
     });
 }

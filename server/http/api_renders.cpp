@@ -11,8 +11,8 @@ namespace dermis::api_detail {
 
 namespace {
 
-/// The frame query: size, camera, time, format and what to compare (patterns, only, revision).
-/// False (and the 422 sent) when a parameter is malformed.
+/// The frame query: size, camera, time, format, view and what to compare (patterns, only,
+/// revision). False (and the 422 sent) when a parameter is malformed.
 bool frameParams(const Req& req, Res& res, FrameParams& p) {
     if (req.has_param("format")) p.format = req.get_param_value("format");
     if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
@@ -20,6 +20,15 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         !numberParam(req, res, "pitch", p.pitch) || !numberParam(req, res, "distance", p.distance) ||
         !numberParam(req, res, "time", p.time))
         return false;
+    if (req.has_param("view")) {
+        const auto view = frameViewFromString(req.get_param_value("view"));
+        if (!view) {
+            sendError(res, 422, "invalid_argument",
+                      "dermis::Api: view: must be shaded, bump, displacement or normal", "view");
+            return false;
+        }
+        p.view = *view;
+    }
     if (req.has_param("patterns")) {
         const std::string v = req.get_param_value("patterns");
         if (v != "on" && v != "off") {

@@ -84,6 +84,7 @@ struct FrameParams {
     bool patternsOff = false;          ///< no dynamic patterns (every placement disabled)
     std::vector<std::string> only;     ///< solo: only these placements (others disabled)
     std::optional<std::uint64_t> revision; ///< the document as it was at this revision
+    FrameView view = FrameView::Shaded;    ///< shaded, or an unlit view of the maps
 };
 
 /// A server-sent-events subscription to one scene: events (whole SSE messages) queue up until
@@ -162,6 +163,13 @@ public:
     /// "convention"} (json), or a size×size PNG (core rasterizeUvEdges).
     Result<nlohmann::json> uvLayout(const std::string& id) const;
     Result<EncodedImage> uvLayoutPng(const std::string& id, int size) const;
+    /// The model's base-colour texture as PNG, for the editor to draw the UV layout over: the
+    /// image covering the most triangles (Model::dominantBaseColorImage), as decoded (RGBA8;
+    /// alpha kept only when some pixel is not opaque), fitted into maxSide × maxSide with its
+    /// aspect kept when `maxSide` is given (core downsizeImage: box filter, never enlarged).
+    /// Fails: maxSide outside [16, 4096] (InvalidArgument, "size"), an unknown model (NotFound,
+    /// "id"), a model without a base-colour texture (NotFound, "texture").
+    Result<EncodedImage> modelTexture(const std::string& id, std::optional<int> maxSide) const;
 
     // --- patterns
     nlohmann::json listPatterns() const;
@@ -267,7 +275,7 @@ public:
     Result<EncodedImage> heightmap(const std::string& id, const std::string& which,
                                    const std::string& format);
     /// Validates a stateless batch ({"scene", "frames": [{"time"} | {"pose"}], "format",
-    /// "size"?}); returns a job that renders frame k on demand.
+    /// "view"?, "size"?}); returns a job that renders frame k on demand.
     struct BatchJob {
         std::size_t frames = 0;
         std::function<Result<EncodedImage>(std::size_t k)> render;

@@ -1,6 +1,8 @@
-// Characters: upload (.glb, or .gltf with its files), list, describe, delete, UV layout.
+// Characters: upload (.glb, or .gltf with its files), list, describe, delete, UV layout,
+// base-colour texture.
 #include "service/service_state.hpp"
 
+#include "core/preview.hpp"
 #include "core/uv_layout.hpp"
 #include "io/frame_io.hpp"
 #include "io/gltf_loader.hpp"
@@ -193,6 +195,25 @@ Result<EncodedImage> Service::uvLayoutPng(const std::string& id, int size) const
     auto model = findModel(*state_, id);
     if (!model) return model.error();
     auto png = encodePng(rasterizeUvEdges(uvEdges(**model), size), true);
+    if (!png) return png.error();
+    return EncodedImage{std::move(*png), "image/png", ""};
+}
+
+Result<EncodedImage> Service::modelTexture(const std::string& id, std::optional<int> maxSide) const {
+    if (maxSide && (*maxSide < 16 || *maxSide > 4096)) return bad("size", "must be in [16, 4096]");
+    std::shared_ptr<const Model> model;
+    {
+        std::shared_lock<std::shared_mutex> lock(state_->mutex);
+        auto it = state_->models.find(id);
+        if (it == state_->models.end()) return notFound("id", "no model \"" + id + "\"");
+        model = it->second.model; // kept alive while encoding, without the lock
+    }
+    const int image = model->dominantBaseColorImage();
+    if (image < 0) return notFound("texture", "model \"" + id + "\" has no base-colour texture");
+    const Image8& src = model->images[static_cast<std::size_t>(image)];
+    bool opaque = true;
+    for (std::size_t k = 3; k < src.rgba.size() && opaque; k += 4) opaque = src.rgba[k] == 255;
+    auto png = maxSide ? encodePng(downsizeImage(src, *maxSide), !opaque) : encodePng(src, !opaque);
     if (!png) return png.error();
     return EncodedImage{std::move(*png), "image/png", ""};
 }

@@ -22,6 +22,7 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     o.pitch = p.pitch;
     o.distance = p.distance;
     o.time = p.time;
+    o.view = p.view;
     RenderLimits rl;
     rl.maxSide = limits.maxRenderSide;
     auto planned = planFrame(snap.scene, *snap.model, snap.images, snap.base, o, rl);
@@ -226,6 +227,11 @@ Result<Service::BatchJob> Service::batch(const json& body) {
     if (auto f = body.find("format"); f != body.end()) {
         if (!f->is_string() || (*f != "png" && *f != "jpeg")) return bad("/format", "must be png or jpeg");
         params.format = f->get<std::string>();
+    }
+    if (auto v = body.find("view"); v != body.end()) {
+        auto view = v->is_string() ? frameViewFromString(v->get<std::string>()) : std::nullopt;
+        if (!view) return bad("/view", "must be shaded, bump, displacement or normal");
+        params.view = *view;
     }
     struct Item {
         State::Snapshot snap;

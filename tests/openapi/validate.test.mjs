@@ -296,6 +296,8 @@ try {
   await api("GET", "/scenes/{id}/lint", { params: { id }, expect: 200 });
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "x=128&y=100&width=256&height=256", expect: 200 });
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "x=1&y=1&width=256&height=256", expect: 200 });
+  const noTexture = await api("GET", "/models/{id}/texture", { params: { id: "builtin:default" }, expect: 404 });
+  assert.equal(noTexture.json().error.code, "no_texture");
   const byUv = await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=0.29&v=0.737", expect: 200 });
   assert.equal(byUv.json().hit, true);
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=1.5&v=0.5", expect: 422 });
