@@ -4,7 +4,8 @@
 //     documented example (models/default.scene.json, examples/*.scene.json, the SPEC's example in
 //     the schema's own tests below) and refuses broken documents;
 //   * every response schema in openapi.yaml compiles, and live answers of the routes that have one
-//     (scenes, history, presence, pick, probe, activation, lint, errors) validate against it;
+//     (scenes, history, presence, pick, probe, activation, lint, sweep steps, errors) validate
+//     against it;
 //   * a wrong answer (a scene answer without its revision, a placement with h < 0, an error
 //     without its code) fails — so the schemas are not vacuous.
 // Usage: node validate.test.mjs <dermis-server> <source dir>   (exit 0 = pass)
@@ -108,6 +109,9 @@ try {
   check("GET /scenes/{id}/probe", 200, (await call("GET", s + "/probe?u=0.29&v=0.737")).json());
   check("GET /scenes/{id}/activation", 200, (await call("GET", s + "/activation?clip=squat&fps=10")).json());
   check("GET /scenes/{id}/lint", 200, (await call("GET", s + "/lint")).json());
+  check("GET /scenes/{id}/sweep", 200, (await call("GET", s + "/sweep?placement=clavicle_r&steps=4&format=json")).json());
+  check("GET /scenes/{id}/sweep", 200, (await call("GET", s + "/sweep?clip=squat&steps=4&format=json")).json());
+  check("GET /scenes/{id}/sweep", 200, (await call("GET", s + "/sweep?clip=squat&placement=knee_l&steps=4&format=json")).json());
   check("GET /scenes/{id}/pick", 200, (await call("GET", s + "/pick?x=128&y=100&width=256&height=256")).json());
   check("GET /scenes/{id}/pick", 200, (await call("GET", s + "/pick?x=1&y=1&width=256&height=256")).json());
   const notFound = await call("GET", "/scenes/s_0000000000000000");
