@@ -10,7 +10,8 @@
 //  * edit (PATCH a placement with If-Match), revert (POST /revert to an old revision);
 //  * probe (GET /probe at the elbow crease), activation (GET /activation of elbow_curl at 30 fps),
 //    lint of the default pattern set (18 placements, 7 clips), pick of a 512² frame's pixel,
-//    mirror of the left elbow crease (a new twin each time);
+//    sweep of the left elbow crease (64 steps as JSON; a 3×3 contact sheet of 160² cells, 9 GL
+//    renders), mirror of the left elbow crease (a new twin each time);
 //  * reopen_ms: Service::open of the data folder with that history.
 #include "http/api.hpp"
 #include "service/service.hpp"
@@ -145,6 +146,12 @@ int main(int argc, char** argv) {
     }
     const std::string fullBase = "/api/v1/scenes/" + (*full)["id"].get<std::string>();
     measure("lint_default_scene", [&](int) { return ok(c.Get(fullBase + "/lint")); });
+    measure("sweep_json_elbow_64", [&](int) {
+        return ok(c.Get(fullBase + "/sweep?placement=elbow_l&steps=64&format=json"));
+    });
+    measure("sweep_sheet_elbow_9x160", [&](int) {
+        return ok(c.Get(fullBase + "/sweep?placement=elbow_l&steps=9&size=160&msaa=1"));
+    });
     measure("pick_512", [&](int r) {
         return ok(c.Get(fullBase + "/pick?width=512&height=512&x=" + std::to_string(200 + r % 100) + "&y=200"));
     });

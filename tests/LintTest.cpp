@@ -1,7 +1,8 @@
 // LintTest — the UV → surface lookup and the scene lint of SPEC §6, on the default character and
 // purpose-built scenes: a footprint hanging off a UV chart, two overlapping footprints on one
-// target, a θ range no clip reaches, a driver joint with no influence under the footprint; the
-// default elbow crease gets none of these. No GL, no HTTP.
+// target, a θ range no clip reaches, a driver joint with no influence under the footprint, mirror
+// pairs made asymmetric; the default elbow crease gets none of these and the default set's left /
+// right pairs are symmetric. No GL, no HTTP.
 #include "core/lint.hpp"
 #include "io/scene_files.hpp"
 
@@ -39,6 +40,18 @@ protected:
         Scene s = loaded_->scene;
         s.placements = placements;
         return lintScene(s, loaded_->model, *lookup_, loaded_->images);
+    }
+    static int indexOf(const std::vector<Placement>& ps, const std::string& id) {
+        for (std::size_t i = 0; i < ps.size(); ++i)
+            if (ps[i].id == id) return static_cast<int>(i);
+        throw std::runtime_error("no placement " + id);
+    }
+    /// The mirror_asymmetric findings of a lint.
+    static std::vector<LintFinding> mirrorFindings(const std::vector<LintFinding>& f) {
+        std::vector<LintFinding> out;
+        for (const LintFinding& x : f)
+            if (x.code == "mirror_asymmetric") out.push_back(x);
+        return out;
     }
     static bool has(const std::vector<LintFinding>& f, const std::string& code, int placement) {
         for (const LintFinding& x : f)
@@ -137,6 +150,66 @@ TEST_F(LintTest, FindsEachPurposeBuiltProblem) {
     // Disabled placements are not linted.
     far.enabled = false;
     EXPECT_TRUE(lint({far}).empty());
+}
+
+TEST_F(LintTest, TheDefaultMirrorPairsAreSymmetric) {
+    // Elbows, knees, biceps, thighs, clavicles (opposite axes, negated ranges) and scapulae pair
+    // by joint name; the waist and rib pairs share one spine joint and are no pair.
+    const auto f = lint(loaded_->scene.placements);
+    for (const LintFinding& x : mirrorFindings(f)) ADD_FAILURE() << x.message;
+}
+
+TEST_F(LintTest, FindsAsymmetricMirrorPairs) {
+    const std::vector<Placement> all = loaded_->scene.placements;
+    const int left = indexOf(all, "elbow_l"), right = indexOf(all, "elbow_r");
+    auto expectOne = [&](const std::vector<Placement>& ps, const std::string& what) {
+        const auto found = mirrorFindings(lint(ps));
+        ASSERT_EQ(found.size(), 1u) << what;
+        EXPECT_EQ(found[0].placement, std::min(left, right)) << what;
+        EXPECT_EQ(found[0].severity, LintSeverity::Warning);
+        EXPECT_NE(found[0].message.find("'elbow_l'"), std::string::npos) << found[0].message;
+        EXPECT_NE(found[0].message.find("'elbow_r'"), std::string::npos) << found[0].message;
+        EXPECT_NE(found[0].message.find(what), std::string::npos) << found[0].message;
+    };
+
+    std::vector<Placement> moved = all; // 0.05 UV = 51 texels at 1024²
+    moved[static_cast<std::size_t>(right)].center[0] += 0.05;
+    expectOne(moved, "texels");
+    std::vector<Placement> nudged = all; // 2 texels: within the tolerance
+    nudged[static_cast<std::size_t>(right)].center[1] += 2.0 / 1024.0;
+    EXPECT_TRUE(mirrorFindings(lint(nudged)).empty());
+
+    std::vector<Placement> range = all;
+    range[static_cast<std::size_t>(right)].thetaMax = 100;
+    expectOne(range, "theta range [0.0, 100.0]");
+
+    std::vector<Placement> turned = all;
+    turned[static_cast<std::size_t>(right)].rotation = 90;
+    expectOne(turned, "footprint");
+    std::vector<Placement> stretched = all;
+    stretched[static_cast<std::size_t>(right)].scale[0] *= 1.6;
+    expectOne(stretched, "footprint");
+
+    std::vector<Placement> axis = all;
+    axis[static_cast<std::size_t>(right)].axis = {0, 1, 0};
+    axis[static_cast<std::size_t>(right)].axisName = "y";
+    expectOne(axis, "axis");
+
+    std::vector<Placement> gain = all;
+    gain[static_cast<std::size_t>(right)].h = 2.0;
+    expectOne(gain, "h, model");
+
+    // An intentionally different pattern is no pair, nor is a placement without a twin.
+    std::vector<Placement> other = moved;
+    other[static_cast<std::size_t>(right)].pattern = "neck_rings";
+    EXPECT_TRUE(mirrorFindings(lint(other)).empty());
+    std::vector<Placement> alone = moved;
+    alone.erase(alone.begin() + right);
+    EXPECT_TRUE(mirrorFindings(lint(alone)).empty());
+    // A disabled twin is not linted.
+    std::vector<Placement> off = moved;
+    off[static_cast<std::size_t>(right)].enabled = false;
+    EXPECT_TRUE(mirrorFindings(lint(off)).empty());
 }
 
 } // namespace

@@ -1,7 +1,13 @@
 // Scene lint. See lint.hpp.
 #include "lint.hpp"
 
+#include "mirror.hpp"
+
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -74,6 +80,96 @@ std::vector<bool> reachable(const Scene& scene, const Model& model) {
     return out;
 }
 
+/// |a − b| in degrees, modulo 180 (so 0 for a footprint turned by a half turn).
+double halfTurnDistance(double a, double b) {
+    const double d = std::fmod(std::abs(a - b), 180.0);
+    return std::min(d, 180.0 - d);
+}
+
+std::string num(double x, int decimals = 2) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+    return buf;
+}
+
+/// mirror_asymmetric findings: pairs are enabled placements with the same pattern on joints that
+/// are mirror twins by name (mirrorJointName), each paired once with the candidate nearest to
+/// where it mirrors; the pair is compared with what mirrorPlacement makes of the first.
+void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& lookup,
+                     std::vector<LintFinding>& out) {
+    const std::size_t n = scene.placements.size();
+    std::vector<bool> paired(n, false);
+    std::optional<SymmetryPlane> plane;
+    const double texW = scene.heightmapSize[0], texH = scene.heightmapSize[1];
+    for (std::size_t i = 0; i < n; ++i) {
+        const Placement& p = scene.placements[i];
+        if (!p.enabled || paired[i]) continue;
+        const std::string twinJoint = mirrorJointName(model, p.joint);
+        if (twinJoint.empty()) continue;
+        std::vector<std::size_t> candidates;
+        for (std::size_t j = 0; j < n; ++j) {
+            const Placement& q = scene.placements[j];
+            if (j != i && !paired[j] && q.enabled && q.pattern == p.pattern && q.joint == twinJoint)
+                candidates.push_back(j);
+        }
+        if (candidates.empty()) continue;
+        if (!plane) plane = symmetryPlane(model);
+        auto m = mirrorPlacement(p, model, lookup, *plane);
+        if (!m) continue; // a centre on no chart: off_chart says so
+        std::size_t best = candidates.front();
+        double bestTexels = std::numeric_limits<double>::infinity();
+        for (std::size_t j : candidates) {
+            const Placement& q = scene.placements[j];
+            const double d = std::hypot((q.center[0] - m->center[0]) * texW, (q.center[1] - m->center[1]) * texH);
+            if (d < bestTexels) {
+                bestTexels = d;
+                best = j;
+            }
+        }
+        paired[i] = paired[best] = true;
+        const Placement& q = scene.placements[best];
+
+        std::vector<std::string> what;
+        if (bestTexels > kMirrorCenterTexels)
+            what.push_back("its centre (" + num(q.center[0], 4) + ", " + num(q.center[1], 4) + ") is " +
+                           num(bestTexels, 1) + " texels from where '" + p.id + "' mirrors to (" +
+                           num(m->center[0], 4) + ", " + num(m->center[1], 4) + ")");
+        // A footprint's mirror image is a reflection, which a placement cannot express: the twin
+        // may have the mirrored rotation (what the mirror route makes) or that turned by 180°
+        // (the reflection itself for a pattern symmetric about its v axis, like a crease).
+        const double turn = halfTurnDistance(q.rotation, m->rotation);
+        const double du = std::abs(q.scale[0] / m->scale[0] - 1.0), dv = std::abs(q.scale[1] / m->scale[1] - 1.0);
+        if (turn > kMirrorRotationDegrees || std::max(du, dv) > kMirrorScaleFraction)
+            what.push_back("its footprint (scale " + num(q.scale[0], 3) + " x " + num(q.scale[1], 3) +
+                           ", rotation " + num(q.rotation, 1) + ") is not the mirrored one (scale " +
+                           num(m->scale[0], 3) + " x " + num(m->scale[1], 3) + ", rotation " +
+                           num(m->rotation, 1) + " or " + num(m->rotation + (m->rotation > 0 ? -180.0 : 180.0), 1) + ")");
+        // An axis and its opposite with the negated range are the same driver.
+        glm::dvec3 am(m->axis[0], m->axis[1], m->axis[2]), aq(q.axis[0], q.axis[1], q.axis[2]);
+        am = glm::normalize(am);
+        aq = glm::normalize(aq);
+        double qMin = q.thetaMin, qMax = q.thetaMax;
+        if (glm::dot(am, aq) < 0.0) {
+            aq = -aq;
+            qMin = -qMin;
+            qMax = -qMax;
+        }
+        const double axisDeg = glm::degrees(std::acos(std::clamp(glm::dot(am, aq), -1.0, 1.0)));
+        if (axisDeg > kMirrorAxisDegrees)
+            what.push_back("its axis is " + num(axisDeg, 1) + " degrees from the mirrored axis");
+        if (std::abs(qMin - m->thetaMin) > kMirrorThetaDegrees || std::abs(qMax - m->thetaMax) > kMirrorThetaDegrees)
+            what.push_back("its theta range [" + num(q.thetaMin, 1) + ", " + num(q.thetaMax, 1) + "]" +
+                           (qMin != q.thetaMin ? " (about the opposite axis: [" + num(qMin, 1) + ", " + num(qMax, 1) + "])" : "") +
+                           " is not the mirrored [" + num(m->thetaMin, 1) + ", " + num(m->thetaMax, 1) + "]");
+        if (std::abs(q.h - p.h) > 1e-6 || q.model != p.model || q.target != p.target || q.response != p.response)
+            what.push_back("its h, model, target or response differs");
+        if (what.empty()) continue;
+        std::string message = "mirror pair '" + p.id + "' / '" + q.id + "' is not symmetric: ";
+        for (std::size_t k = 0; k < what.size(); ++k) message += (k ? "; " : "") + what[k];
+        out.push_back({"mirror_asymmetric", LintSeverity::Warning, static_cast<int>(i), message});
+    }
+}
+
 } // namespace
 
 std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,
@@ -137,6 +233,9 @@ std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const
                                    percent(shared, n) + " of this footprint): heights add up"});
         }
     }
+    lintMirrorPairs(scene, model, lookup, out);
+    std::stable_sort(out.begin(), out.end(),
+                     [](const LintFinding& a, const LintFinding& b) { return a.placement < b.placement; });
     return out;
 }
 

@@ -1,7 +1,18 @@
 // Dermis core — what may be wrong with a scene that still validates (SPEC §6 Lint): footprints
 // hanging off the UV charts (the pattern is lost there) or across a chart seam, footprints
 // overlapping on one target, θ ranges no clip reaches, driver joints with no skin influence under
-// their footprint.
+// their footprint, mirror pairs that are not symmetric.
+//
+// Mirror pairs: two enabled placements with the same pattern whose joints are mirror twins by
+// name (mirrorJointName: elbow.l / elbow.r; an intentionally different pattern is no pair), each
+// placement paired once, with the candidate nearest to where it mirrors. The first of the pair
+// (document order) is mirrored by mirrorPlacement (core/mirror.hpp) and compared with the
+// second: centre (kMirrorCenterTexels of the scene's height map), scale (kMirrorScaleFraction
+// per axis), rotation (kMirrorRotationDegrees, modulo 180°: a reflection is no rotation, so the
+// twin may have the mirrored rotation or that turned by a half turn, which is the reflection of a
+// pattern symmetric about its v axis), axis (kMirrorAxisDegrees; an axis and its opposite with
+// the negated θ range count as the same driver), θ range (kMirrorThetaDegrees), and h / model /
+// target / response (equal). Unpaired placements are no finding.
 //
 // Each placement's footprint is sampled on a 12×12 grid of pattern coordinates; only samples
 // where its pattern is not flat (|L| > 0.02, when the image is given) count, so a transparent
@@ -20,14 +31,23 @@ namespace dermis {
 enum class LintSeverity { Info, Warning };
 std::string_view toString(LintSeverity s);
 
+/// Tolerances of a mirror pair (see above).
+inline constexpr double kMirrorCenterTexels = 4.0;     ///< centre distance, height-map texels
+inline constexpr double kMirrorScaleFraction = 0.15;   ///< |scale / mirrored scale − 1| per axis
+inline constexpr double kMirrorRotationDegrees = 10.0; ///< footprint rotation, modulo 180°
+inline constexpr double kMirrorAxisDegrees = 5.0;      ///< angle between the axes
+inline constexpr double kMirrorThetaDegrees = 0.5;     ///< θmin and θmax each
+
 struct LintFinding {
-    std::string code;     ///< off_chart, across_seam, overlap, unreachable_range, no_influence, no_uvs
+    /// off_chart, across_seam, overlap, unreachable_range, no_influence, mirror_asymmetric, no_uvs
+    std::string code;
     LintSeverity severity = LintSeverity::Warning;
     int placement = -1;   ///< index in Scene::placements (−1: the scene as a whole)
     std::string message;  ///< for people: what and why, with the numbers
 };
 
-/// The findings of `scene` on `model`, by placement in document order. `images` may lack a
+/// The findings of `scene` on `model`, by placement in document order (a mirror pair's finding
+/// under its first placement, naming both). `images` may lack a
 /// pattern (then every sample counts). Never fails: unknown joints or clips are what
 /// validation reports, not lint.
 std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,

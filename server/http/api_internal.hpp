@@ -7,7 +7,7 @@
 //   api_session.cpp  /session (browser sign-in) and the SessionStore
 //   api_models.cpp   /models…            api_patterns.cpp  /patterns…
 //   api_scenes.cpp   /scenes, placements, pose
-//   api_renders.cpp  frames, height maps, the stateless batch (/render)
+//   api_renders.cpp  frames, frame diffs, height maps, sweeps, the stateless batch (/render)
 //   api_events.cpp   /scenes/{id}/events (server-sent events)
 // Registration with httplib, Api::routes() (checked against openapi.yaml by RoutesHttpTest), the
 // 405 Allow lists and the open-route check of authentication all read that table, so a route

@@ -1,5 +1,6 @@
-// Dermis HTTP shell — render routes: a scene's frame, its height maps, and the stateless batch
-// (POST /render), whose frames stream as multipart/mixed parts as they finish. Renders go through
+// Dermis HTTP shell — render routes: a scene's frame, its height maps, its sweep (a contact sheet
+// of a joint or clip swept in steps, or the steps as JSON), and the stateless batch (POST
+// /render), whose frames stream as multipart/mixed parts as they finish. Renders go through
 // the Service to the renderer's thread (a full queue answers 503 + Retry-After).
 #include "http/api_internal.hpp"
 
@@ -62,6 +63,35 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
     return true;
 }
 
+/// The sweep query: placement, clip, steps, size, format (png | json) and the frame's camera,
+/// msaa, time and compare parameters (width/height are refused: cells are size × size). False
+/// (and the 422 sent) when a parameter is malformed.
+bool sweepParams(const Req& req, Res& res, SweepParams& s) {
+    if (!frameParams(req, res, s.frame)) return false;
+    if (req.has_param("width") || req.has_param("height")) {
+        sendError(res, 422, "invalid_argument",
+                  "dermis::Api: width/height: a sweep's cells are size x size: use size",
+                  req.has_param("width") ? "width" : "height");
+        return false;
+    }
+    if (s.frame.format != "png" && s.frame.format != "json") {
+        sendError(res, 422, "invalid_argument", "dermis::Api: format: must be png or json", "format");
+        return false;
+    }
+    std::optional<int> steps, size;
+    if (!intParam(req, res, "steps", steps) || !intParam(req, res, "size", size)) return false;
+    if (steps) s.steps = *steps;
+    if (size) s.size = *size;
+    if (req.has_param("placement")) s.placement = req.get_param_value("placement");
+    if (req.has_param("clip")) s.clip = req.get_param_value("clip");
+    if ((req.has_param("placement") && s.placement.empty()) || (req.has_param("clip") && s.clip.empty())) {
+        const char* field = req.has_param("placement") && s.placement.empty() ? "placement" : "clip";
+        sendError(res, 422, "invalid_argument", std::string("dermis::Api: ") + field + ": must not be empty", field);
+        return false;
+    }
+    return true;
+}
+
 } // namespace
 
 void installRenderRoutes(RouteTable& t) {
@@ -78,6 +108,18 @@ void installRenderRoutes(RouteTable& t) {
         if (!req.has_param("against"))
             return sendError(res, 422, "invalid_argument", "dermis::Api: against: off or a revision number is required", "against");
         auto r = a.svc.frameDiff(req.matches[1], p, req.get_param_value("against"));
+        if (!r) return sendError(res, r.error());
+        sendImage(res, std::move(*r));
+    });
+    t.add("GET", "/scenes/{id}/sweep", [](Api::Impl& a, const Req& req, Res& res) {
+        SweepParams p;
+        if (!sweepParams(req, res, p)) return;
+        if (p.frame.format == "json") {
+            auto r = a.svc.sweepSteps(req.matches[1], p);
+            if (!r) return sendError(res, r.error());
+            return sendJson(res, 200, *r);
+        }
+        auto r = a.svc.sweep(req.matches[1], p);
         if (!r) return sendError(res, r.error());
         sendImage(res, std::move(*r));
     });

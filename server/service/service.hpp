@@ -15,7 +15,7 @@
 //
 // Files: service.cpp (open, info), service_models.cpp, service_patterns.cpp,
 // service_scenes.cpp (documents and edits), service_history.cpp (revisions, revert, presence),
-// service_inspect.cpp (probe, activation),
+// service_inspect.cpp (pick, probe, activation, lint), service_sweep.cpp (sweeps),
 // service_renders.cpp (frames, maps, batch), service_events.cpp; shared private state in
 // service_state.hpp.
 //
@@ -86,6 +86,19 @@ struct FrameParams {
     std::optional<std::uint64_t> revision; ///< the document as it was at this revision
     FrameView view = FrameView::Shaded;    ///< shaded, or an unlit view of the maps
 };
+
+/// Query parameters of a sweep (SPEC §6 Sweep). `frame` carries the camera, msaa, time and what
+/// to compare exactly as a frame's (its width/height are not used: each cell is size × size).
+struct SweepParams {
+    std::string placement;    ///< the placement whose joint is swept, or whose t labels a clip sweep
+    std::string clip;         ///< sweep this clip's time instead of a joint ("" = a joint sweep)
+    int steps = 8;            ///< 2..kMaxSweepCells for a sheet, 2..kMaxSweepSteps (1000) for JSON
+    int size = 128;           ///< each cell's side in pixels
+    FrameParams frame;
+};
+
+/// Most cells of one contact sheet.
+inline constexpr int kMaxSweepCells = 64;
 
 /// A server-sent-events subscription to one scene: events (whole SSE messages) queue up until
 /// taken. A reader that falls kMaxQueued events behind loses them: the queue is replaced by one
@@ -259,6 +272,23 @@ public:
     /// message}] from core lintScene, plus `unused_upload` (info) for every uploaded pattern no
     /// scene uses.
     Result<nlohmann::json> lint(const std::string& id);
+
+    // --- sweeps (service_sweep.cpp)
+    /// The steps of a sweep as JSON (core jointSweep / clipSweep on the frame's snapshot):
+    /// joint sweeps {scene, placement, joint, axis, theta_min, theta_max, time, steps: [{theta,
+    /// t}], placements: {pid: [t…]}}; clip sweeps {scene, clip, duration, placement (or null),
+    /// steps: [{time, t: {pid: t}}]} (t of every placement, or of `placement` alone when given).
+    /// Fails: InvalidArgument "placement" when neither placement nor clip is given, "steps"
+    /// outside 2..1000; NotFound "placement" / "clip" for unknown ones; like frame() otherwise.
+    Result<nlohmann::json> sweepSteps(const std::string& id, const SweepParams& params);
+    /// The sweep rendered as a PNG contact sheet: one size × size cell per step, laid out by
+    /// core sheetLayout, each labelled (θ and t; or the clip time and the t of `placement`, or of
+    /// every placement with t ≥ 0.005, most active first, as many lines as fit 40% of the cell).
+    /// The renderer has no batch call: the cells are N renderFrame calls made in this one request,
+    /// holding one render-queue slot. Fails like sweepSteps, with "steps" outside 2..kMaxSweepCells, "size" outside
+    /// 1..8192 (InvalidArgument) or over the render-side limit, alone or as the sheet's side
+    /// (TooLarge).
+    Result<EncodedImage> sweep(const std::string& id, const SweepParams& params);
 
     // --- renders
     /// A frame of scene `id` with `params`' overrides; `patternsOff`, `only` (unknown ids fail,

@@ -296,6 +296,11 @@ try {
   await api("GET", "/scenes/{id}/lint", { params: { id }, expect: 200 });
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "x=128&y=100&width=256&height=256", expect: 200 });
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "x=1&y=1&width=256&height=256", expect: 200 });
+  for (const q of ["placement=clavicle_r&steps=4&format=json", "clip=squat&steps=4&format=json", "clip=squat&placement=knee_l&steps=4&format=json"])
+    await api("GET", "/scenes/{id}/sweep", { params: { id }, query: q, expect: 200 });
+  const sheet = await api("GET", "/scenes/{id}/sweep", { params: { id }, query: "placement=elbow_l&steps=4&size=48", expect: 200 });
+  assert.ok(isPng(sheet.bytes));
+  await api("GET", "/scenes/{id}/sweep", { params: { id }, query: "placement=elbow_l&steps=0", expect: 422 });
   const noTexture = await api("GET", "/models/{id}/texture", { params: { id: "builtin:default" }, expect: 404 });
   assert.equal(noTexture.json().error.code, "no_texture");
   const byUv = await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=0.29&v=0.737", expect: 200 });
