@@ -51,6 +51,16 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
             return false;
         }
     }
+    if (req.has_param("preview")) {
+        const std::string v = req.get_param_value("preview");
+        json patch = json::parse(v, nullptr, false);
+        if (v.size() > 16384 || patch.is_discarded() || !patch.is_object() || patch.size() > 100) {
+            sendError(res, 422, "invalid_argument",
+                      "dermis::Api: preview: a JSON object (at most 16 KB) of placement id -> patch", "preview");
+            return false;
+        }
+        p.preview = std::move(patch);
+    }
     if (req.has_param("revision")) {
         std::optional<double> r;
         if (!numberParam(req, res, "revision", r)) return false;

@@ -85,6 +85,10 @@ struct FrameParams {
     std::vector<std::string> only;     ///< solo: only these placements (others disabled)
     std::optional<std::uint64_t> revision; ///< the document as it was at this revision
     FrameView view = FrameView::Shaded;    ///< shaded, or an unlit view of the maps
+    /// Preview: placement id → a JSON merge patch applied to that placement for this frame only
+    /// (nothing is stored, no revision is made) — the editor's frames while a drag runs. Empty:
+    /// none. Unknown ids and patches that make the document invalid fail (field "preview").
+    nlohmann::json preview = nlohmann::json::object();
 };
 
 /// Query parameters of a sweep (SPEC §6 Sweep). `frame` carries the camera, msaa, time and what

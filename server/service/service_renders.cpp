@@ -41,24 +41,47 @@ Result<Image8> Service::State::renderImage(const Snapshot& snap, const FramePara
 Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string& id,
                                                               const FrameParams& p) const {
     Result<Snapshot> snap = makeError(ErrorCode::Internal, "", "", "");
-    if (p.revision) {
+    const bool preview = p.preview.is_object() && !p.preview.empty();
+    if (p.revision || preview) {
         std::uint64_t current = 0;
+        json doc;
         {
             std::shared_lock<std::shared_mutex> lock(mutex);
             auto it = scenes.find(id);
             if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
             current = it->second.revision;
+            if (!p.revision || *p.revision == current) doc = it->second.doc;
         }
-        if (*p.revision == 0 || *p.revision > current)
+        if (p.revision && (*p.revision == 0 || *p.revision > current))
             return notFound("revision", "scene " + id + " has no revision " + std::to_string(*p.revision));
-        auto doc = store->readRevision(id, *p.revision);
-        if (!doc) return doc.error();
+        if (doc.is_null()) {
+            auto old = store->readRevision(id, *p.revision);
+            if (!old) return old.error();
+            doc = std::move(*old);
+        }
+        if (preview) {
+            json& placements = doc["placements"];
+            for (auto it = p.preview.begin(); it != p.preview.end(); ++it) {
+                json* target = nullptr;
+                for (json& pl : placements)
+                    if (pl.is_object() && pl.value("id", "") == it.key()) target = &pl;
+                if (!target) return bad("preview", "no placement \"" + it.key() + "\" in scene " + id);
+                if (!it.value().is_object())
+                    return bad("preview", "the patch of \"" + it.key() + "\" must be a JSON object");
+                if (auto pid = it.value().find("id"); pid != it.value().end() && *pid != it.key())
+                    return bad("preview", "a placement's id cannot be changed");
+                target->merge_patch(it.value());
+            }
+        }
         std::shared_lock<std::shared_mutex> lock(mutex);
-        auto prepared = prepare(*doc, false);
-        if (!prepared)
+        auto prepared = prepare(doc, false);
+        if (!prepared) {
+            if (preview)
+                return bad("preview", "the previewed document is not valid: " + prepared.error().message);
             return makeError(ErrorCode::Conflict, "dermis::Service", "revision",
                              "revision " + std::to_string(*p.revision) +
                                  " no longer renders: " + prepared.error().message);
+        }
         snap = snapshotOf(prepared->scene, prepared->model);
     } else {
         snap = snapshot(id);

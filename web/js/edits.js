@@ -9,6 +9,7 @@
 
 import { store, set, emit } from "./store.js";
 import { notify } from "./notice.js";
+import { trace } from "./trace.js";
 
 let api = null;
 const undoStack = []; // revisions to go back to (the document before one of my edits)
@@ -51,7 +52,9 @@ async function send(method, path, body, { undoable = true, quiet = false } = {})
   const payload = typeof body === "function" ? body(store.doc) : body;
   if (payload === null) return null;
   try {
+    const sentAt = performance.now();
     const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, payload, before);
+    if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
     accept(answer);
     if (undoable) {
       undoStack.push(before);
@@ -121,6 +124,10 @@ export class Stream {
     this.before = store.revision;
     this.timer = null;
     this.done = false;
+    ++store.gestures;
+  }
+  end() {
+    if (!this.ended) { this.ended = true; --store.gestures; emit("gestures"); }
   }
   send(value) {
     if (this.done) return;
@@ -152,6 +159,7 @@ export class Stream {
         this.inFlight = this.apply(value).finally(() => { this.inFlight = null; });
       }
     }
+    this.end();
     if (this.sent > 0) {
       undoStack.push(this.before);
       redoStack.length = 0;
@@ -163,6 +171,7 @@ export class Stream {
     this.pending = undefined;
     if (this.timer) { clearTimeout(this.timer); this.timer = null; }
     if (this.inFlight) await this.inFlight;
+    this.end();
     if (this.sent > 0) await revert(this.before, { undoable: false });
   }
 }

@@ -4,10 +4,12 @@
 // bump / displacement / normal; compare with a split slider, flicker, or the diff heat map against
 // "patterns off" or a chosen revision.
 //
-// Frames are coalesced: one request in flight per image, the newest wanted URL wins when it ends,
+// While a drag runs in the texture view, frames preview the dragged placement (the frame route's
+// `preview`: nothing stored) at each pointer move, with MSAA off; the edits go to the server at
+// their own pace. Frames are coalesced: one request in flight per image, the newest wanted URL wins when it ends,
 // and a frame never replaces a newer one; a frame slower than 500 ms shows a spinner.
 
-import { store, on, set, emit, shownTime } from "./store.js";
+import { store, on, set, emit, shownTime, whenIdle } from "./store.js";
 import { API, query } from "./api.js";
 import * as geo from "./geometry.js";
 import { notify } from "./notice.js";
@@ -127,13 +129,13 @@ export function initFrameView(section, theApi) {
   $("placeTool").onclick = () => setPlaceTool(!placeTool);
   $("resetCamera").onclick = () => set({ camera: { yaw: 0, pitch: 10, distance: null } });
   orbit(stage);
-  on("doc revision camera view compare solo time pinnedRevision", () => {
+  on("doc revision camera view compare solo time pinnedRevision gestures drag", () => {
     $("viewMode").value = store.view;
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
     refresh();
   });
-  on("revision", fillAgainst);
+  on("revision", () => whenIdle("compare-list", fillAgainst, 400));
 }
 
 /// Sets the frame size (one of 384, 512, 768, 1024; a permalink's size).
@@ -157,11 +159,13 @@ export function frameParams() {
   const c = store.camera;
   return {
     width: frameSize, height: frameSize,
+    msaa: store.gestures > 0 ? 1 : undefined, // while dragging: quicker frames; the scene's MSAA after
     yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined,
     time: shownTime(),
     view: store.view === "shaded" ? undefined : store.view,
     only: store.solo.length ? store.solo.join(",") : undefined,
     revision: store.pinnedRevision ?? store.revision,
+    preview: previewSource() ? JSON.stringify(previewSource()) : undefined,
   };
 }
 
@@ -286,6 +290,9 @@ async function click(e) {
 }
 
 let currentPattern = () => null;
+let previewSource = () => null;
+/// fn() → {placementId: fields} the frames preview (a drag in the texture view), or null.
+export function setPreviewSource(fn) { previewSource = fn; }
 export function setPatternSource(fn) { currentPattern = fn; }
 
 /// Adds a placement of the library's current pattern at `uv` driven by `suggested`.

@@ -63,7 +63,8 @@ export function connect() {
     const ev = JSON.parse(e.data);
     emit("event");
     if (ev.scene !== store.sceneId) return;
-    if (ev.revision <= store.revision) return; // ours (applied from the answer) or older
+    if (ev.revision <= store.revision) return; // older than what this editor has
+    if (ev.client && ev.client === api.client && store.busy > 0) return; // ours: its answer brings the document
     reload();
   });
   es.addEventListener("resync", () => reload());

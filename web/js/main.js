@@ -4,13 +4,13 @@
 // placements, and "Copy link".
 
 import { Api, makeClientName, ApiError } from "./api.js";
-import { store, set, on, emit } from "./store.js";
+import { store, set, on, emit, whenIdle } from "./store.js";
 import { signIn } from "./signin.js";
 import { notify } from "./notice.js";
 import { initImages, forget } from "./images.js";
 import { initEdits, accept, clearUndo, canUndo, canRedo, putScene, undo, redo, revert } from "./edits.js";
-import { initTextureView, fit, screenGeometry } from "./texture_view.js";
-import { initFrameView, setPatternSource, setFrameSize, frameStats, frameUrl, pickAt } from "./frame_view.js";
+import { initTextureView, fit, screenGeometry, dragPreview } from "./texture_view.js";
+import { initFrameView, setPatternSource, setPreviewSource, setFrameSize, frameStats, frameUrl, pickAt } from "./frame_view.js";
 import { initLibrary, currentPattern, uploadPattern } from "./panels/library.js";
 import { initPlacements } from "./panels/placements.js";
 import { initParams } from "./panels/params.js";
@@ -103,7 +103,12 @@ function wireToolbar() {
     $("unpin").onclick = () => set({ pinnedRevision: null });
     $("revertPinned").onclick = () => revert(store.pinnedRevision);
   });
-  on("revision", () => { forget(`/scenes/${store.sceneId}/heightmaps/`); loadLint(); });
+  on("revision", () => whenIdle("lint", () => {
+    forget(`/scenes/${store.sceneId}/heightmaps/`);
+    store.overlayRevision = store.revision; // the overlay follows once things are quiet
+    loadLint();
+    emit("overlay");
+  }));
   // Files dropped anywhere: a .glb makes a new scene, an image becomes a pattern, anything else is refused.
   document.addEventListener("dragover", (e) => { if ([...e.dataTransfer.types].includes("Files")) e.preventDefault(); });
   document.addEventListener("drop", (e) => {
@@ -150,6 +155,7 @@ async function start() {
   initTextureView($("textureView"));
   initFrameView($("frameView"), api);
   setPatternSource(currentPattern);
+  setPreviewSource(dragPreview);
   initLibrary($("libraryPanel"), api);
   initPlacements($("placementsPanel"));
   initParams($("paramsPanel"), api);

@@ -25,7 +25,8 @@ export const store = {
   cursorUV: [0.5, 0.5], // last pointer position in the texture view
   liveCamera: null,     // the camera the server used (GET drivers: "auto" distance resolved)
   online: true,
-  busy: 0,
+  busy: 0,              // edits queued or in flight
+  gestures: 0,          // drags and slider gestures running
 };
 
 const listeners = new Map();
@@ -62,3 +63,18 @@ export const heightmapSize = () => (store.doc && store.doc.heightmap && store.do
 export const clipByName = (name) => (store.model ? store.model.clips.find((c) => c.name === name) : undefined);
 /// The time the 3D view shows.
 export const shownTime = () => (store.time !== null ? store.time : (store.doc ? store.doc.pose.time || 0 : 0));
+
+const idleTimers = new Map();
+
+/// Runs fn once things are quiet: no gesture running, no edit in flight, and `delay` ms after
+/// the last call with the same `key` — what the side panels (history, lint, activation, the
+/// dial) fetch after a change, so that while dragging the frames have the server to themselves.
+export function whenIdle(key, fn, delay = 200) {
+  clearTimeout(idleTimers.get(key));
+  const attempt = () => {
+    if (store.gestures > 0 || store.busy > 0) { idleTimers.set(key, setTimeout(attempt, delay)); return; }
+    idleTimers.delete(key);
+    fn();
+  };
+  idleTimers.set(key, setTimeout(attempt, delay));
+}

@@ -78,6 +78,11 @@ export function redraw() {
   requestAnimationFrame(draw);
 }
 
+/// The running drag's placement as the frame should preview it ({id: fields}), or null.
+export function dragPreview() {
+  return drag && drag.kind !== "pan" && drag.value ? { [drag.id]: drag.value } : null;
+}
+
 /// True while a drag runs (Esc cancels it; see cancelDrag).
 export const dragging = () => drag !== null && drag.kind !== "pan";
 
@@ -111,7 +116,7 @@ function draw() {
     ctx.globalAlpha = 1;
   }
   if (store.overlay !== "none") {
-    const ov = image(`/scenes/${store.sceneId}/heightmaps/${store.overlay}?format=png&size=512&revision=${store.revision}`);
+    const ov = image(`/scenes/${store.sceneId}/heightmaps/${store.overlay}?format=png&revision=${store.overlayRevision || store.revision}`);
     if (ov) {
       ctx.globalAlpha = 0.8;
       ctx.globalCompositeOperation = "screen";
@@ -288,12 +293,7 @@ function pointerDown(e) {
   if (store.pinnedRevision !== null) return; // an old revision is shown: no edits until the person leaves it
   const orig = { ...placementById(what.id) };
   drag = { ...what, start: uv, orig, value: null,
-           stream: new Stream(async (fields) => {
-             const sentAt = performance.now();
-             const answer = await patchPlacement(what.id, fields, { undoable: false });
-             if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
-             return answer;
-           }) };
+           stream: new Stream((fields) => patchPlacement(what.id, fields, { undoable: false })) };
   capture(e);
 }
 
@@ -334,7 +334,7 @@ async function pointerUp(e) {
   const d = drag;
   drag = null;
   if (d.kind === "pan") return;
-  if (!d.value) { d.stream.done = true; return; }
+  if (!d.value) { d.stream.done = true; d.stream.end(); return; }
   await d.stream.finish();
   redraw();
 }

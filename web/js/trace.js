@@ -1,6 +1,7 @@
 // Latency trace of dragging, for the browser benchmark (off unless a test turns it on through
 // window.dermisEditor.trace.on = true): pointer moves, edit acknowledgements (when the edit was
-// sent, and answered) and frames (when requested, and on screen), all performance.now() ms.
+// sent, and answered — taken before the answer is applied, so a frame it causes is wanted after)
+// and frames (when wanted, and on screen), all performance.now() ms.
 
 export const trace = { on: false, moves: [], acks: [], frames: [] };
 

@@ -2,7 +2,7 @@
 // lane per placement (brightness = t), the route's flags marked (never active, saturated, jump),
 // the shown time as a cursor; click or drag to jump to a time.
 
-import { store, on, set, clipByName, shownTime } from "../store.js";
+import { store, on, set, clipByName, shownTime, whenIdle } from "../store.js";
 import { notify } from "../notice.js";
 
 let api, canvas, data = null, key = "";
@@ -11,7 +11,7 @@ export function initActivation(section, theApi) {
   api = theApi;
   section.innerHTML = `<canvas id="activation" width="900" height="220" tabindex="0" aria-label="activation strip: t of each placement over the clip; click to jump to a time"></canvas>`;
   canvas = section.querySelector("#activation");
-  on("revision doc", load);
+  on("revision doc", () => whenIdle("activation", load));
   on("time selection", draw);
   const jump = (e) => {
     if (!data) return;

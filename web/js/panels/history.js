@@ -1,7 +1,7 @@
 // History panel: the scene's revisions, newest first, with operation, client and time; click one
 // to revert to it (a new revision equal to that one; undoable). Reloads when the revision moves.
 
-import { store, on } from "../store.js";
+import { store, on, whenIdle } from "../store.js";
 import { revert } from "../edits.js";
 import { escapeHtml } from "./library.js";
 import { notify } from "../notice.js";
@@ -12,7 +12,7 @@ export function initHistory(section, theApi) {
   api = theApi;
   section.innerHTML = `<h2>History</h2><ul class="list history" id="historyList" aria-label="revisions"></ul>`;
   list = section.querySelector("#historyList");
-  on("revision", load);
+  on("revision", () => whenIdle("history", load));
 }
 
 async function load() {

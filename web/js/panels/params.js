@@ -4,7 +4,7 @@
 // "go to pose" buttons (pose the driver at θmin / θmax) and the sweep contact sheet. Each field
 // is sent when it changes (Enter or leaving it).
 
-import { store, on, primary, shownTime } from "../store.js";
+import { store, on, primary, shownTime, whenIdle } from "../store.js";
 import { patchPlacement, patchPose, mirrorPlacement } from "../edits.js";
 import { height, normalizedT } from "../deform.js";
 import { escapeHtml } from "./library.js";
@@ -17,8 +17,9 @@ export function initParams(section, theApi) {
   api = theApi;
   section.innerHTML = `<h2>Parameters <span class="grow"></span><span id="paramsId" class="badge"></span></h2><div id="paramsBody"></div>`;
   box = section.querySelector("#paramsBody");
-  on("selection doc model patterns", render);
-  on("selection doc time revision", loadDrivers);
+  on("selection model patterns", render);
+  on("doc", refreshValues);
+  on("selection doc time revision", () => whenIdle("drivers", loadDrivers, 60));
   on("drivers", drawLive);
 }
 
@@ -43,6 +44,7 @@ const opt = (values, cur) => values.map((v) => `<option${v === cur ? " selected"
 
 function render() {
   const p = primary();
+  shownId = p ? p.id : null;
   document.getElementById("paramsId").textContent = p ? p.id : "";
   if (!p) {
     box.innerHTML = `<p class="hint">Select a placement (click it in either view or in the list), or place a new one: choose a pattern and press 1–9 over the texture view, or use the place tool on the 3D view.</p>`;
@@ -96,6 +98,23 @@ function render() {
   $("clearPose").onclick = () => patchPose({ joints: { [p.joint]: null } });
   $("sweep").onclick = () => openSweep(p);
   $("mirror").onclick = () => mirrorPlacement(p.id);
+  drawLive();
+}
+
+let shownId = null;
+
+/// The document changed: the same placement's fields take the new values in place (the field
+/// being typed in keeps its text); another placement, or a vanished one, renders anew.
+function refreshValues() {
+  const p = primary();
+  if (!p || p.id !== shownId || !box.querySelector("#pH")) { render(); return; }
+  const set = (id, v) => { const el = box.querySelector("#" + id); if (el && el !== document.activeElement) el.value = String(v); };
+  set("pLabel", p.label || ""); set("pPattern", p.pattern); set("pJoint", p.joint); set("pAxis", p.axis);
+  set("pMin", p.theta_min); set("pMax", p.theta_max); set("pH", p.h); set("pModel", p.model); set("pTarget", p.target);
+  set("pResponse", p.response); set("pU", p.center[0]); set("pV", p.center[1]); set("pSX", p.scale[0]); set("pSY", p.scale[1]);
+  set("pRot", p.rotation);
+  const en = box.querySelector("#pEnabled");
+  if (en) en.checked = p.enabled;
   drawLive();
 }
 

@@ -3,7 +3,7 @@
 // new order); click selects in both views (Shift adds). Rows are buttons: Tab reaches them, Enter
 // selects, Alt+↑/↓ moves the selection in the list.
 
-import { store, on, set } from "../store.js";
+import { store, on, set, whenIdle } from "../store.js";
 import { patternImagePath } from "../images.js";
 import { patchPlacement, putScene } from "../edits.js";
 import { escapeHtml } from "./library.js";
@@ -15,7 +15,8 @@ export function initPlacements(section) {
     <ul class="list" id="placementList" aria-label="placements"></ul>`;
   list = section.querySelector("#placementList");
   count = section.querySelector("#placementCount");
-  on("doc selection lint solo", render);
+  on("selection lint solo", render);
+  on("doc", () => whenIdle("placements", render, 0)); // not on every step of a drag
 }
 
 export function toggleEnabled(ids) {
