@@ -213,6 +213,18 @@ TEST_F(BadInputHttpTest, BadInputGetsAJsonErrorWithTheRightStatus) {
         {"uv-layout size=0", "GET", "/models/builtin:default/uv-layout?format=png&size=0", "", "", {422}, "size"},
         {"pattern image size=0", "GET", "/patterns/crease/image?size=0", "", "", {422}, "size"},
         {"pattern image size=99999", "GET", "/patterns/crease/image?size=99999", "", "", {413, 422}, "size"},
+        // --- frame previews: {placement id: merge patch}, nothing stored
+        {"preview not JSON", "GET", scene + "/frame?preview=%7Bx", "", "", {422}, "preview"},
+        {"preview an array", "GET", scene + "/frame?preview=%5B1%5D", "", "", {422}, "preview"},
+        {"preview of an unknown placement", "GET", scene + "/frame?preview=%7B%22ghost%22%3A%7B%7D%7D", "", "", {422}, "preview"},
+        {"preview with NaN-like h", "GET", scene + "/frame?preview=%7B%22elbow%22%3A%7B%22h%22%3A%22nan%22%7D%7D", "", "", {422}, "preview"},
+        {"preview of 20 KB", "GET", scene + "/frame?preview=%7B%22elbow%22%3A%7B%22label%22%3A%22" + std::string(20000, 'a') + "%22%7D%7D", "", "", {422, 414, 431}, ""},
+        // --- pick by texture point, drivers
+        {"pick u outside [0,1]", "GET", scene + "/pick?u=1.5&v=0.5", "", "", {422}, "u"},
+        {"pick u without v", "GET", scene + "/pick?u=0.5", "", "", {422}, "v"},
+        {"pick u,v and x,y", "GET", scene + "/pick?u=0.5&v=0.5&x=1&y=1", "", "", {422}, "u"},
+        {"drivers of an unknown revision", "GET", scene + "/drivers?revision=9999", "", "", {404}, "revision"},
+        {"drivers at a negative time", "GET", scene + "/drivers?time=-1", "", "", {422}, "time"},
         // --- sweeps (SPEC §6 Sweep): steps 2..64 for a sheet, 2..1000 as JSON; cells size x size
         {"sweep without placement or clip", "GET", scene + "/sweep?steps=4", "", "", {422}, "placement"},
         {"sweep steps=0", "GET", scene + "/sweep?placement=elbow&steps=0", "", "", {422}, "steps"},

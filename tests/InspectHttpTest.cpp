@@ -254,3 +254,41 @@ TEST_F(InspectHttpTest, FrameViews) {
 }
 
 } // namespace
+
+TEST_F(InspectHttpTest, PreviewRendersAnEditWithoutStoringIt) {
+    Http h = http();
+    Reply created = h.post("/scenes", {{"default_patterns", true}});
+    ASSERT_EQ(created.status, 201) << created;
+    const std::string s = "/scenes/" + created.js()["id"].get<std::string>();
+    const std::string size = "width=128&height=128&msaa=1";
+    // {"elbow_l":{"center":[0.3,0.5],"h":2}}, percent-encoded.
+    const std::string moveElbow = "%7B%22elbow_l%22%3A%7B%22center%22%3A%5B0.3%2C0.5%5D%2C%22h%22%3A2%7D%7D";
+    Reply before = h.get(s + "/frame?" + size);
+    Reply preview = h.get(s + "/frame?preview=" + moveElbow + "&" + size);
+    ASSERT_EQ(preview.status, 200) << preview;
+    EXPECT_TRUE(preview.body != before.body) << "the previewed elbow changes the frame";
+    // Nothing was stored: same revision, same document.
+    Reply doc = h.get(s);
+    EXPECT_EQ(doc.js()["revision"], 1);
+    EXPECT_EQ(doc.js()["scene"], created.js()["scene"]);
+    // The preview equals the frame of the edited document, byte for byte; with revision= too.
+    Reply atOne = h.get(s + "/frame?revision=1&preview=" + moveElbow + "&" + size);
+    ASSERT_EQ(atOne.status, 200) << atOne;
+    EXPECT_TRUE(atOne.body == preview.body);
+    ASSERT_EQ(h.patch(s + "/placements/elbow_l", {{"center", {0.3, 0.5}}, {"h", 2}}).status, 200);
+    EXPECT_TRUE(h.get(s + "/frame?" + size).body == preview.body) << "the preview equals the edit's frame";
+    // A preview of the old revision still applies to that revision's document.
+    Reply oldPreview = h.get(s + "/frame?revision=1&preview=%7B%22elbow_l%22%3A%7B%22h%22%3A2%7D%7D&" + size);
+    ASSERT_EQ(oldPreview.status, 200) << oldPreview;
+    EXPECT_TRUE(oldPreview.body != before.body) << "h = 2 on revision 1's elbow";
+    EXPECT_TRUE(oldPreview.body != preview.body) << "revision 1's elbow is where it was";
+
+    expectError(h.get(s + "/frame?preview=%7B%22nope%22%3A%7B%7D%7D"), 422, "preview");   // unknown id
+    expectError(h.get(s + "/frame?preview=%5B%5D"), 422, "preview");                       // not an object
+    expectError(h.get(s + "/frame?preview=%7B"), 422, "preview");                           // not JSON
+    expectError(h.get(s + "/frame?preview=%7B%22elbow_l%22%3A3%7D"), 422, "preview");       // patch not an object
+    expectError(h.get(s + "/frame?preview=%7B%22elbow_l%22%3A%7B%22h%22%3A-1%7D%7D"), 422, "preview"); // invalid
+    expectError(h.get(s + "/frame?preview=%7B%22elbow_l%22%3A%7B%22id%22%3A%22x%22%7D%7D"), 422, "preview");
+    EXPECT_EQ(h.get(s).js()["revision"], 2);
+    ASSERT_EQ(h.del(s).status, 204);
+}
