@@ -139,6 +139,39 @@ try {
       await screenshot(page, "editor-sweep.png");
       await page.keyboard.press("Escape");
     }],
+    ["the bump-map overlay on the texture view", async () => {
+      await page.selectOption("#overlay", "bump");
+      await until(() => page.evaluate(() => {
+        const c = document.getElementById("uv"), d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+        let warm = 0;
+        for (let i = 0; i < d.length; i += 4) if (d[i] > 200 && d[i + 1] > 120 && d[i + 1] < 200 && d[i + 2] < 120) ++warm;
+        return warm > 200;
+      }), "raised skin drawn warm");
+      await screenshot(page, "editor-overlay.png");
+      await page.selectOption("#overlay", "none");
+    }],
+    ["every control is labelled and reachable by keyboard", async () => {
+      const unlabelled = await page.evaluate(() => {
+        const bad = [];
+        for (const el of document.querySelectorAll("button, input, select, canvas[tabindex], [tabindex]")) {
+          const r = el.getBoundingClientRect();
+          if (el.type === "file" || r.width === 0 || r.height === 0 || el.closest("[hidden], dialog:not([open])")) continue;
+          const label = el.getAttribute("aria-label") || el.title || (el.labels && el.labels.length && el.labels[0].textContent.trim()) || el.textContent.trim();
+          if (!label) bad.push(el.outerHTML.slice(0, 80));
+          if (el.tabIndex < 0) bad.push("not focusable: " + el.outerHTML.slice(0, 80));
+        }
+        return bad;
+      });
+      assert.deepEqual(unlabelled, []);
+      // Tab walks from the toolbar into the views and panels; footprints are selected by keys.
+      await page.focus("#scene");
+      const seen = new Set();
+      for (let i = 0; i < 200 && !(seen.has("uv") && seen.has("frameStage")); ++i) { await page.keyboard.press("Tab"); seen.add(await page.evaluate(() => { const e = document.activeElement; return e.id || `${e.tagName}.${e.className}:${(e.getAttribute("aria-label") || e.textContent).slice(0, 20)}`; })); }
+      assert.ok(seen.has("uv") && seen.has("frameStage"), `Tab reaches the views: ${[...seen].join(" | ")}`);
+      await page.focus("#uv");
+      await page.keyboard.press("n");
+      assert.equal((await state(page)).selection.length, 1);
+    }],
     ["a server error appears on screen", async () => {
       await page.setInputFiles("#loadFile", { name: "broken.scene.json", mimeType: "application/json", buffer: Buffer.from(JSON.stringify({ format: "dermis.scene/1", model: "builtin:default", placements: [{ id: "x", pattern: "crease", joint: "no_such_joint" }] })) });
       await noticeMatching(/no joint named 'no_such_joint'/);

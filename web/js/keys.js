@@ -45,7 +45,7 @@ const typing = (el) => el && (el.tagName === "INPUT" && !["range", "checkbox", "
 
 function onKey(e, { dlg, fitTexture }) {
   if (e.key === "Escape" && cancelDrag()) { e.preventDefault(); return; }
-  if (dlg.open || document.getElementById("signin").hidden === false) return;
+  if (document.querySelector("dialog[open]") || document.getElementById("signin").hidden === false) return; // dialogs keep their keys (Esc closes)
   const mod = e.ctrlKey || e.metaKey;
   if (mod && (e.key === "z" || e.key === "Z")) {
     if (typing(document.activeElement)) return;

@@ -9,7 +9,7 @@
 
 import { store, on, emit, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
-import { image, onImageLoaded, patternImagePath } from "./images.js";
+import { image, heightOverlay, onImageLoaded, patternImagePath } from "./images.js";
 import { Stream, patchPlacement } from "./edits.js";
 import { trace } from "./trace.js";
 
@@ -116,14 +116,8 @@ function draw() {
     ctx.globalAlpha = 1;
   }
   if (store.overlay !== "none") {
-    const ov = image(`/scenes/${store.sceneId}/heightmaps/${store.overlay}?format=png&revision=${store.overlayRevision || store.revision}`);
-    if (ov) {
-      ctx.globalAlpha = 0.8;
-      ctx.globalCompositeOperation = "screen";
-      ctx.drawImage(ov, ox, oy, s, s);
-      ctx.globalCompositeOperation = "source-over";
-      ctx.globalAlpha = 1;
-    }
+    const ov = heightOverlay(`/scenes/${store.sceneId}/heightmaps/${store.overlay}?revision=${store.overlayRevision || store.revision}`);
+    if (ov) ctx.drawImage(ov, ox, oy, s, s);
   }
   if (store.layout) {
     ctx.strokeStyle = "rgba(140, 160, 185, 0.35)";
