@@ -59,6 +59,7 @@ export function initTextureView(section) {
   canvas.addEventListener("wheel", wheel, { passive: false });
   canvas.addEventListener("contextmenu", (e) => e.preventDefault());
   on("doc selection lint presence overlay layout model revision solo", redraw);
+  on("layoutMode", () => requestAnimationFrame(fit)); // the stage changed size: fit the UV square again
   onImageLoaded(redraw);
 }
 
