@@ -126,6 +126,44 @@ try {
       assert.ok(Math.abs(added.center[0] - pick.uv[0]) < 0.002 && Math.abs(added.center[1] - pick.uv[1]) < 0.002);
       await page.click("#placeTool");
     }],
+    ["clicking the model selects the placement there; the wheel zooms", async () => {
+      await page.keyboard.press("Escape");
+      // Find a frame pixel whose skin lies in a footprint (the editor's own pick), then click it.
+      const target = await page.evaluate(async () => {
+        const ed = window.dermisEditor, doc = ed.store.doc;
+        const inside = (p, uv) => {
+          const a = (p.rotation * Math.PI) / 180, c = Math.cos(a), s = Math.sin(a);
+          const dx = uv[0] - p.center[0], dy = uv[1] - p.center[1];
+          const x = (c * dx + s * dy) / p.scale[0] + 0.5, y = (-s * dx + c * dy) / p.scale[1] + 0.5;
+          return x >= 0.1 && x <= 0.9 && y >= 0.1 && y <= 0.9;
+        };
+        for (let y = 140; y < 400; y += 12)
+          for (let x = 200; x < 320; x += 12) {
+            const hit = await ed.pickAt(x, y);
+            if (!hit.hit) continue;
+            const p = doc.placements.find((q) => inside(q, hit.uv));
+            if (p && doc.placements.filter((q) => inside(q, hit.uv)).length === 1) return { x, y, id: p.id };
+          }
+        return null;
+      });
+      assert.ok(target, "a pixel on a footprint");
+      const box = await page.$eval("#frame", (i) => { const r = i.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
+      const side = Math.min(box[2], box[3]);
+      await page.mouse.click(box[0] + (box[2] - side) / 2 + ((target.x + 0.5) / 512) * side, box[1] + (box[3] - side) / 2 + ((target.y + 0.5) / 512) * side);
+      await until(async () => (await state(page)).selection[0] === target.id, `${target.id} selected by a click in 3D`);
+      const d0 = (await state(page)).camera.distance;
+      await page.mouse.wheel(0, 300);
+      await until(async () => { const d = (await state(page)).camera.distance; return d !== null && d !== d0; }, "the wheel set a distance");
+      await page.click("#resetCamera");
+    }],
+    ["Alt+↓ on a placement row moves it down (server order)", async () => {
+      const ids0 = (await doc()).placements.map((p) => p.id);
+      await page.focus(`#placementList li[data-placement="${ids0[0]}"] .name`);
+      await page.keyboard.press("Alt+ArrowDown");
+      const ids1 = await until(async () => { const ids = (await doc()).placements.map((p) => p.id); return ids[1] === ids0[0] && ids; }, "moved down one");
+      assert.equal(ids1[0], ids0[1]);
+      assert.equal(ids1.length, ids0.length);
+    }],
     ["the activation strip jumps to the clicked time", async () => {
       const box = await page.$eval("#activation", (c) => { const r = c.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
       await page.mouse.click(box[0] + box[2] * 0.9, box[1] + box[3] / 2);
