@@ -10,6 +10,8 @@
 #include "gl/renderer.hpp"
 #include "io/scene_files.hpp"
 
+#include "GlTestBackend.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -22,12 +24,7 @@ namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
 
-GlBackend requestedBackend() {
-    const char* env = std::getenv("DERMIS_TEST_GL");
-    if (!env || !*env) return GlBackend::Auto;
-    auto b = glBackendFromString(env);
-    return b ? *b : GlBackend::Auto;
-}
+using test::requestedBackend;
 
 const FrameView kViews[] = {FrameView::Shaded, FrameView::Bump, FrameView::Displacement,
                             FrameView::Normal};

@@ -6,6 +6,8 @@
 #include "core/probe.hpp"
 #include "io/scene_files.hpp"
 
+#include "DefaultSceneFixture.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,21 +16,9 @@ using namespace dermis;
 
 namespace {
 
-const std::string kScene = std::string(DERMIS_SOURCE_DIR) + "/models/default.scene.json";
 
-class InspectTest : public ::testing::Test {
+class InspectTest : public test::DefaultSceneTest {
 protected:
-    static void SetUpTestSuite() {
-        auto l = loadSceneFile(kScene);
-        ASSERT_TRUE(l) << l.error().message;
-        loaded_ = new LoadedScene(std::move(*l));
-    }
-    static void TearDownTestSuite() {
-        delete loaded_;
-        loaded_ = nullptr;
-    }
-    void SetUp() override { ASSERT_NE(loaded_, nullptr); }
-    static inline LoadedScene* loaded_ = nullptr;
 };
 
 TEST_F(InspectTest, ProbeEqualsTheCpuBakeAndExplainsIt) {

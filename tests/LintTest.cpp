@@ -6,6 +6,8 @@
 #include "core/lint.hpp"
 #include "io/scene_files.hpp"
 
+#include "DefaultSceneFixture.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,21 +16,18 @@ using namespace dermis;
 
 namespace {
 
-const std::string kScene = std::string(DERMIS_SOURCE_DIR) + "/models/default.scene.json";
 
-class LintTest : public ::testing::Test {
+class LintTest : public test::DefaultSceneTest {
 protected:
     static void SetUpTestSuite() {
-        auto l = loadSceneFile(kScene);
-        ASSERT_TRUE(l) << l.error().message;
-        loaded_ = new LoadedScene(std::move(*l));
-        lookup_ = new UvLookup(loaded_->model);
+        DefaultSceneTest::SetUpTestSuite();
+        if (loaded_) lookup_ = new UvLookup(loaded_->model);
     }
     static void TearDownTestSuite() {
         delete lookup_;
-        delete loaded_;
+        lookup_ = nullptr;
+        DefaultSceneTest::TearDownTestSuite();
     }
-    void SetUp() override { ASSERT_NE(loaded_, nullptr); }
 
     static const Placement& elbow() {
         for (const Placement& p : loaded_->scene.placements)
@@ -58,7 +57,6 @@ protected:
             if (x.code == code && x.placement == placement) return true;
         return false;
     }
-    static inline LoadedScene* loaded_ = nullptr;
     static inline UvLookup* lookup_ = nullptr;
 };
 

@@ -7,6 +7,8 @@
 #include "gl/renderer.hpp"
 #include "io/scene_files.hpp"
 
+#include "GlTestBackend.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -17,12 +19,7 @@ namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
 
-GlBackend requestedBackend() {
-    const char* env = std::getenv("DERMIS_TEST_GL");
-    if (!env || !*env) return GlBackend::Auto;
-    auto b = glBackendFromString(env);
-    return b ? *b : GlBackend::Auto;
-}
+using test::requestedBackend;
 
 class PickGLTest : public ::testing::Test {
 protected:

@@ -18,6 +18,8 @@
 #include "io/scene_files.hpp"
 #include "ImageCompare.hpp"
 
+#include "GlTestBackend.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -35,12 +37,7 @@ const std::string kSource = DERMIS_SOURCE_DIR;
 const std::string kCesium = kShared + "/models/CesiumMan/CesiumMan.glb";
 const std::string kBarbarian = kShared + "/models/KayKitBarbarian/Barbarian.glb";
 
-GlBackend requestedBackend() {
-    const char* env = std::getenv("DERMIS_TEST_GL");
-    if (!env || !*env) return GlBackend::Auto;
-    auto b = glBackendFromString(env);
-    return b ? *b : GlBackend::Auto;
-}
+using test::requestedBackend;
 
 class RendererGLTest : public ::testing::Test {
 protected:

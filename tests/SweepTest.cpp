@@ -10,6 +10,8 @@
 #include "core/frame_plan.hpp"
 #include "io/scene_files.hpp"
 
+#include "DefaultSceneFixture.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,7 +20,6 @@ using namespace dermis;
 
 namespace {
 
-const std::string kScene = std::string(DERMIS_SOURCE_DIR) + "/models/default.scene.json";
 
 Image8 blank(int w, int h, std::uint8_t grey = 0) {
     Image8 img;
@@ -181,24 +182,13 @@ TEST(SweepTest, LabelsFitTheCell) {
     EXPECT_EQ(labelScale(blank(256, 256)), 2);
 }
 
-class SweepSceneTest : public ::testing::Test {
+class SweepSceneTest : public test::DefaultSceneTest {
   protected:
-    static void SetUpTestSuite() {
-        auto l = loadSceneFile(kScene);
-        ASSERT_TRUE(l) << l.error().message;
-        loaded_ = new LoadedScene(std::move(*l));
-    }
-    static void TearDownTestSuite() {
-        delete loaded_;
-        loaded_ = nullptr;
-    }
-    void SetUp() override { ASSERT_NE(loaded_, nullptr); }
     static std::size_t indexOf(const std::string& id) {
         for (std::size_t i = 0; i < loaded_->scene.placements.size(); ++i)
             if (loaded_->scene.placements[i].id == id) return i;
         throw std::runtime_error("no placement " + id);
     }
-    static inline LoadedScene* loaded_ = nullptr;
 };
 
 TEST_F(SweepSceneTest, JointSweepDrivesTheDriverAcrossItsRange) {

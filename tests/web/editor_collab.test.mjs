@@ -10,14 +10,13 @@
 // whose joints the model lacks.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
-import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, until, sleep } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, runSuite, until, sleep } from "./editor_lib.mjs";
 
 const exe = process.argv[2];
 let server = await startServer(exe, [], "dermis-editor-collab-");
 const api = apiClient(server.base);
 const browser = await launch();
-let failures = 1;
-try {
+await runSuite("WebEditorCollabBrowserTest", async () => {
   const ctxA = await browser.newContext(), ctxB = await browser.newContext();
   const a = await openEditor(ctxA, server.base + "/");
   const sceneId = (await state(a)).sceneId;
@@ -25,7 +24,7 @@ try {
   const serverPlacement = async (id) => (await api("GET", `/scenes/${sceneId}`)).body.scene.placements.find((p) => p.id === id);
   const select = async (page, id) => { await page.click(`#placementList li[data-placement="${id}"] .name`); await page.focus("#uv"); };
 
-  failures = await runChecks("WebEditorCollabBrowserTest", [
+  let failures = await runChecks("WebEditorCollabBrowserTest", [
     ["an edit in one context appears in the other within 1 s", async () => {
       assert.equal((await state(b)).sceneId, sceneId);
       await select(a, "stomach");
@@ -144,11 +143,8 @@ try {
     }],
     ["no script errors", async () => { assert.deepEqual(a.errors, []); assert.deepEqual(b.errors, []); }],
   ]);
-} catch (e) {
-  console.error("WebEditorCollabBrowserTest: FAILED:", e.stack || e.message);
-  failures = Math.max(failures, 1);
-} finally {
+  return failures;
+}, async () => {
   await browser.close();
   server.stop();
-}
-process.exit(failures ? 1 : 0);
+});

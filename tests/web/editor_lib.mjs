@@ -109,6 +109,21 @@ export async function runChecks(suite, checks) {
   return failures;
 }
 
+/// Runs a suite: `body` (async, returns the failure count; a throw counts as one failure), then
+/// `cleanup`; exits the process 0 when nothing failed, else 1.
+export async function runSuite(name, body, cleanup) {
+  let failures = 1;
+  try {
+    failures = await body();
+  } catch (e) {
+    console.error(`${name}: FAILED:`, e.stack || e.message);
+    failures = Math.max(failures, 1);
+  } finally {
+    await cleanup();
+  }
+  process.exit(failures ? 1 : 0);
+}
+
 /// Counts the edit requests (non-GET to /api/v1/scenes/, except presence) a page sends.
 export function countEdits(page) {
   const log = [];

@@ -10,13 +10,12 @@
 import assert from "node:assert/strict";
 import { writeFileSync } from "node:fs";
 import { join } from "node:path";
-import { startServer, launch, apiClient, openEditor, settledFrameHash, state, footprint, screenshot, runChecks, until, sleep, shotDir } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, settledFrameHash, state, footprint, screenshot, runChecks, runSuite, until, sleep, shotDir } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-panels-");
 const api = apiClient(server.base);
 const browser = await launch();
-let failures = 1;
-try {
+await runSuite("WebEditorPanelsBrowserTest", async () => {
   const context = await browser.newContext();
   const page = await openEditor(context, server.base + "/");
   const sceneId = (await state(page)).sceneId;
@@ -36,7 +35,7 @@ try {
   }, [selector, name, type, fromUrl, text]);
   const noticeMatching = (re) => page.waitForFunction((src) => [...document.querySelectorAll("#notices .notice")].some((n) => new RegExp(src).test(n.textContent)), re.source, { timeout: 10000 });
 
-  failures = await runChecks("WebEditorPanelsBrowserTest", [
+  let failures = await runChecks("WebEditorPanelsBrowserTest", [
     ["dropping a PNG on the library uploads it", async () => {
       const n0 = (await api("GET", "/patterns")).body.patterns.length;
       await dropFile("#patternDrop", "my_wrinkle.png", "image/png", { fromUrl: "/api/v1/patterns/crease/image?size=128" });
@@ -254,11 +253,8 @@ try {
   writeFileSync(join(shotDir, "editor-drag-bench.json"), JSON.stringify(figures, null, 2) + "\n");
   if (lat.length < 50) { console.log("benchmark: too few moves reached a frame"); ++failures; }
   if (page.errors.length) { console.log("script errors:", page.errors); ++failures; }
-} catch (e) {
-  console.error("WebEditorPanelsBrowserTest: FAILED:", e.stack || e.message);
-  failures = Math.max(failures, 1);
-} finally {
+  return failures;
+}, async () => {
   await browser.close();
   server.stop();
-}
-process.exit(failures ? 1 : 0);
+});

@@ -8,13 +8,12 @@
 // H sends enabled:false and zeroes that region of the bump map; S solos; M mirrors.
 import assert from "node:assert/strict";
 import { startServer, launch, apiClient, openEditor, waitFrame, settledFrameHash, state, footprint, screenshot,
-         runChecks, countEdits, until, sleep } from "./editor_lib.mjs";
+         runChecks, runSuite, countEdits, until, sleep } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-tex-");
 const api = apiClient(server.base);
 const browser = await launch();
-let failures = 1;
-try {
+await runSuite("WebEditorTextureBrowserTest", async () => {
   const context = await browser.newContext();
   const page = await openEditor(context, server.base + "/");
   const edits = countEdits(page);
@@ -27,7 +26,7 @@ try {
   };
   const settle = async () => until(async () => (await state(page)).revision === (await api("GET", `/scenes/${sceneId}`)).body.revision, "the editor has the server's revision");
 
-  failures = await runChecks("WebEditorTextureBrowserTest", [
+  let failures = await runChecks("WebEditorTextureBrowserTest", [
     ["one outline per placement and a decoded frame", async () => {
       const s = await state(page);
       assert.ok(s.doc.placements.length >= 10);
@@ -269,11 +268,8 @@ try {
     }],
     ["no script errors", async () => assert.deepEqual(page.errors, [])],
   ]);
-} catch (e) {
-  console.error("WebEditorTextureBrowserTest: FAILED:", e.stack || e.message);
-  failures = Math.max(failures, 1);
-} finally {
+  return failures;
+}, async () => {
   await browser.close();
   server.stop();
-}
-process.exit(failures ? 1 : 0);
+});
