@@ -90,23 +90,19 @@ export async function revert(revision, { undoable = true } = {}) {
   return edit("POST", "/revert", { revision }, { undoable });
 }
 
-export async function undo() {
-  if (!undoStack.length) return notify("Nothing to undo.", "info");
-  const target = undoStack.pop();
+/// Goes back (undo) or forward (redo): a revert to the revision on top of `from`, whose own
+/// revision then goes on `to`. A refused revert leaves both stacks as they were.
+async function travel(from, to, nothing) {
+  if (!from.length) return notify(nothing, "info");
+  const target = from.pop();
   const here = store.revision;
-  if (await revert(target, { undoable: false })) redoStack.push(here);
-  else undoStack.push(target);
+  if (await revert(target, { undoable: false })) to.push(here);
+  else from.push(target);
   emit("undo");
 }
 
-export async function redo() {
-  if (!redoStack.length) return notify("Nothing to redo.", "info");
-  const target = redoStack.pop();
-  const here = store.revision;
-  if (await revert(target, { undoable: false })) undoStack.push(here);
-  else redoStack.push(target);
-  emit("undo");
-}
+export const undo = () => travel(undoStack, redoStack, "Nothing to undo.");
+export const redo = () => travel(redoStack, undoStack, "Nothing to redo.");
 
 /// A stream of edits from one gesture (a drag, a slider). send(value) queues the newest value
 /// (the first leaves one interval after the stream starts, so a gesture cancelled at once sends
