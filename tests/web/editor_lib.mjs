@@ -78,6 +78,19 @@ export async function settledFrameHash(page) {
   return createHash("sha256").update(Buffer.from(bytes)).digest("hex");
 }
 
+/// Waits until the editor is quiet — no gesture, no edit queued or in flight, twice 100 ms apart —
+/// and has the server's revision of its scene (`api` is an apiClient of the same server).
+export async function settled(page, api) {
+  let quiet = 0;
+  await until(async () => {
+    const s = await page.evaluate(() => { const t = window.dermisEditor.store; return { busy: t.busy, gestures: t.gestures, revision: t.revision, id: t.sceneId }; });
+    const server = (await api("GET", `/scenes/${s.id}`)).body.revision;
+    quiet = s.busy === 0 && s.gestures === 0 && s.revision === server ? quiet + 1 : 0;
+    if (quiet < 2) await sleep(100);
+    return quiet >= 2;
+  }, "the editor is quiet and at the server's revision", 15000);
+}
+
 /// The editor's state fields (JSON-safe).
 export const state = (page) => page.evaluate(() => {
   const s = window.dermisEditor.store;

@@ -10,7 +10,7 @@
 import assert from "node:assert/strict";
 import { writeFileSync } from "node:fs";
 import { join } from "node:path";
-import { startServer, launch, apiClient, openEditor, settledFrameHash, state, footprint, screenshot, runChecks, runSuite, until, sleep, shotDir } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, settledFrameHash, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep, shotDir } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-panels-");
 const api = apiClient(server.base);
@@ -21,7 +21,7 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
   const sceneId = (await state(page)).sceneId;
   const doc = async () => (await api("GET", `/scenes/${sceneId}`)).body.scene;
   const select = async (id) => { await page.click(`#placementList li[data-placement="${id}"] .name`); };
-  const settle = async () => until(async () => (await state(page)).revision === (await api("GET", `/scenes/${sceneId}`)).body.revision, "the editor has the server's revision");
+  const settle = () => settled(page, api);
   const uploads = [];
   page.on("request", (r) => { if (r.method() === "POST" && new URL(r.url()).pathname === "/api/v1/patterns") uploads.push(r.url()); });
   /// Drops a file (name, MIME type, bytes from `fromUrl` or the text `text`) on `selector`.

@@ -8,7 +8,7 @@
 // H sends enabled:false and zeroes that region of the bump map; S solos; M mirrors.
 import assert from "node:assert/strict";
 import { startServer, launch, apiClient, openEditor, waitFrame, settledFrameHash, state, footprint, screenshot,
-         runChecks, runSuite, countEdits, until, sleep } from "./editor_lib.mjs";
+         runChecks, runSuite, settled, countEdits, until, sleep } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-tex-");
 const api = apiClient(server.base);
@@ -24,7 +24,7 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
     await page.click(`#placementList li[data-placement="${id}"] .name`);
     await page.focus("#uv");
   };
-  const settle = async () => until(async () => (await state(page)).revision === (await api("GET", `/scenes/${sceneId}`)).body.revision, "the editor has the server's revision");
+  const settle = () => settled(page, api);
 
   let failures = await runChecks("WebEditorTextureBrowserTest", [
     ["one outline per placement and a decoded frame", async () => {
@@ -115,7 +115,8 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       await page.mouse.move(g.center[0] + r * Math.sin(a), g.center[1] - r * Math.cos(a), { steps: 6 });
       await page.mouse.up();
       await page.keyboard.up("Shift");
-      const p = await until(async () => { const q = await serverPlacement("thigh_l"); return q.rotation !== 0 && q; }, "rotated");
+      await settle();
+      const p = await serverPlacement("thigh_l");
       assert.equal(p.rotation % 15, 0, `rotation ${p.rotation}`);
       assert.ok(Math.abs(p.rotation - 37) <= 8, `rotation ${p.rotation} near 37`);
     }],
@@ -215,7 +216,9 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       await settle();
       // Pose the left elbow at the crease's θmax so that it shows, through the parameters panel.
       await select("elbow_l");
+      const thetaMax = (await serverPlacement("elbow_l")).theta_max;
       await page.click("#goMax");
+      await until(async () => { const j = (await api("GET", `/scenes/${sceneId}`)).body.scene.pose.joints["forearm.l"]; return j && j.axis_angles && j.axis_angles.x === thetaMax; }, "posed at θmax");
       await settle();
       const p = await serverPlacement("elbow_l");
       const probe = async () => (await api("GET", `/scenes/${sceneId}/probe?u=${p.center[0]}&v=${p.center[1]}`)).body;

@@ -167,7 +167,7 @@ export class Stream {
     this.pending = undefined;
     if (this.timer) { clearTimeout(this.timer); this.timer = null; }
     if (this.inFlight) await this.inFlight;
-    this.end();
     if (this.sent > 0) await revert(this.before, { undoable: false });
+    this.end(); // after the revert: a gesture counts until the scene is back
   }
 }
