@@ -29,7 +29,7 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # npm packages of the tests (pinned by package-lock.json), installed once per lock change:
-# the Khronos glTF validator and playwright-core (drives Debian's Chromium in the viewer test).
+# the Khronos glTF validator and playwright-core (drives Debian's Chromium in the editor tests).
 here="$(cd "$(dirname "$0")/.." && pwd)"
 for dir in "$here/tests/gltf-validator" "$here/tests/web" "$here/tests/openapi"; do
   if [ -f "$dir/package-lock.json" ] &&
