@@ -1,6 +1,6 @@
 // AtomicFileTest — the one file writer (server/io/atomic_file): whole files or none, no temporary
 // left behind, links replaced rather than followed, failures that leave the target as it was;
-// scratch files that go away; whole-file reads with a size limit. Files only.
+// whole-file reads with a size limit. Files only.
 #include "io/atomic_file.hpp"
 #include "TestFiles.hpp"
 
@@ -74,24 +74,6 @@ TEST(AtomicFileTest, TempNamesAreRecognisedByTheirMarker) {
     EXPECT_FALSE(isTempName("s_1.json"));
     EXPECT_FALSE(isTempName("template.png"));
     EXPECT_FALSE(isTempName("tmp.png"));
-}
-
-TEST(AtomicFileTest, ScratchFilesHoldTheirBytesAndGoAway) {
-    std::string path;
-    {
-        auto scratch = ScratchFile::create(bytes("pixels"), ".tga");
-        ASSERT_TRUE(scratch) << scratch.error().message;
-        path = scratch->path();
-        EXPECT_EQ(fs::path(path).extension(), ".tga");
-        EXPECT_EQ(readBytes(path), bytes("pixels"));
-        ScratchFile moved = std::move(*scratch);
-        EXPECT_EQ(moved.path(), path);
-        EXPECT_TRUE(fs::exists(path)); // the moved-from one removed nothing
-    }
-    EXPECT_FALSE(fs::exists(path));
-    auto a = ScratchFile::create(bytes("a"), ".x"), b = ScratchFile::create(bytes("b"), ".x");
-    ASSERT_TRUE(a && b);
-    EXPECT_NE(a->path(), b->path());
 }
 
 TEST(AtomicFileTest, WholeFileReadsKnowMissingFoldersAndLimits) {

@@ -1,7 +1,7 @@
 // BadInputHttpTest — the errors table, end to end on one server (HttpTestFixture.hpp: a real
 // dermis::Service + dermis::Api on 127.0.0.1, a GL context on $DERMIS_TEST_GL, cpp-httplib clients
 // over loopback). It checks:
-//   * a table of bad inputs (malformed JSON, wrong types, non-finite numbers, unknown ids, path
+//   * a table of bad inputs (malformed JSON, wrong types, non-finite and out-of-bounds numbers, unknown ids, path
 //     tricks, bad sizes and formats, corrupt and oversized uploads, wrong content types, sign-in
 //     bodies, conflicts, limits): each answers {"error": {"code", "message", "field"}} with the
 //     right status and the server stays healthy after each; none of them changes what it refers to.
@@ -144,6 +144,14 @@ TEST_F(BadInputHttpTest, BadInputGetsAJsonErrorWithTheRightStatus) {
         {"center 1e999", "POST", "/scenes", J, replaceInDoc("[0.3,0.4]", "[1e999,0.4]"), {400, 422}, ""},
         {"h -1e999", "POST", "/scenes", J, replaceInDoc("\"theta_min\"", "\"h\": -1e999, \"theta_min\""), {400, 422}, ""},
         {"theta_min == theta_max", "POST", "/scenes", J, withPlacementField("theta_max", 0), {422}, "/placements/0/theta_max"},
+        // --- finite but out of bounds (issue #12.7) → 422 naming the field
+        {"h 1e39", "POST", "/scenes", J, withPlacementField("h", 1e39), {422}, "/placements/0/h"},
+        {"h 1e39 in a placement patch", "PATCH", scene + "/placements/elbow", J, R"({"h": 1e39})", {422}, "/placements/0/h"},
+        {"theta_max 1e20", "POST", "/scenes", J, withPlacementField("theta_max", 1e20), {422}, "/placements/0/theta_max"},
+        {"rotation 1e30", "POST", "/scenes", J, withPlacementField("rotation", 1e30), {422}, "/placements/0/rotation"},
+        {"bump_strength 1e39", "PUT", scene, J, doc([](json& d) { d["render"]["bump_strength"] = 1e39; }), {422}, "/render/bump_strength"},
+        {"displacement_scale 1e39", "PUT", scene, J, doc([](json& d) { d["render"]["displacement_scale"] = 1e39; }), {422}, "/render/displacement_scale"},
+        {"pose time 1e12", "PATCH", scene + "/pose", J, R"({"time": 1e12})", {422}, "/pose/time"},
         {"negative h", "POST", "/scenes", J, withPlacementField("h", -1), {422}, "/placements/0/h"},
         {"zero scale", "POST", "/scenes", J, withPlacementField("scale", json::array({0, 0.1})), {422}, "/placements/0/scale/0"},
         {"negative pose time", "PATCH", scene + "/pose", J, R"({"time": -1})", {422}, "/pose/time"},

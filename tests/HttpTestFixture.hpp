@@ -110,6 +110,8 @@ class LiveServer {
 
     int port() const { return port_; }
     Service& service() { return *service_; }
+    /// The data folder (absolute): no answer of the server may contain it.
+    std::string dataDir() const { return dir_.str(); }
 
   private:
     LiveServer() = default;

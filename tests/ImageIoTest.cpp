@@ -1,12 +1,14 @@
 // ImageIoTest — pattern images in (SPEC §2 value mapping), float maps out, bad files rejected.
-// Writes and reads temporary files through OpenImageIO.
+// Writes and reads temporary files through OpenImageIO; decoding from memory writes no file.
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 using namespace dermis;
 using namespace dermis::test;
@@ -213,6 +215,36 @@ TEST(ImageIoTest, BadFilesGiveErrorsNotCrashes) {
         writeBytes(dir / "t.png", truncated);
         EXPECT_FALSE(readHeightImage(dir / "t.png").ok()) << cut;
     }
+}
+
+// Issue #12.8: uploads are decoded from memory; nothing goes to the temp folder, whatever the
+// format and whether the bytes decode or not.
+TEST(ImageIoTest, DecodingFromMemoryWritesNoFile) {
+    TempDir dir, tmp;
+    std::vector<std::uint8_t> px8(3 * 2 * 3); // RGB: HDR, WebP and GIF write no grey
+    for (std::size_t k = 0; k < px8.size(); ++k) px8[k] = static_cast<std::uint8_t>(k * 13);
+    std::vector<std::string> names;
+    for (const char* ext : {"png", "jpg", "tif", "exr", "bmp", "hdr", "webp", "gif", "tga"}) {
+        const std::string name = std::string("p.") + ext;
+        writeImage(dir / name, 3, 2, 3, px8, TypeDesc::UINT8);
+        names.push_back(name);
+    }
+    const char* old = std::getenv("TMPDIR");
+    const std::string saved = old ? old : "";
+    ::setenv("TMPDIR", tmp.str().c_str(), 1);
+    for (const std::string& name : names) {
+        const auto bytes = readBytes(dir / name);
+        auto img = readHeightImageFromMemory(bytes);
+        EXPECT_TRUE(img.ok()) << name << ": " << img.error().message;
+        if (img) EXPECT_EQ(img->width, 3) << name;
+        auto rgba = decodeImage8(bytes);
+        EXPECT_TRUE(rgba.ok()) << name << ": " << rgba.error().message;
+        std::vector<std::uint8_t> corrupt(bytes.begin(), bytes.begin() + static_cast<long>(bytes.size() / 2));
+        (void)readHeightImageFromMemory(corrupt); // fails or not: in memory either way
+    }
+    if (old) ::setenv("TMPDIR", saved.c_str(), 1);
+    else ::unsetenv("TMPDIR");
+    EXPECT_TRUE(std::filesystem::is_empty(tmp.str())) << "files left in " << tmp.str();
 }
 
 TEST(ImageIoTest, OversizedPatternsAreRejected) {

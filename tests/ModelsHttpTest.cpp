@@ -6,9 +6,12 @@
 //   * base-colour textures as PNG (CesiumMan's at its size and downsized; none on the default
 //     character or RiggedFigure: 404 no_texture);
 //   * a multipart .gltf with its external buffer, and multipart uploads that are refused (missing
-//     buffer, a URI outside the folder, a folder in a part name, no .gltf part, not JSON).
+//     buffer, a URI outside the folder, a folder in a part name, no .gltf part, not JSON); no
+//     answer to a bad upload contains a path of the server (the data folder, /tmp).
 #include "HttpTestFixture.hpp"
 #include "io/gltf_loader.hpp"
+
+#include <filesystem>
 
 using namespace dermis;
 using namespace dermis::test;
@@ -216,6 +219,68 @@ TEST_F(ModelsHttpTest, GltfWithExternalFilesUploadsAsMultipart) {
         EXPECT_TRUE(r.js().contains("error")) << name << ": " << r;
     }
     EXPECT_EQ(http().get("/models").js()["models"].size(), models);
+}
+
+// Issue #12.9: error answers to bad uploads name ids, parts and fields, never a path of the server
+// (the data folder, where uploads are stored).
+TEST_F(ModelsHttpTest, BadUploadErrorsNameNoServerPath) {
+    const std::string data = server_->dataDir();
+    std::error_code ec;
+    const std::string canonical = std::filesystem::canonical(data, ec).string();
+    ASSERT_FALSE(data.empty());
+    auto post = [&](const std::string& path, const httplib::MultipartFormDataItems& items) {
+        httplib::Client cli("127.0.0.1", server_->port());
+        auto r = cli.Post((std::string(kApi) + path).c_str(), items);
+        Reply out;
+        if (r) {
+            out.status = r->status;
+            out.body = r->body;
+        }
+        return out;
+    };
+    auto expectNoPath = [&](const std::string& name, const Reply& r) {
+        EXPECT_GE(r.status, 400) << name << ": " << r;
+        EXPECT_LT(r.status, 500) << name << ": " << r;
+        EXPECT_EQ(r.body.find(data), std::string::npos) << name << ": " << r;
+        if (!canonical.empty()) EXPECT_EQ(r.body.find(canonical), std::string::npos) << name << ": " << r;
+    };
+    const auto [gltf, bin] = triangleGltf("tri.bin");
+    json textured = json::parse(gltf);
+    textured["images"] = {{{"uri", "skin.png"}}};
+    textured["textures"] = {{{"source", 0}}};
+    textured["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+    textured["meshes"][0]["primitives"][0]["material"] = 0;
+    const std::vector<std::pair<std::string, httplib::MultipartFormDataItems>> bad = {
+        {"missing buffer", {{"gltf", gltf, "tri.gltf", ""}}},
+        {"bad buffer name", {{"gltf", triangleGltf("no such.bin").first, "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}}},
+        {"absolute buffer uri", {{"gltf", triangleGltf("/etc/x.bin").first, "tri.gltf", ""}}},
+        {"escaping buffer uri", {{"gltf", triangleGltf("../../tri.bin").first, "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}}},
+        {"file uri", {{"gltf", triangleGltf("file:///etc/x.bin").first, "tri.gltf", ""}}},
+        {"short buffer", {{"gltf", gltf, "tri.gltf", ""}, {"buffer", bin.substr(0, 10), "tri.bin", ""}}},
+        {"missing image", {{"gltf", textured.dump(), "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}}},
+        {"corrupt image", {{"gltf", textured.dump(), "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""},
+                           {"image", std::string("\x89PNG\r\n\x1a\nbroken"), "skin.png", ""}}},
+        {"folder in a part name", {{"gltf", gltf, "tri.gltf", ""}, {"buffer", bin, "../tri.bin", ""}}},
+        {"not json", {{"gltf", "not json", "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}}},
+    };
+    for (const auto& [name, items] : bad) expectNoPath(name, post("/models?name=tri", items));
+
+    Http h = http();
+    const auto png = domePng();
+    const std::vector<std::pair<std::string, std::vector<std::uint8_t>>> images = {
+        {"truncated png", std::vector<std::uint8_t>(png.begin(), png.begin() + static_cast<long>(png.size() / 2))},
+        {"png magic only", std::vector<std::uint8_t>(png.begin(), png.begin() + 8)},
+        {"garbage", std::vector<std::uint8_t>(500, 0x5a)},
+        {"empty", {}},
+    };
+    for (const auto& [name, bytes] : images) {
+        expectNoPath("pattern " + name, h.upload("/patterns?name=bad", bytes, "image/png"));
+        expectNoPath("glb " + name, h.upload("/models?name=bad", bytes, "model/gltf-binary"));
+    }
+    std::string glb = "glTF";
+    glb += std::string(40, '\0');
+    expectNoPath("glb header only", h.upload("/models?name=bad", std::vector<std::uint8_t>(glb.begin(), glb.end()),
+                                              "model/gltf-binary"));
 }
 
 TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {

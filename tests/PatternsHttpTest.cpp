@@ -2,7 +2,8 @@
 // real dermis::Service + dermis::Api on 127.0.0.1, a GL context on $DERMIS_TEST_GL, cpp-httplib
 // clients over loopback). It checks:
 //   * patterns: the built-in manifest and previews, a custom PNG upload used by id and through a
-//     scene's alias map, 409 while in use, 204 once unused.
+//     scene's alias map, 409 while in use, 204 once unused (an alias no placement names is
+//     dropped); previews of tall patterns keep the aspect ratio.
 #include "HttpTestFixture.hpp"
 
 using namespace dermis;
@@ -88,6 +89,59 @@ TEST_F(PatternsHttpTest, CustomPatternUploadUseAndDelete) {
     EXPECT_EQ(h.del("/patterns/" + pid).status, 204);
     expectError(h.get("/patterns/" + pid + "/image"), 404, "id");
     expectError(h.del("/patterns/" + pid), 404, "id");
+    EXPECT_EQ(h.del("/scenes/" + sid).status, 204);
+}
+
+// Issue #12.6: previews fit the longer side into `size` and keep the aspect ratio, for tall and
+// wide patterns alike (a 1×4096 one at size 256 once asked for 256×1048576 pixels).
+TEST_F(PatternsHttpTest, TallAndWidePatternPreviewsKeepTheAspect) {
+    Http h = http();
+    for (const auto& [w, ht] : {std::pair{1, 4096}, std::pair{4096, 1}, std::pair{30, 120}}) {
+        Reply up = h.upload("/patterns?name=thin", domePng(w, ht), "image/png");
+        ASSERT_EQ(up.status, 201) << up;
+        const std::string pid = up.js()["id"];
+        for (int size : {1, 5, 256, 2048}) {
+            Reply img = h.get("/patterns/" + pid + "/image?size=" + std::to_string(size));
+            ASSERT_EQ(img.status, 200) << w << "x" << ht << " size " << size << ": " << img;
+            auto dec = decodeFrame(img.bytes());
+            ASSERT_TRUE(dec) << dec.error().message;
+            const int longer = std::max(w, ht), shorter = std::min(w, ht);
+            const int expectShort = std::max(1, static_cast<int>(std::lround(double(shorter) * size / longer)));
+            EXPECT_EQ(w >= ht ? dec->width : dec->height, size) << w << "x" << ht << " size " << size;
+            EXPECT_EQ(w >= ht ? dec->height : dec->width, expectShort) << w << "x" << ht << " size " << size;
+        }
+        expectError(h.get("/patterns/" + pid + "/image?size=2049"), 422, "size");
+        expectError(h.get("/patterns/" + pid + "/image?size=0"), 422, "size");
+        EXPECT_EQ(h.del("/patterns/" + pid).status, 204);
+    }
+}
+
+// Issue #12.5: placing an uploaded pattern by id adds the alias {p: p}; once the last placement
+// using it goes, the alias goes too, and the pattern can be deleted.
+TEST_F(PatternsHttpTest, StaleAliasDoesNotBlockDeletion) {
+    Http h = http();
+    Reply up = h.upload("/patterns?name=dome", domePng(), "image/png");
+    ASSERT_EQ(up.status, 201) << up;
+    const std::string pid = up.js()["id"];
+    json doc = smallScene();
+    doc["placements"] = {placementOf(pid, "dome")};
+    const std::string sid = createScene(doc);
+    ASSERT_FALSE(sid.empty());
+    Reply got = h.get("/scenes/" + sid);
+    ASSERT_EQ(got.status, 200) << got;
+    json placed = got.js()["scene"];
+    EXPECT_EQ(placed["patterns"][pid], pid);
+    expectError(h.del("/patterns/" + pid), 409, "id");
+
+    // The editor's way: the document it got back, less the placement (the alias left in).
+    placed["placements"] = json::array();
+    Reply put = h.put("/scenes/" + sid, placed);
+    ASSERT_EQ(put.status, 200) << put;
+    EXPECT_FALSE(put.js()["scene"].contains("patterns") && put.js()["scene"]["patterns"].contains(pid))
+        << put.js()["scene"].dump();
+    EXPECT_EQ(h.del("/patterns/" + pid).status, 204);
+    // The scene still validates without the pattern.
+    EXPECT_EQ(h.put("/scenes/" + sid, put.js()["scene"]).status, 200);
     EXPECT_EQ(h.del("/scenes/" + sid).status, 204);
 }
 

@@ -381,6 +381,14 @@ TEST(SceneTest, AcceptsEdgeValues) {
     EXPECT_EQ(s.render.displacement, dermis::DisplacementMode::Tessellated);
     EXPECT_EQ(s.placements[0].thetaMin, 120.0);
     EXPECT_EQ(s.placements[0].h, 0.0);
+    // Every bound is inclusive (scene.hpp kMax…).
+    Scene b = parseOk(doc(R"("placements":[{"pattern":"crease","joint":"j","h":100,"scale":[16, 16],
+        "center":[-16, 16],"rotation":-3600,"theta_min":-360,"theta_max":360}],
+        "pose":{"time":86400,"joints":{"j":{"axis_angles":{"x":360,"y":-360}}}},
+        "render":{"camera":{"yaw":3600,"distance":10000},"displacement_scale":1000,"bump_strength":100})"));
+    EXPECT_EQ(b.placements[0].h, dermis::kMaxPlacementHeight);
+    EXPECT_EQ(b.placements[0].thetaMax, dermis::kMaxAngle);
+    EXPECT_EQ(b.render.bumpStrength, dermis::kMaxBumpStrength);
     // Unknown fields are ignored at every level.
     parseOk(doc(R"("future":1,"render":{"hdr":true},"placements":[{"pattern":"crease",
         "joint":"j","note":"x"}],"pose":{"joints":{"j":{"rotation":[0,0,0,1],"w":1}}})"));
@@ -558,6 +566,26 @@ const BadCase kBadCases[] = {
     {"DisplacementUnknown", doc(R"("render":{"displacement":"geometry"})"), "/render/displacement"},
     {"DisplacementNumber", doc(R"("render":{"displacement":1})"), "/render/displacement"},
     {"MsaaFraction", doc(R"("render":{"msaa":2.5})"), "/render/msaa"},
+    // Bounds of every number (issue #12.7; scene.hpp kMax…).
+    {"HeightHuge", placement(R"("h":1e39)"), "/placements/0/h"},
+    {"HeightAboveMax", placement(R"("h":100.5)"), "/placements/0/h"},
+    {"HeightNegative", placement(R"("h":-1)"), "/placements/0/h"},
+    {"ScaleAboveMax", placement(R"("scale":[0.1, 17])"), "/placements/0/scale/1"},
+    {"CenterHuge", placement(R"("center":[1e300, 0.5])"), "/placements/0/center/0"},
+    {"CenterBelowMin", placement(R"("center":[0.5, -16.5])"), "/placements/0/center/1"},
+    {"RotationHuge", placement(R"("rotation":1e30)"), "/placements/0/rotation"},
+    {"RotationAboveMax", placement(R"("rotation":3601)"), "/placements/0/rotation"},
+    {"ThetaMinBelowMin", placement(R"("theta_min":-361)"), "/placements/0/theta_min"},
+    {"ThetaMaxHuge", placement(R"("theta_max":1e20)"), "/placements/0/theta_max"},
+    {"PoseTimeHuge", doc(R"("pose":{"time":1e12})"), "/pose/time"},
+    {"AxisAngleHuge", doc(R"("pose":{"joints":{"j":{"axis_angles":{"y":1e9}}}})"),
+     "/pose/joints/j/axis_angles/y"},
+    {"CameraYawHuge", doc(R"("render":{"camera":{"yaw":1e300}})"), "/render/camera/yaw"},
+    {"CameraDistanceHuge", doc(R"("render":{"camera":{"distance":1e300}})"),
+     "/render/camera/distance"},
+    {"DisplacementScaleHuge", doc(R"("render":{"displacement_scale":1e39})"),
+     "/render/displacement_scale"},
+    {"BumpStrengthHuge", doc(R"("render":{"bump_strength":100.5})"), "/render/bump_strength"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Table, SceneBadInput, testing::ValuesIn(kBadCases),

@@ -58,6 +58,13 @@ TEST(PreviewTest, HeightsMapToGreyWithTheAspectKept) {
     EXPECT_EQ(img.rgba[3], 255);                      // opaque
     const Image8 flat = heightPreview(HeightImage(3, 3, 0.0f), 1);
     EXPECT_EQ(flat.rgba[0], 128);                     // L = 0: mid grey
+    // Tall sources fit their height (issue #12.6), never more than maxSide² pixels.
+    const Image8 tall = heightPreview(HeightImage(1, 4096, 0.0f), 256);
+    EXPECT_EQ(tall.width, 1);
+    EXPECT_EQ(tall.height, 256);
+    const Image8 tall5 = heightPreview(HeightImage(2, 8, 0.0f), 5);
+    EXPECT_EQ(tall5.width, 1);
+    EXPECT_EQ(tall5.height, 5);
 }
 
 TEST(PreviewTest, DownsizeAveragesBoxesAndKeepsTheAspect) {

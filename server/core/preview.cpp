@@ -7,9 +7,17 @@
 
 namespace dermis {
 
-Image8 heightPreview(const HeightImage& src, int width) {
-    const int w = width;
-    const int h = std::max(1, static_cast<int>(std::lround(double(width) * src.height / src.width)));
+Image8 heightPreview(const HeightImage& src, int maxSide) {
+    // The longer side gets maxSide, the other keeps the aspect ratio (issue #12.6: a 1×4096
+    // pattern at width 256 asked for 256×1048576 pixels).
+    const int longer = std::max(src.width, src.height);
+    auto scaled = [&](int side) {
+        return side == longer ? maxSide
+                              : std::clamp(static_cast<int>(std::lround(double(side) * maxSide / longer)),
+                                           1, maxSide);
+    };
+    const int w = scaled(src.width);
+    const int h = scaled(src.height);
     Image8 img;
     img.width = w;
     img.height = h;

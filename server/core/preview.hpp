@@ -9,10 +9,11 @@
 
 namespace dermis {
 
-/// A `width`-wide RGBA8 grey picture of `src` (height keeps the aspect ratio, at least 1), sampled
-/// bilinearly at pixel centres: grey = (L + 1) / 2 clamped to [0, 1], so L = −1 is black, 0 mid
-/// grey, +1 white; alpha 255. Preconditions: `src` non-empty, width ≥ 1.
-Image8 heightPreview(const HeightImage& src, int width);
+/// An RGBA8 grey picture of `src` whose longer side is `maxSide` pixels (the other keeps the aspect
+/// ratio, at least 1, so at most maxSide² pixels), sampled bilinearly at pixel centres:
+/// grey = (L + 1) / 2 clamped to [0, 1], so L = −1 is black, 0 mid grey, +1 white; alpha 255.
+/// Preconditions: `src` non-empty, maxSide ≥ 1.
+Image8 heightPreview(const HeightImage& src, int maxSide);
 
 /// `src` made to fit in maxSide × maxSide, its aspect ratio kept: when its longer side is larger
 /// than maxSide, that side becomes maxSide and the other round(side · maxSide / longer) (at least

@@ -47,15 +47,22 @@ Status validateRenderSettings(const RenderSettings& r, const RenderLimits& limit
     }
     const Camera& c = r.camera;
     if (!std::isfinite(c.yaw)) return bad("/render/camera/yaw", "must be a finite number");
+    if (!(std::abs(c.yaw) <= kMaxTurnAngle))
+        return bad("/render/camera/yaw", "must be in [" + fmt(-kMaxTurnAngle) + ", " + fmt(kMaxTurnAngle) +
+                                             "], got " + fmt(c.yaw));
     if (!(c.pitch >= -90.0 && c.pitch <= 90.0))
         return bad("/render/camera/pitch", "must be in [-90, 90], got " + fmt(c.pitch));
-    if (c.distance && !(std::isfinite(*c.distance) && *c.distance > 0.0))
-        return bad("/render/camera/distance", "must be > 0 (or \"auto\"), got " + fmt(*c.distance));
-    if (r.displacementScale && !(std::isfinite(*r.displacementScale) && *r.displacementScale >= 0.0))
-        return bad("/render/displacement_scale",
-                   "must be >= 0 (or \"auto\"), got " + fmt(*r.displacementScale));
-    if (!(std::isfinite(r.bumpStrength) && r.bumpStrength >= 0.0))
-        return bad("/render/bump_strength", "must be >= 0, got " + fmt(r.bumpStrength));
+    if (c.distance && !(std::isfinite(*c.distance) && *c.distance > 0.0 && *c.distance <= kMaxCameraDistance))
+        return bad("/render/camera/distance", "must be in (0, " + fmt(kMaxCameraDistance) +
+                                                  "] (or \"auto\"), got " + fmt(*c.distance));
+    if (r.displacementScale &&
+        !(std::isfinite(*r.displacementScale) && *r.displacementScale >= 0.0 &&
+          *r.displacementScale <= kMaxDisplacementScale))
+        return bad("/render/displacement_scale", "must be in [0, " + fmt(kMaxDisplacementScale) +
+                                                     "] (or \"auto\"), got " + fmt(*r.displacementScale));
+    if (!(std::isfinite(r.bumpStrength) && r.bumpStrength >= 0.0 && r.bumpStrength <= kMaxBumpStrength))
+        return bad("/render/bump_strength",
+                   "must be in [0, " + fmt(kMaxBumpStrength) + "], got " + fmt(r.bumpStrength));
     if (r.msaa != 1 && r.msaa != 2 && r.msaa != 4)
         return bad("/render/msaa", "must be 1, 2 or 4, got " + std::to_string(r.msaa));
     return Ok{};

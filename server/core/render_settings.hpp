@@ -36,8 +36,9 @@ struct RenderLimits {
 
 /// Checks ranges, naming the first offending field by JSON pointer under "/render":
 /// size sides in [1, kMaxRenderSize] (InvalidArgument) and ≤ limits.maxSide (TooLarge);
-/// camera yaw finite, pitch in [−90, 90], distance finite and > 0 when set; displacement_scale
-/// finite and ≥ 0 when set; bump_strength finite and ≥ 0; msaa 1, 2 or 4.
+/// camera yaw in [−kMaxTurnAngle, kMaxTurnAngle], pitch in [−90, 90], distance in (0, kMaxCameraDistance]
+/// when set; displacement_scale in [0, kMaxDisplacementScale] when set; bump_strength in
+/// [0, kMaxBumpStrength] (bounds in scene.hpp); msaa 1, 2 or 4.
 /// `where` names the calling function in the message.
 Status validateRenderSettings(const RenderSettings& render, const RenderLimits& limits = {},
                               const char* where = "dermis::validateRenderSettings");

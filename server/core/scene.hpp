@@ -48,13 +48,13 @@ nlohmann::json toJson(const PatternManifest& manifest);
 struct Placement {
     std::string id;                      ///< unique within the scene
     std::string pattern;                 ///< key of Scene::patterns, or a built-in pattern id
-    std::array<double, 2> center{0.5, 0.5}; ///< UV
-    std::array<double, 2> scale{0.1, 0.1};  ///< UV size of the footprint, > 0
-    double rotation = 0.0;               ///< degrees, counter-clockwise in (u, v) per SPEC
+    std::array<double, 2> center{0.5, 0.5}; ///< UV, each in [−kMaxPlacementCenter, kMaxPlacementCenter]
+    std::array<double, 2> scale{0.1, 0.1};  ///< UV size of the footprint, in (0, kMaxPlacementScale]
+    double rotation = 0.0;               ///< degrees, counter-clockwise in (u, v) per SPEC; |r| ≤ kMaxTurnAngle
     std::string joint;                   ///< joint name in the model
     std::string axisName = "x";          ///< "x", "y", "z", or "" when `axis` was a vector
     std::array<double, 3> axis{1, 0, 0}; ///< unit vector (normalised on parse)
-    double thetaMin = 0.0, thetaMax = 90.0, h = 1.0;
+    double thetaMin = 0.0, thetaMax = 90.0, h = 1.0; ///< θ in [−kMaxAngle, kMaxAngle], h in [0, kMaxPlacementHeight]
     DeformModel model = DeformModel::Scale;
     Target target = Target::Bump;
     Response response = Response::Log2;
@@ -64,6 +64,21 @@ struct Placement {
 
 /// Longest placement label, in bytes.
 constexpr std::size_t kMaxLabelLength = 120;
+
+// Ranges of the scene document's numbers (README "Scene documents"; schemas/scene.json agrees).
+// parseScene rejects anything outside with InvalidArgument naming the field; the bounds keep every
+// sum finite: a texel's height is at most kMaxPlacements·h·|L| ≤ 256·100·1 (L = response ∈ [−1, 1]
+// times a pattern value in [−1, 1]), so 1e39 can no longer fill a map with inf.
+constexpr double kMaxPlacementHeight = 100.0; ///< h ∈ [0, 100]
+constexpr double kMaxPlacementScale = 16.0;   ///< each scale component ∈ (0, 16] UV
+constexpr double kMaxPlacementCenter = 16.0;  ///< each center component ∈ [−16, 16] UV
+constexpr double kMaxAngle = 360.0;      ///< degrees: theta_min/max, pose axis_angles ∈ [−360, 360]
+constexpr double kMaxTurnAngle = 3600.0; ///< degrees: footprint rotation, camera yaw ∈ [−3600, 3600]
+                                         ///< (ten turns: editors may accumulate, they are periodic)
+constexpr double kMaxPoseTime = 86400.0;        ///< pose time ∈ [0, 86400] s
+constexpr double kMaxCameraDistance = 10000.0;  ///< camera distance ∈ (0, 10000] model units
+constexpr double kMaxDisplacementScale = 1000.0; ///< displacement_scale ∈ [0, 1000]
+constexpr double kMaxBumpStrength = 100.0;       ///< bump_strength ∈ [0, 100]
 
 /// A joint override of the pose: exactly one of rotation / axisAngles is set.
 struct JointPose {

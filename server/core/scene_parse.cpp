@@ -31,9 +31,9 @@ constexpr const char* kSceneWhere = "dermis::parseScene";
 constexpr const char* kSceneTextWhere = "dermis::parseSceneText";
 constexpr const char* kBuiltinPrefix = "builtin:";
 
-/// A placement's footprint may cover the UV square many times over, but not absurdly: a scale of
-/// 1e300 would make every texel of the map sample one pattern texel and is surely a typo.
-constexpr double kMaxPlacementScale = 16.0;
+// The numeric ranges (kMaxPlacementHeight, kMaxAngle, …) are public, in scene.hpp. A footprint
+// may cover the UV square many times over, but not absurdly: a scale of 1e300 would make every
+// texel of the map sample one pattern texel and is surely a typo.
 
 // --- small predicates -------------------------------------------------------------------------
 
@@ -182,6 +182,11 @@ Status parsePlacementFootprint(const Reader& rd, const json& v, const std::strin
     if (const json* c = Reader::find(v, "center")) {
         auto uv = rd.numbers<2>(*c, ptr + "/center");
         if (!uv) return uv.error();
+        for (std::size_t i = 0; i < 2; ++i)
+            if (std::abs((*uv)[i]) > kMaxPlacementCenter)
+                return rd.bad(member(ptr + "/center", i),
+                              "must be in [" + Reader::fmt(-kMaxPlacementCenter) + ", " +
+                                  Reader::fmt(kMaxPlacementCenter) + "], got " + Reader::fmt((*uv)[i]));
         out.center = *uv;
     }
     if (const json* s = Reader::find(v, "scale")) {
@@ -195,7 +200,7 @@ Status parsePlacementFootprint(const Reader& rd, const json& v, const std::strin
         out.scale = *su;
     }
     if (const json* r = Reader::find(v, "rotation")) {
-        auto d = rd.number(*r, ptr + "/rotation");
+        auto d = rd.numberIn(*r, ptr + "/rotation", -kMaxTurnAngle, kMaxTurnAngle);
         if (!d) return d.error();
         out.rotation = *d;
     }
@@ -229,12 +234,12 @@ Status parsePlacementDriver(const Reader& rd, const json& v, const std::string& 
     }
 
     if (const json* t = Reader::find(v, "theta_min")) {
-        auto d = rd.number(*t, ptr + "/theta_min");
+        auto d = rd.numberIn(*t, ptr + "/theta_min", -kMaxAngle, kMaxAngle);
         if (!d) return d.error();
         out.thetaMin = *d;
     }
     if (const json* t = Reader::find(v, "theta_max")) {
-        auto d = rd.number(*t, ptr + "/theta_max");
+        auto d = rd.numberIn(*t, ptr + "/theta_max", -kMaxAngle, kMaxAngle);
         if (!d) return d.error();
         out.thetaMax = *d;
     }
@@ -242,7 +247,7 @@ Status parsePlacementDriver(const Reader& rd, const json& v, const std::string& 
         return rd.bad(ptr + "/theta_max",
                       "must differ from theta_min (" + Reader::fmt(out.thetaMin) + ")");
     if (const json* h = Reader::find(v, "h")) {
-        auto d = rd.numberIn(*h, ptr + "/h", 0.0);
+        auto d = rd.numberIn(*h, ptr + "/h", 0.0, kMaxPlacementHeight);
         if (!d) return d.error();
         out.h = *d;
     }
@@ -343,7 +348,7 @@ Status parseJointPose(const Reader& rd, const json& v, const std::string& ptr, J
         static constexpr const char* kNames[3] = {"x", "y", "z"};
         for (std::size_t i = 0; i < 3; ++i) {
             if (const json* a = Reader::find(*axisAngles, kNames[i])) {
-                auto d = rd.number(*a, p + "/" + kNames[i]);
+                auto d = rd.numberIn(*a, p + "/" + kNames[i], -kMaxAngle, kMaxAngle);
                 if (!d) return d.error();
                 angles[i] = *d;
             }
@@ -362,7 +367,7 @@ Status parsePose(const Reader& rd, const json& v, Pose& pose) {
         pose.animation = *s;
     }
     if (const json* t = Reader::find(v, "time")) {
-        auto d = rd.numberIn(*t, ptr + "/time", 0.0);
+        auto d = rd.numberIn(*t, ptr + "/time", 0.0, kMaxPoseTime);
         if (!d) return d.error();
         pose.time = *d;
     }

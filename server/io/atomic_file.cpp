@@ -1,4 +1,4 @@
-// Whole-or-nothing file writes and scratch files. See atomic_file.hpp.
+// Whole-or-nothing file writes and whole-file reads. See atomic_file.hpp.
 #include "io/atomic_file.hpp"
 
 #include <fcntl.h>
@@ -86,42 +86,6 @@ Status writeFileAtomically(const std::string& path, const std::vector<std::uint8
     if (durability == Durability::Durable)
         return syncFolder(fs::path(path).parent_path().string(), where);
     return Ok{};
-}
-
-Result<ScratchFile> ScratchFile::create(const std::vector<std::uint8_t>& bytes,
-                                        const std::string& suffix) {
-    const char* where = "dermis::ScratchFile::create";
-    std::error_code ec;
-    fs::path dir = fs::temp_directory_path(ec);
-    if (ec) dir = "/tmp";
-    std::string name = (dir / "dermis-XXXXXX").string() + suffix;
-    const int fd = ::mkstemps(name.data(), static_cast<int>(suffix.size()));
-    if (fd < 0)
-        return makeError(ErrorCode::Io, where, dir.string(),
-                         "cannot create a scratch file: " + errnoText(errno));
-    ScratchFile file(name);
-    int err = writeAll(fd, bytes);
-    if (::close(fd) != 0 && err == 0) err = errno;
-    if (err != 0)
-        return makeError(ErrorCode::Io, where, name, "cannot write: " + errnoText(err));
-    return file;
-}
-
-ScratchFile::ScratchFile(ScratchFile&& o) noexcept : path_(std::move(o.path_)) {
-    o.path_.clear();
-}
-
-ScratchFile& ScratchFile::operator=(ScratchFile&& o) noexcept {
-    if (this != &o) {
-        if (!path_.empty()) ::unlink(path_.c_str());
-        path_ = std::move(o.path_);
-        o.path_.clear();
-    }
-    return *this;
-}
-
-ScratchFile::~ScratchFile() {
-    if (!path_.empty()) ::unlink(path_.c_str());
 }
 
 Result<std::vector<std::uint8_t>> readWholeFile(const std::string& path, std::size_t maxBytes,

@@ -9,8 +9,8 @@
 // A crash between create and rename leaves a temporary file behind; whoever owns the folder
 // removes names for which isTempName holds (Store::open does, for the data folder).
 //
-// ScratchFile is the other file Dermis writes: a private temporary file under the system's temp
-// folder, for libraries that read only from a path; it is removed when the ScratchFile goes.
+// Dermis writes no other temporary file: images are decoded from memory (image_io.hpp), so
+// nothing goes to the system temp folder.
 //
 // Thread-safe. Does not create folders. Failure: a file that cannot be created, written, synced
 // or renamed → ErrorCode::Io naming `where` with the target path as `field`; the temporary file
@@ -45,26 +45,6 @@ Status writeFileAtomically(const std::string& path, const std::vector<std::uint8
 
 /// fsyncs a folder (after a rename or removal inside it). Io error naming `where` and the folder.
 Status syncFolder(const std::string& folder, const char* where = "dermis::syncFolder");
-
-/// A private file under the system temp folder holding given bytes, removed on destruction.
-/// Move-only. `create` fails with ErrorCode::Io when the file cannot be created or written.
-class ScratchFile {
-public:
-    /// `suffix` ends the name (e.g. ".tga", so a library can pick a reader by extension).
-    static Result<ScratchFile> create(const std::vector<std::uint8_t>& bytes,
-                                      const std::string& suffix);
-    ScratchFile(ScratchFile&& o) noexcept;
-    ScratchFile& operator=(ScratchFile&& o) noexcept;
-    ScratchFile(const ScratchFile&) = delete;
-    ScratchFile& operator=(const ScratchFile&) = delete;
-    ~ScratchFile();
-
-    const std::string& path() const { return path_; }
-
-private:
-    explicit ScratchFile(std::string path) : path_(std::move(path)) {}
-    std::string path_;
-};
 
 /// Reads a whole regular file. NotFound when it does not exist, Io when it cannot be read,
 /// TooLarge when it is larger than `maxBytes`.

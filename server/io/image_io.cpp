@@ -2,7 +2,7 @@
 // mapping and failure modes.
 #include "image_io.hpp"
 
-#include "io/atomic_file.hpp"
+#include "io/atomic_file.hpp" // writeFileAtomically
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -88,29 +88,32 @@ Result<HeightImage> readHeight(ImageInput& in, const char* where, const std::str
     return img;
 }
 
-/// Opens encoded bytes: through an in-memory proxy when the plugin supports it, else via a
-/// ScratchFile that lives until `fn` returns.
+/// Opens encoded bytes through an in-memory proxy (OpenImageIO's "oiio:ioproxy" open config) and
+/// calls `fn` on the open image. Nothing is written anywhere (issue #12.8: a scratch file in the
+/// system temp folder outlived a kill -9); a plugin that cannot read from memory is Unsupported.
 template <class Fn>
 auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where, Fn&& fn)
     -> decltype(fn(std::declval<ImageInput&>())) {
     if (bytes.empty()) return makeError(ErrorCode::Parse, where, "", "empty image data");
     const std::string name = sniffName(bytes);
-    {
-        OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
-        ImageSpec config;
-        // Values as stored: no premultiplication of colour by alpha (glTF textures and pattern
-        // images are unassociated).
-        config.attribute("oiio:UnassociatedAlpha", 1);
-        auto in = ImageInput::open(name, &config, &proxy);
-        if (in) return fn(*in);
-        OIIO::geterror(); // clear
-    }
-    auto tmp = ScratchFile::create(bytes, name.substr(name.find('.')));
-    if (!tmp) return tmp.error();
+    OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
+    OIIO::Filesystem::IOProxy* proxyPtr = &proxy;
     ImageSpec config;
+    config.attribute("oiio:ioproxy", TypeDesc::PTR, &proxyPtr);
+    // Values as stored: no premultiplication of colour by alpha (glTF textures and pattern
+    // images are unassociated).
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = ImageInput::open(tmp->path(), &config);
-    if (!in) return oiioError(where, "", "unrecognised or corrupt image data");
+    auto in = ImageInput::create(name, false, &config);
+    if (!in) return oiioError(where, "", "unrecognised image data");
+    if (!in->supports("ioproxy")) {
+        OIIO::geterror(); // clear
+        return makeError(ErrorCode::Unsupported, where, "",
+                         std::string("this image format (") + in->format_name() +
+                             ") cannot be decoded from memory");
+    }
+    ImageSpec spec;
+    if (!in->open(name, spec, config))
+        return oiioError(where, "", "unrecognised or corrupt image data: " + in->geterror());
     return fn(*in);
 }
 

@@ -1,5 +1,6 @@
 // Dermis io shell — pattern images in, float height maps out (to memory or to a file), through
-// OpenImageIO. Formats a plugin cannot read from memory go through a ScratchFile.
+// OpenImageIO. Encoded bytes are decoded from memory only (an IOProxy), never through a file;
+// a format whose plugin cannot read from memory is Unsupported.
 //
 // Value mapping of SPEC §2: 16-bit unsigned L = clamp((v − 32768)/32767, −1, 1); 8-bit unsigned
 // L = clamp((v − 128)/127, −1, 1); half/float/double images as they are, clamped to [−1, 1]; any
@@ -23,7 +24,9 @@ constexpr int kMaxPatternSize = 8192;
 
 /// Reads a pattern (or static height map) file.
 Result<HeightImage> readHeightImage(const std::string& path);
-/// Same, from encoded bytes in memory (PNG, TIFF, EXR, … by content).
+/// Same, from encoded bytes in memory (PNG, JPEG, TIFF, EXR, BMP, HDR, WebP, GIF, TGA, by
+/// content), decoded in memory: no file is written, not even a temporary one. Parse for empty,
+/// unrecognised or corrupt data; Unsupported for a format that cannot be read from memory.
 Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes);
 
 /// Encodes a height map in memory as a single-channel ("Y") 32-bit float OpenEXR, row 0 first,

@@ -9,6 +9,8 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iterator>
+#include <set>
 
 namespace dermis {
 
@@ -38,6 +40,15 @@ Error queueFull() {
 
 double nowSeconds() {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+Error withoutDataPath(Error e, const std::string& dataDir) {
+    if (dataDir.empty()) return e;
+    for (std::string* text : {&e.message, &e.field})
+        for (std::size_t at = text->find(dataDir); at != std::string::npos;
+             at = text->find(dataDir, at + 6))
+            text->replace(at, dataDir.size(), "<data>");
+    return e;
 }
 
 std::string sanitizeName(const std::string& name) {
@@ -90,6 +101,12 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool
         }
     auto scene = parseScene(doc, manifest);
     if (!scene) return scene.error();
+    // A (valid) alias no placement names is dropped (issue #12.5): it would otherwise keep its
+    // pattern "in use" after the last placement using it went, and DELETE /patterns/{id} answer 409.
+    std::set<std::string> named;
+    for (const Placement& p : scene->placements) named.insert(p.pattern);
+    for (auto it = scene->patterns.begin(); it != scene->patterns.end();)
+        it = named.count(it->first) ? std::next(it) : scene->patterns.erase(it);
     auto model = models.find(scene->model);
     if (model == models.end())
         return notFound("/model", "no model \"" + scene->model + "\" (use builtin:default or an uploaded id)");

@@ -191,7 +191,11 @@ public:
     // --- patterns
     nlohmann::json listPatterns() const;
     Result<nlohmann::json> addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name);
+    /// A grey PNG preview whose longer side is `size` pixels, the aspect kept (core heightPreview).
+    /// Fails: size outside [1, 2048] (InvalidArgument, "size"), an unknown pattern (NotFound, "id").
     Result<EncodedImage> patternImage(const std::string& id, int size) const;
+    /// Fails: Conflict while a built-in, or named by a scene's heightmap base or placement (an alias
+    /// no placement names is dropped when a document is prepared, so it never holds a pattern).
     Status deletePattern(const std::string& id);
 
     // --- scenes (every answer is {"id", "revision", "scene"})

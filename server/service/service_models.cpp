@@ -109,7 +109,7 @@ Result<json> Service::State::addModelEntry(ModelEntry e,
                                            const std::function<Status(Store&, const json&)>& write) {
     std::lock_guard<std::mutex> writer(writeMutex);
     if (auto s = write(*store, {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}}); !s)
-        return s.error();
+        return withoutDataPath(s.error(), store->dir());
     json summary = modelSummary(e);
     std::unique_lock<std::shared_mutex> lock(mutex);
     models[e.id] = std::move(e);

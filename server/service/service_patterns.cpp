@@ -79,7 +79,7 @@ Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const s
     if (auto s = state_->store->putBlob("patterns", e.id, sniffExtension(bytes), bytes,
                                         {{"name", e.name}, {"bytes", e.bytes}, {"created", nowSeconds()}});
         !s)
-        return s.error();
+        return withoutDataPath(s.error(), state_->store->dir());
     std::unique_lock<std::shared_mutex> lock(state_->mutex);
     state_->images[e.id] = std::move(stored);
     state_->patterns[e.id] = std::move(e);

@@ -73,6 +73,10 @@ double nowSeconds();
 /// [A-Za-z0-9_. -] only, at most 64 characters.
 std::string sanitizeName(const std::string& name);
 
+/// A store failure as an answer may show it (issue #12.9): the data folder `dataDir` replaced by
+/// "<data>" in the message and field, so that no answer reveals a path of the server.
+Error withoutDataPath(Error e, const std::string& dataDir);
+
 /// An error in a render setting a frame parameter overrode names the parameter ("width"), not
 /// the document field ("/render/size/0").
 Error asParamError(Error e, const FrameParams& p);
