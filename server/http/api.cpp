@@ -317,6 +317,13 @@ bool Api::Impl::isOpen(const std::string& method, const std::string& path) const
     return any && allOpen;
 }
 
+std::size_t Api::Impl::bodyLimitOf(const Req& req) const {
+    const std::size_t upload = svc.limits().maxUploadBytes;
+    const bool isUpload = req.method == "POST" &&
+                          (req.path == kPrefix + "/patterns" || req.path == kPrefix + "/models");
+    return isUpload ? upload : std::min(upload, opt.maxJsonBytes);
+}
+
 bool Api::Impl::authorized(const Req& req) const {
     const std::string auth = req.get_header_value("Authorization");
     if (auth.rfind("Bearer ", 0) == 0 && constantTimeEquals(auth.substr(7), opt.token)) return true;
@@ -326,10 +333,17 @@ bool Api::Impl::authorized(const Req& req) const {
 }
 
 void Api::Impl::install() {
-    httplib::Server& s = server;
-    const int threads = opt.threads;
-    s.new_task_queue = [threads] {
-        return new httplib::ThreadPool(static_cast<std::size_t>(threads));
+    GuardedServer& s = server;
+    s.limits.headSeconds = std::max(1, opt.headSeconds);
+    s.limits.stallSeconds = svc.limits().requestTimeoutSeconds;
+    s.limits.maxConnections = std::max(1, opt.maxConnections);
+    s.limits.maxPerAddress = std::max(1, opt.maxConnectionsPerAddress);
+    // Every body is limited while it streams (chunked ones too): uploads at the upload limit,
+    // everything else at the JSON limit. The budget leaves room for chunk framing; the exact
+    // size of a Content-Length body is checked before it is read (pre-routing, below).
+    s.bodyLimit = [this](const Req& req) {
+        const std::size_t limit = bodyLimitOf(req);
+        return limit + limit / 16 + 4096;
     };
     s.set_tcp_nodelay(true);
     s.set_payload_max_length(svc.limits().maxUploadBytes);
@@ -340,6 +354,22 @@ void Api::Impl::install() {
     // Authentication: with a token set, every route but the open ones needs the bearer token or
     // a live session's cookie. Unknown paths under the prefix need them too (no probing).
     s.set_pre_routing_handler([this](const Req& req, Res& res) {
+        // A Content-Length past the route's limit is answered before any of the body is read.
+        if (req.has_header("Content-Length")) {
+            const std::string v = req.get_header_value("Content-Length");
+            char* end = nullptr;
+            errno = 0;
+            const unsigned long long n = std::strtoull(v.c_str(), &end, 10);
+            const std::size_t limit = bodyLimitOf(req);
+            if (!v.empty() && *end == '\0' && (errno == ERANGE || n > limit)) {
+                GuardedServer::closeAfterAnswer(req);
+                sendError(res, 413, "too_large",
+                          "dermis-server: body: Content-Length " + v + " is over the limit of " +
+                              std::to_string(limit) + " bytes for " + req.method + " " + req.path,
+                          "body");
+                return httplib::Server::HandlerResponse::Handled;
+            }
+        }
         if (opt.token.empty() || req.path.rfind(kPrefix, 0) != 0)
             return httplib::Server::HandlerResponse::Unhandled;
         if (isOpen(req.method, req.path.substr(kPrefix.size())) || authorized(req))
@@ -355,6 +385,11 @@ void Api::Impl::install() {
     // A known path asked with a method it does not serve is 405 with Allow, not "no such route".
     s.set_error_handler([this](const Req& req, Res& res) {
         if (!res.body.empty()) return;
+        if (GuardedServer::bodyOverLimit()) { // a streamed body went past its limit: 413, close
+            GuardedServer::closeAfterAnswer(req);
+            res.status = 413;
+        }
+        if (res.status == 413) GuardedServer::closeAfterAnswer(req);
         if (res.status == 404 && req.path.rfind(kPrefix, 0) == 0) {
             const std::string allow = allowedMethods(req.path.substr(kPrefix.size()));
             if (!allow.empty()) {
@@ -374,7 +409,8 @@ void Api::Impl::install() {
         sendError(res, status, code,
                   "dermis-server: " + req.method + " " + req.path + ": " +
                       (status == 404   ? "no such route"
-                       : status == 413 ? "body too large"
+                       : status == 413 ? "body over the limit of " +
+                                                 std::to_string(bodyLimitOf(req)) + " bytes"
                                        : "bad request"),
                   status == 413 ? "body" : "");
     });
@@ -449,6 +485,7 @@ void Api::stop() {
     impl_->stopping = true;
     impl_->svc.closeSubscriptions();
     impl_->server.stop();
+    impl_->server.closeAll(); // slow clients are not waited for
 }
 
 } // namespace dermis

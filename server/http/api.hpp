@@ -28,7 +28,15 @@ struct ApiOptions {
     int port = 8080;       ///< 0 = any free port
     std::string token;     ///< every route but the open ones needs it (or a session); empty = none
     std::string webDir;    ///< static files served at / (the editor); empty = none
-    int threads = 32;      ///< HTTP worker threads (event streams hold one each)
+    int threads = 32;      ///< event streams open at once: threads / 2 (each holds a thread)
+    /// Connections (README "Reliability"): one thread each, at most maxConnections at once and
+    /// maxConnectionsPerAddress per peer address; a request head must arrive within headSeconds.
+    int maxConnections = 1024;
+    int maxConnectionsPerAddress = 256;
+    int headSeconds = 10;
+    /// Bodies of JSON routes: at most this (and at most the upload limit); uploads (POST /models,
+    /// POST /patterns) at most ServerLimits::maxUploadBytes. Enforced while the body streams.
+    std::size_t maxJsonBytes = 8u << 20;
     int maxSessions = 256; ///< browser sessions kept at once; the oldest is forgotten beyond
     int sessionMaxAgeSeconds = 12 * 3600; ///< a session's lifetime (and its cookie's Max-Age)
 };

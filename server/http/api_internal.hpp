@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -173,13 +174,61 @@ private:
 /// more than one), at most 16.
 std::vector<std::string> cookieValues(const Req& req, const std::string& name);
 
+// --- connections (api_connections.cpp) ----------------------------------------------------------
+
+/// httplib's server with its connection handling replaced (issue #12): one thread per connection
+/// (no fixed pool for slow clients to fill), a deadline for the whole request head, a cap per
+/// peer address, a byte budget for every body enforced while it streams, a progress timeout on
+/// every write, and a stop() that shuts every open connection instead of waiting for it.
+/// Requests themselves are still parsed and routed by httplib (Server::process_request).
+class GuardedServer : public httplib::Server {
+public:
+    struct Limits {
+        int headSeconds = 10;  ///< the whole request head (line and headers) within this
+        int idleSeconds = 5;   ///< keep-alive: the next request starts within this
+        int stallSeconds = 30; ///< every read or write of a body makes progress within this
+        int maxConnections = 1024; ///< open at once; past it a connection is answered 503, closed
+        int maxPerAddress = 256;   ///< open at once per peer address (see process_and_close_socket)
+    };
+    Limits limits;
+    /// The most body bytes (as sent, chunk framing included) a request may send; set before
+    /// serving. Past it the read fails and the request is answered 413 and closed.
+    std::function<std::size_t(const Req&)> bodyLimit;
+
+    GuardedServer();
+    ~GuardedServer() override;
+    /// Shuts every open connection (their threads end soon); new ones are closed at once.
+    void closeAll();
+    /// Waits (up to `timeout`) until no connection thread runs; true when none does.
+    bool waitIdle(std::chrono::milliseconds timeout);
+    /// On a handler's thread: true when the current request's body went past its limit.
+    static bool bodyOverLimit();
+    /// On a handler's thread: answer this request with Connection: close, then close (its body,
+    /// if any, is not read).
+    static void closeAfterAnswer(const Req& req);
+
+    struct Conn;
+    struct Threads;
+
+private:
+    bool process_and_close_socket(socket_t sock) override;
+    bool admit(Conn& c);
+    void forget(Conn& c);
+
+    std::mutex mutex_;
+    std::condition_variable idle_;
+    std::vector<Conn*> conns_; ///< open connections, oldest first
+    int threads_ = 0;          ///< connection threads running
+    bool closing_ = false;
+};
+
 } // namespace api_detail
 
 /// The server: options, the httplib server, state shared by the handlers.
 struct Api::Impl {
     Service& svc;
     ApiOptions opt;
-    httplib::Server server;
+    api_detail::GuardedServer server;
     std::atomic<bool> stopping{false};
     /// Open event streams. Each holds an HTTP worker thread for as long as it is open, so at most
     /// half the workers may stream; more are refused with 503 (otherwise a few dozen open editor
@@ -196,6 +245,9 @@ struct Api::Impl {
     /// True when `path` (under the prefix) needs no credentials: an open route of `method`, or a
     /// path all of whose routes are open (so that a wrong method there answers 405, not 401).
     bool isOpen(const std::string& method, const std::string& path) const;
+    /// The most body bytes `req`'s route takes: the upload limit for POST /models and
+    /// POST /patterns, the smaller of it and opt.maxJsonBytes for every other request.
+    std::size_t bodyLimitOf(const api_detail::Req& req) const;
     /// True when the request carries the bearer token or the cookie of a live session.
     bool authorized(const api_detail::Req& req) const;
 
