@@ -105,9 +105,6 @@ TEST_F(GpuCacheHttpTest, DeletedPatternsGiveTheirTexturesBack) {
     for (int cycle = 1; cycle < 20; ++cycle) {
         ASSERT_TRUE(patternCycle(h, png)) << "cycle " << cycle;
         peak = std::max(peak, rssMb());
-        if (std::getenv("DERMIS_TEST_VERBOSE"))
-            std::cout << "cycle " << cycle << ": " << rssMb() << " MB, "
-                      << h.get("/info").js()["gpu_cache"].dump() << "\n";
     }
     const double after = rssMb();
     std::cout << "[ rss ] before " << before << " MB, after 19 more cycles " << after
