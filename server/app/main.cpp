@@ -3,7 +3,8 @@
 //   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH]
 //                        [--view V] [--heightmaps] [--gl B]
 //   dermis-server info   [--gl B]
-//   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B] [limits]
+//   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B]
+//                         [--gpu-cache-mb MB] [limits]
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
 #include "core/normalmap.hpp"
 #include "gl/gl_backend.hpp"
@@ -268,6 +269,7 @@ struct ServeArgs {
     int port = 8080;
     dermis::ServerLimits limits;
     double maxUploadMb = 64;
+    double gpuCacheMb = static_cast<double>(dermis::kDefaultGpuCacheBytes >> 20);
 };
 
 int runServe(ServeArgs a) {
@@ -283,7 +285,9 @@ int runServe(ServeArgs a) {
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
     std::signal(SIGPIPE, SIG_IGN);
 
-    auto renderer = Renderer::create(backendOf(a.gl));
+    RendererOptions rendererOptions;
+    rendererOptions.cacheBudgetBytes = static_cast<std::size_t>(a.gpuCacheMb * 1024.0 * 1024.0);
+    auto renderer = Renderer::create(backendOf(a.gl), rendererOptions);
     if (!renderer) return fail(renderer.error());
     ServiceConfig config;
     config.dataDir = a.data;
@@ -339,6 +343,10 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
                    "Token every API route but /health and /session requires, as a bearer token or "
                    "through a page's sign-in (POST /api/v1/session) (or $DERMIS_TOKEN)");
     app.add_option("--web", s.web, "Folder of the web editor served at / (default: the content folder's web/)");
+    app.add_option("--gpu-cache-mb", s.gpuCacheMb,
+                   "GPU memory kept for pattern textures and model uploads between renders "
+                   "(least recently used freed first; deleted content freed at once)")
+        ->check(CLI::Range(0.0, 1048576.0));
     app.add_option("--max-upload-mb", s.maxUploadMb, "Largest request body / upload")->check(CLI::Range(0.001, 4096.0));
     app.add_option("--max-render-side", s.limits.maxRenderSide, "Largest frame side")->check(CLI::Range(16, 8192));
     app.add_option("--max-map-side", s.limits.maxMapSide, "Largest height-map side")->check(CLI::Range(16, 4096));

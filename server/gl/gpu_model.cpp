@@ -60,6 +60,17 @@ GLuint uploadImage(const Image8& img) {
     return tex;
 }
 
+/// Estimated GPU bytes of `m`'s upload: 56 per vertex (position, normal, uv, joints, weights),
+/// 4 per index, 4 per texel of each image plus a third for its mipmaps.
+std::size_t uploadBytes(const Model& m) {
+    std::size_t bytes = 0;
+    for (const MeshPart& part : m.parts)
+        bytes += part.positions.size() * 56 + part.indices.size() * 4;
+    for (const Image8& img : m.images)
+        bytes += static_cast<std::size_t>(std::max(img.width, 1)) * std::max(img.height, 1) * 4 * 4 / 3;
+    return bytes;
+}
+
 /// A part's vertex attributes as the CPU skinning reads them: missing normals are computed,
 /// missing UVs are zero, a vertex without joint data follows influence 0, out-of-range joints
 /// weigh 0; triangles with an out-of-range index are dropped.
@@ -132,8 +143,7 @@ void Renderer::Impl::dropOrphanedModels() {
     // Their address may be reused by a new model.
     for (auto it = models.begin(); it != models.end();) {
         if (it->second.owner.expired()) {
-            it->second.destroy();
-            it = models.erase(it);
+            eraseModel(it++);
         } else {
             ++it;
         }
@@ -144,12 +154,18 @@ Result<GpuModel*> Renderer::Impl::modelFor(const std::shared_ptr<const Model>& m
     if (!model) return makeError(ErrorCode::InvalidArgument, kWhere, "model", "no model");
     dropOrphanedModels();
     auto found = models.find(model.get());
-    if (found != models.end()) return &found->second;
+    if (found != models.end()) {
+        found->second.lastUse = useCounter;
+        return &found->second;
+    }
 
     const Model& m = *model;
     GpuModel gm;
     gm.owner = model;
     gm.autoDisplacement = autoDisplacementScale(m);
+    gm.bytes = uploadBytes(m);
+    gm.lastUse = useCounter;
+    makeRoom(gm.bytes);
     for (const Image8& img : m.images)
         gm.textures.push_back(uploadImage(img));
     for (const MeshPart& part : m.parts) {
@@ -167,6 +183,7 @@ Result<GpuModel*> Renderer::Impl::modelFor(const std::shared_ptr<const Model>& m
         gm.destroy();
         return s.error();
     }
+    modelBytes += gm.bytes;
     auto [it, inserted] = models.emplace(model.get(), std::move(gm));
     return &it->second;
 }

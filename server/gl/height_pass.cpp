@@ -1,6 +1,6 @@
-// Stage 1 of the renderer: pattern and base textures cached by content id, the height targets,
-// the height pass (one quad per placement, additive), readback and upload of maps
-// (see renderer_impl.hpp).
+// Stage 1 of the renderer: pattern and base textures cached by content id (in the byte budget of
+// gpu_cache.cpp), the height targets, the height pass (one quad per placement, additive), readback
+// and upload of maps (see renderer_impl.hpp).
 #include "gl/renderer_impl.hpp"
 
 #include "gl/uniform_blocks.hpp"
@@ -92,7 +92,6 @@ HeightPassBlock placementBlock(const BakePlacement& p, int W, int H) {
 
 Result<GLuint> Renderer::Impl::patternTexture(std::uint64_t id, const HeightImage& image,
                                               const std::string& field) {
-    ++useCounter;
     if (auto it = patterns.find(id); it != patterns.end()) {
         it->second.lastUse = useCounter;
         return it->second.tex;
@@ -101,19 +100,17 @@ Result<GLuint> Renderer::Impl::patternTexture(std::uint64_t id, const HeightImag
         return makeError(ErrorCode::InvalidArgument, kWhere, field,
                          "pattern is larger than the GL's maximum texture size " +
                              std::to_string(info.maxTextureSize));
-    // Bounded cache: drop the least recently used texture beyond kMaxPatternTextures.
+    // Bounded cache: room within the byte budget, and at most kMaxPatternTextures textures.
     constexpr std::size_t kMaxPatternTextures = 256;
-    if (patterns.size() >= kMaxPatternTextures) {
-        auto oldest = std::min_element(patterns.begin(), patterns.end(), [](const auto& a, const auto& b) {
-            return a.second.lastUse < b.second.lastUse;
-        });
-        glDeleteTextures(1, &oldest->second.tex);
-        patterns.erase(oldest);
-    }
     PatternTexture pt;
+    pt.bytes = static_cast<std::size_t>(image.width) * image.height * sizeof(float);
+    makeRoom(pt.bytes);
+    while (patterns.size() >= kMaxPatternTextures && evictOldest(useCounter, true)) {
+    }
     pt.tex = makeFloatTexture(image.width, image.height, image.data.data(), GL_NEAREST);
     pt.lastUse = useCounter;
     patterns[id] = pt;
+    patternBytes += pt.bytes;
     return pt.tex;
 }
 
@@ -147,11 +144,9 @@ Result<std::uint64_t> Renderer::Impl::resolveBase(const HeightPassInput& in) {
         base->width > info.maxTextureSize || base->height > info.maxTextureSize)
         return makeError(ErrorCode::InvalidArgument, kWhere, "/heightmap/base", "empty or oversized base map");
     const std::uint64_t key = in.baseId ? in.baseId : contentHash(*base);
-    if (key != baseId || !baseTexture) {
-        glDeleteTextures(1, &baseTexture);
-        baseTexture = makeFloatTexture(base->width, base->height, base->data.data(), GL_NEAREST);
-        baseId = key;
-    }
+    auto tex = patternTexture(key, *base, "/heightmap/base");
+    if (!tex) return tex.error();
+    baseTexture = *tex;
     return key;
 }
 

@@ -41,6 +41,7 @@ void Renderer::Impl::loop() {
             job = std::move(jobs.front());
             jobs.pop_front();
         }
+        ++useCounter;
         job();
     }
 }
@@ -131,20 +132,15 @@ void Renderer::Impl::createSharedObjects() {
 }
 
 void Renderer::Impl::dropPatternTextures() {
-    for (auto& [k, p] : patterns)
-        glDeleteTextures(1, &p.tex);
-    patterns.clear();
-    glDeleteTextures(1, &baseTexture);
-    baseTexture = 0;
-    baseId = 0;
+    while (!patterns.empty())
+        erasePattern(patterns.begin());
     lastHeights.reset();
 }
 
 void Renderer::Impl::shutdown() {
     if (!context) return;
-    for (auto& [k, m] : models)
-        m.destroy();
-    models.clear();
+    while (!models.empty())
+        eraseModel(models.begin());
     dropPatternTextures();
     heights.destroy();
     frame.destroy();
@@ -196,8 +192,10 @@ FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> mo
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
-Result<std::unique_ptr<Renderer>> Renderer::create(GlBackend backend) {
+Result<std::unique_ptr<Renderer>> Renderer::create(GlBackend backend, const RendererOptions& options) {
     auto impl = std::make_unique<Impl>();
+    impl->cacheBudget = options.cacheBudgetBytes;
+    impl->publishCacheStats();
     std::promise<Status> started;
     std::future<Status> startedFuture = started.get_future();
     Impl* raw = impl.get();

@@ -17,10 +17,13 @@
 // the render thread and waits for it, so calls are serialised. One Renderer per process at a time
 // (the GL entry points are process-wide). This header includes no EGL/GL.
 //
-// Caches: a model's buffers and textures are uploaded once per Model object (kept while the
-// caller's shared_ptr lives); pattern and base textures are cached by content id (see
-// HeightPassInput), so a deleted image whose reused address holds a new one is never mistaken for
-// it. Errors: Result<…> with ErrorCode::Unavailable when no backend starts (the
+// Caches: a model's buffers and textures are uploaded once per Model object; pattern and base
+// textures are cached by content id (see HeightPassInput), so a deleted image whose reused address
+// holds a new one is never mistaken for it. Both share one byte budget (RendererOptions): before
+// an upload, and after every job, the least recently used entries not needed by the running job
+// are freed until the cache fits (a job that needs more than the budget gets it, and its entries
+// are trimmed when it ends). forgetPattern / forgetModel free the entries of deleted content at
+// once; a model whose owner is gone is dropped at the next job. Errors: Result<…> with ErrorCode::Unavailable when no backend starts (the
 // message lists what was tried), InvalidArgument for bad inputs (field named), Internal for GL
 // failures (shader compile log, incomplete framebuffer).
 #pragma once
@@ -37,6 +40,8 @@
 
 #include <glm/glm.hpp>
 
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -51,6 +56,26 @@ struct RendererInfo {
     int maxTextureSize = 0;
     int maxSamples = 0;
     std::vector<std::string> tried; ///< one line per backend tried before this one, with why it failed
+};
+
+/// Default byte budget of the renderer's GPU cache (pattern textures and model uploads).
+inline constexpr std::size_t kDefaultGpuCacheBytes = std::size_t{512} << 20;
+
+struct RendererOptions {
+    /// Bytes of pattern/base textures and model buffers/textures kept between jobs (estimated
+    /// from their formats and sizes). The render targets are not counted.
+    std::size_t cacheBudgetBytes = kDefaultGpuCacheBytes;
+};
+
+/// What the renderer's GPU cache holds, as of the last job that ended.
+struct GpuCacheStats {
+    std::size_t textures = 0;     ///< pattern and base textures
+    std::size_t textureBytes = 0; ///< their bytes (R32F: 4 per texel)
+    std::size_t models = 0;       ///< models with uploaded buffers and textures
+    std::size_t modelBytes = 0;   ///< their bytes (vertex attributes, indices, textures with mips)
+    std::size_t budgetBytes = 0;  ///< RendererOptions::cacheBudgetBytes
+    std::size_t evictions = 0;    ///< entries freed for the budget since creation (not forgotten ones)
+    std::size_t forgotten = 0;    ///< entries freed by forgetPattern / forgetModel since creation
 };
 
 /// Input of the GPU height pass: the same as the CPU reference's (core/frame_plan.hpp). Pattern
@@ -94,13 +119,22 @@ public:
     virtual Result<HeightMaps> bakeHeightMaps(const HeightPassInput& in) = 0;
     /// One frame (and the maps it used when asked).
     virtual Result<FrameResult> renderFrame(const FrameRequest& request) = 0;
+    /// The pattern or base image with this content id (PatternImage::contentId) was deleted:
+    /// whatever was uploaded of it may be freed. Returns at once (queued behind the jobs already
+    /// waiting); a later job that still uses the image uploads it again. Never fails.
+    virtual void forgetPattern(std::uint64_t contentId) { (void)contentId; }
+    /// Same for a model (the caller's pointer identifies it; the renderer keeps no reference).
+    virtual void forgetModel(const std::shared_ptr<const Model>& model) { (void)model; }
+    /// The GPU cache's figures; nullopt for renderers without one. Cheap: takes no GL job.
+    virtual std::optional<GpuCacheStats> cacheStats() const { return std::nullopt; }
 };
 
 class Renderer final : public FrameRenderer {
 public:
     /// Starts the render thread and a GL 4.3 core context on it. Fails (Unavailable) with every
     /// backend tried and why when none starts; never aborts the process.
-    static Result<std::unique_ptr<Renderer>> create(GlBackend backend = GlBackend::Auto);
+    static Result<std::unique_ptr<Renderer>> create(GlBackend backend = GlBackend::Auto,
+                                                    const RendererOptions& options = {});
     ~Renderer() override; ///< finishes queued jobs, destroys GL objects and the context, joins the thread
     Renderer(const Renderer&) = delete;
     Renderer& operator=(const Renderer&) = delete;
@@ -114,6 +148,10 @@ public:
     /// Stage 1 (optional) + stage 2 + readback of one frame.
     /// Render settings are checked by validateRenderSettings, then against the GL's limits.
     Result<FrameResult> renderFrame(const FrameRequest& request) override;
+
+    void forgetPattern(std::uint64_t contentId) override;
+    void forgetModel(const std::shared_ptr<const Model>& model) override;
+    std::optional<GpuCacheStats> cacheStats() const override;
 
     /// Stage 2's skinning alone, captured with transform feedback: per part, the skinned
     /// positions and unit normals without displacement — the GPU twin of dermis::skin.

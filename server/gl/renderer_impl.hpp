@@ -2,6 +2,8 @@
 // GL objects it owns. Included only by the renderer's own files; it includes GL (glad).
 //
 //   renderer.cpp    job queue, init/shutdown, introspection, the public façade;
+//   gpu_cache.cpp   the byte budget of pattern textures and model uploads: LRU eviction,
+//                   forgetting deleted content, the published figures;
 //   gpu_model.cpp   a model's buffers and textures (uploaded once per Model), the joint palette;
 //   height_pass.cpp stage 1: pattern/base texture caches by content id, the height targets, the
 //                   height pass, readback and upload of maps;
@@ -62,6 +64,8 @@ struct GpuModel {
     std::vector<GLuint> textures; ///< one per Model::images entry, sRGB
     int paletteSize = 0;
     double autoDisplacement = 0.01;
+    std::size_t bytes = 0;     ///< estimated GPU bytes of the buffers and textures
+    std::uint64_t lastUse = 0; ///< job counter of its last use, for evicting the least recent
 
     /// The base-colour texture of `part` (of `model`, the Model this was uploaded from), or 0
     /// when its material has none or names no uploaded image.
@@ -81,7 +85,8 @@ struct HeightKey {
 
 struct PatternTexture {
     GLuint tex = 0;
-    std::uint64_t lastUse = 0; ///< frame counter, for evicting the least recently used
+    std::size_t bytes = 0;     ///< width × height × 4 (R32F)
+    std::uint64_t lastUse = 0; ///< job counter of its last use, for evicting the least recent
 };
 
 /// The content id of an image given without one: a hash of its size and pixels (FNV-1a over
@@ -131,22 +136,48 @@ struct Renderer::Impl {
     std::deque<std::function<void()>> jobs;
     bool stopping = false;
 
-    /// Queues `f` for the render thread and waits for its result.
+    /// Queues `f` for the render thread and waits for its result, which is handed back once the
+    /// job has ended (endJob), so that the cache figures a caller reads next include it.
     template <class F>
     auto run(F&& f) -> decltype(f()) {
         using R = decltype(f());
-        auto task = std::make_shared<std::packaged_task<R()>>(std::forward<F>(f));
-        std::future<R> fut = task->get_future();
-        {
-            std::lock_guard<std::mutex> lock(mutex);
-            jobs.push_back([task] { (*task)(); });
-        }
-        cv.notify_one();
+        auto done = std::make_shared<std::promise<R>>();
+        std::future<R> fut = done->get_future();
+        post([this, &f, done] {
+            try {
+                R r = f();
+                endJob();
+                done->set_value(std::move(r));
+            } catch (...) {
+                endJob();
+                done->set_exception(std::current_exception());
+            }
+        });
         return fut.get();
     }
 
-    /// The render thread's loop: runs jobs in order until stopping and drained.
+    /// Queues `f` for the render thread and returns at once (f must not throw; it ends with
+    /// endJob()).
+    void post(std::function<void()> f) {
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            jobs.push_back(std::move(f));
+        }
+        cv.notify_one();
+    }
+
+    /// The render thread's loop: runs jobs in order until stopping and drained, each with its own
+    /// number (useCounter).
     void loop();
+    /// The end of every job: the cache trimmed to its budget, its figures published.
+    void endJob() {
+        trimCache();
+        publishCacheStats();
+    }
+
+    // --- cache figures (any thread) ---------------------------------------------------------------
+    mutable std::mutex statsMutex;
+    GpuCacheStats published; ///< as of the last job that ended
 
     // --- render-thread state ----------------------------------------------------------------------
     std::unique_ptr<gl::GlContext> context;
@@ -163,10 +194,12 @@ struct Renderer::Impl {
     gl::HeightTargets heights;
     gl::FrameTargets frame;
     std::map<const Model*, gl::GpuModel> models;
-    std::map<std::uint64_t, gl::PatternTexture> patterns; ///< by content id
-    std::uint64_t useCounter = 0;
-    GLuint baseTexture = 0;
-    std::uint64_t baseId = 0; ///< content id of what baseTexture holds
+    std::map<std::uint64_t, gl::PatternTexture> patterns; ///< by content id (base maps too)
+    std::uint64_t useCounter = 0; ///< the running job's number (entries used by it are spared)
+    GLuint baseTexture = 0;       ///< the base map of the running height pass (owned by `patterns`)
+    std::size_t cacheBudget = kDefaultGpuCacheBytes;
+    std::size_t patternBytes = 0, modelBytes = 0; ///< sums of the entries' bytes
+    std::size_t evictions = 0, forgotten = 0;
     std::optional<gl::HeightKey> lastHeights; ///< what `heights` holds now, if from a height pass
     std::size_t heightPasses = 0, heightPassesSkipped = 0;
 
@@ -185,6 +218,21 @@ struct Renderer::Impl {
     void dropPatternTextures(); ///< pattern and base textures, and what the targets were from
     Status checkGl(const char* what);
     Result<Renderer::BlockLayout> blockLayout(const std::string& block);
+
+    // gpu_cache.cpp: the byte budget.
+    /// Frees least recently used entries not used by the running job until `incoming` more bytes
+    /// fit the budget (or nothing more can be freed).
+    void makeRoom(std::size_t incoming);
+    /// Frees least recently used entries, the running job's too, until the cache fits the budget.
+    void trimCache();
+    /// Frees the least recently used entry (pattern only with `patternsOnly`) last used before
+    /// job `before`; false if there is none.
+    bool evictOldest(std::uint64_t before, bool patternsOnly = false);
+    void erasePattern(std::map<std::uint64_t, gl::PatternTexture>::iterator it);
+    void eraseModel(std::map<const Model*, gl::GpuModel>::iterator it);
+    void forgetPattern(std::uint64_t contentId);
+    void forgetModel(const std::weak_ptr<const Model>& model);
+    void publishCacheStats();
 
     // gpu_model.cpp
     Result<gl::GpuModel*> modelFor(const std::shared_ptr<const Model>& model);

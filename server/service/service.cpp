@@ -8,6 +8,9 @@
 #include "io/scene_files.hpp"
 
 #include <chrono>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <filesystem>
 #include <iterator>
 #include <set>
@@ -36,6 +39,21 @@ Error notFound(const std::string& field, const std::string& what) {
 
 Error queueFull() {
     return makeError(ErrorCode::Unavailable, "dermis::Service", "", "the render queue is full; retry shortly");
+}
+
+void returnFreedMemory() {
+#ifdef __GLIBC__
+    malloc_trim(0);
+#endif
+}
+
+void keepLargeBuffersMapped() {
+#ifdef __GLIBC__
+    // A fixed threshold: glibc's default one rises to 32 MB after the first large free, and from
+    // then on the decode buffers of large uploads are carved from the HTTP threads' arenas, where
+    // they stay resident after they are freed (issue #12: RSS over upload/delete cycles).
+    mallopt(M_MMAP_THRESHOLD, 4 << 20);
+#endif
 }
 
 double nowSeconds() {
@@ -254,6 +272,7 @@ Result<std::unique_ptr<Service>> Service::open(const ServiceConfig& config,
     st.limits = config.limits;
     st.contentDir = config.contentDir.empty() ? dermisContentDir() : config.contentDir;
     st.renderer = std::move(renderer);
+    keepLargeBuffersMapped();
     auto store = Store::open(config.dataDir);
     if (!store) return store.error();
     st.store = std::move(*store);
@@ -280,14 +299,20 @@ Service::~Service() {
 
 json Service::info() const {
     const RendererInfo& r = state_->renderer->info();
-    return {{"name", "dermis-server"},
-            {"version", "0.1.0"},
-            {"api", "/api/v1"},
-            {"backend", r.backend},
-            {"device", r.device},
-            {"gl", {{"vendor", r.vendor}, {"renderer", r.renderer}, {"version", r.version}}},
-            {"limits", limits_.toJson()},
-            {"render_queue", state_->inFlight.load()}};
+    json out = {{"name", "dermis-server"},
+                {"version", "0.1.0"},
+                {"api", "/api/v1"},
+                {"backend", r.backend},
+                {"device", r.device},
+                {"gl", {{"vendor", r.vendor}, {"renderer", r.renderer}, {"version", r.version}}},
+                {"limits", limits_.toJson()},
+                {"render_queue", state_->inFlight.load()}};
+    if (auto c = state_->renderer->cacheStats())
+        out["gpu_cache"] = {{"textures", c->textures},         {"texture_bytes", c->textureBytes},
+                            {"models", c->models},             {"model_bytes", c->modelBytes},
+                            {"budget_bytes", c->budgetBytes},  {"evictions", c->evictions},
+                            {"forgotten", c->forgotten}};
+    return out;
 }
 
 } // namespace dermis

@@ -158,8 +158,16 @@ Status Service::deleteModel(const std::string& id) {
                                  "model \"" + id + "\" is used by scene " + sid);
     }
     if (auto s = state_->store->removeBlob("models", id); !s) return s;
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    state_->models.erase(id); // renders that hold the model keep it alive until they finish
+    std::shared_ptr<const Model> model;
+    {
+        std::unique_lock<std::shared_mutex> lock(state_->mutex);
+        model = state_->models[id].model;
+        state_->models.erase(id); // renders that hold the model keep it alive until they finish
+    }
+    // Its GPU buffers and textures go too (queued: never waits for a render).
+    state_->renderer->forgetModel(model);
+    model.reset();
+    returnFreedMemory();
     return Ok{};
 }
 

@@ -119,9 +119,16 @@ Status Service::deletePattern(const std::string& id) {
         }
     }
     if (auto s = state_->store->removeBlob("patterns", id); !s) return s;
-    std::unique_lock<std::shared_mutex> lock(state_->mutex);
-    state_->images.erase(id); // a render in flight keeps its copy alive
-    state_->patterns.erase(id);
+    std::uint64_t contentId = 0;
+    {
+        std::unique_lock<std::shared_mutex> lock(state_->mutex);
+        if (auto img = state_->images.find(id); img != state_->images.end()) contentId = img->second->contentId;
+        state_->images.erase(id); // a render in flight keeps its copy alive
+        state_->patterns.erase(id);
+    }
+    // Its GPU texture goes too (queued: never waits for a render).
+    if (contentId) state_->renderer->forgetPattern(contentId);
+    returnFreedMemory();
     return Ok{};
 }
 

@@ -70,6 +70,12 @@ Error bad(const std::string& field, const std::string& what);
 Error notFound(const std::string& field, const std::string& what);
 Error queueFull();
 double nowSeconds();
+/// Hands the heap's free pages back to the system (glibc: malloc_trim): after a delete, so that
+/// the decode buffers of large uploads, kept by the allocator for reuse, do not stay resident.
+void returnFreedMemory();
+/// Buffers of 4 MB and more are mapped and unmapped, never kept in the heap (glibc: mallopt
+/// M_MMAP_THRESHOLD, process-wide; called when a service opens).
+void keepLargeBuffersMapped();
 /// [A-Za-z0-9_. -] only, at most 64 characters.
 std::string sanitizeName(const std::string& name);
 
