@@ -15,16 +15,17 @@
 namespace dermis {
 
 std::size_t GltfLimits::maxElements() const {
-    const std::size_t perTriangles =
-        maxTriangles > std::numeric_limits<std::size_t>::max() / 3 ? std::numeric_limits<std::size_t>::max()
-                                                                   : 3 * maxTriangles;
+    const std::size_t perTriangles = maxTriangles > std::numeric_limits<std::size_t>::max() / 3
+                                         ? std::numeric_limits<std::size_t>::max()
+                                         : 3 * maxTriangles;
     return std::max<std::size_t>(perTriangles, 65536);
 }
 
 std::size_t GltfLimits::maxValues() const {
     const std::size_t e = maxElements();
-    return e > std::numeric_limits<std::size_t>::max() / 24 ? std::numeric_limits<std::size_t>::max()
-                                                            : 24 * e;
+    return e > std::numeric_limits<std::size_t>::max() / 24
+               ? std::numeric_limits<std::size_t>::max()
+               : 24 * e;
 }
 
 namespace gltf_detail {
@@ -58,7 +59,7 @@ class DeclaredSizes {
   private:
     const tg::Model& g_;
     const GltfLimits& limits_;
-    std::vector<std::size_t> meshInstances_;   ///< nodes of the default scene per mesh
+    std::vector<std::size_t> meshInstances_;    ///< nodes of the default scene per mesh
     std::vector<std::size_t> skinnedInstances_; ///< of those, per skin: nodes with mesh and skin
     std::vector<std::vector<int>> skinsOfMesh_; ///< skins instancing each mesh, per instance
     Big values_ = 0;                            ///< accessor values read, each use counted
@@ -81,8 +82,8 @@ class DeclaredSizes {
         values_ += Big(a->count) * Big(comps > 0 ? comps : 1) * times;
         if (values_ > Big(limits_.maxValues()))
             return tooLarge(field, "the accessors read come to " + num(values_) +
-                                       " values, more than the limit " +
-                                       str(limits_.maxValues()) + " (from max_triangles)");
+                                       " values, more than the limit " + str(limits_.maxValues()) +
+                                       " (from max_triangles)");
         return Ok{};
     }
 
@@ -100,7 +101,8 @@ class DeclaredSizes {
             std::vector<char> child(n, 0);
             for (const tg::Node& node : g_.nodes)
                 for (int c : node.children)
-                    if (c >= 0 && static_cast<std::size_t>(c) < n) child[static_cast<std::size_t>(c)] = 1;
+                    if (c >= 0 && static_cast<std::size_t>(c) < n)
+                        child[static_cast<std::size_t>(c)] = 1;
             for (std::size_t i = 0; i < n; ++i)
                 if (!child[i]) roots.push_back(static_cast<int>(i));
         }
@@ -109,14 +111,16 @@ class DeclaredSizes {
         while (!stack.empty()) {
             const int i = stack.back();
             stack.pop_back();
-            if (i < 0 || static_cast<std::size_t>(i) >= n || seen[static_cast<std::size_t>(i)]) continue;
+            if (i < 0 || static_cast<std::size_t>(i) >= n || seen[static_cast<std::size_t>(i)])
+                continue;
             seen[static_cast<std::size_t>(i)] = 1;
             const tg::Node& node = g_.nodes[static_cast<std::size_t>(i)];
             if (node.mesh >= 0 && static_cast<std::size_t>(node.mesh) < g_.meshes.size()) {
                 ++meshInstances_[static_cast<std::size_t>(node.mesh)];
                 skinsOfMesh_[static_cast<std::size_t>(node.mesh)].push_back(
-                    node.skin >= 0 && static_cast<std::size_t>(node.skin) < g_.skins.size() ? node.skin
-                                                                                            : -1);
+                    node.skin >= 0 && static_cast<std::size_t>(node.skin) < g_.skins.size()
+                        ? node.skin
+                        : -1);
             }
             for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
                 stack.push_back(*it);
@@ -139,18 +143,21 @@ class DeclaredSizes {
                     mode != TINYGLTF_MODE_TRIANGLE_FAN)
                     continue; // skipped or refused by the converter
                 auto pos = prim.attributes.find("POSITION");
-                const tg::Accessor* position = pos == prim.attributes.end() ? nullptr : accessor(pos->second);
+                const tg::Accessor* position =
+                    pos == prim.attributes.end() ? nullptr : accessor(pos->second);
                 if (!position) continue; // the converter reports it
                 const tg::Accessor* idx = accessor(prim.indices);
                 const Big listed = Big(idx ? idx->count : position->count);
-                const Big perInstance =
-                    mode == TINYGLTF_MODE_TRIANGLES ? Big(static_cast<unsigned long long>(listed) / 3)
-                                                    : (listed >= 3 ? listed - 2 : 0);
-                const std::string triField = idx ? field + "/indices" : field + "/attributes/POSITION";
+                const Big perInstance = mode == TINYGLTF_MODE_TRIANGLES
+                                            ? Big(static_cast<unsigned long long>(listed) / 3)
+                                            : (listed >= 3 ? listed - 2 : 0);
+                const std::string triField =
+                    idx ? field + "/indices" : field + "/attributes/POSITION";
                 triangles += perInstance * Big(inst);
                 if (triangles > Big(limits_.maxTriangles))
                     return tooLarge(triField, num(perInstance) + " triangles × " + str(inst) +
-                                                  " instances: the model comes to " + num(triangles) +
+                                                  " instances: the model comes to " +
+                                                  num(triangles) +
                                                   " triangles, more than max_triangles " +
                                                   str(limits_.maxTriangles));
                 vertices += Big(position->count) * Big(inst);
@@ -158,8 +165,8 @@ class DeclaredSizes {
                     return tooLarge(field + "/attributes/POSITION",
                                     str(position->count) + " vertices × " + str(inst) +
                                         " instances: the model comes to " + num(vertices) +
-                                        " vertices, more than the limit " + str(limits_.maxElements()) +
-                                        " (from max_triangles)");
+                                        " vertices, more than the limit " +
+                                        str(limits_.maxElements()) + " (from max_triangles)");
                 parts += Big(inst);
                 if (parts > Big(limits_.maxParts))
                     return tooLarge(field, "the model comes to " + num(parts) +
@@ -167,17 +174,20 @@ class DeclaredSizes {
                                                str(limits_.maxParts));
                 // What each instance reads (gltf_convert.cpp: primitive, skinWeights).
                 for (const auto& [name, index] : prim.attributes) {
-                    const bool read = name == "POSITION" || name == "NORMAL" || name == "TEXCOORD_0" ||
-                                      name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0;
+                    const bool read = name == "POSITION" || name == "NORMAL" ||
+                                      name == "TEXCOORD_0" || name.rfind("JOINTS_", 0) == 0 ||
+                                      name.rfind("WEIGHTS_", 0) == 0;
                     if (read)
-                        if (auto s = use(index, field + "/attributes/" + name, Big(inst)); !s) return s;
+                        if (auto s = use(index, field + "/attributes/" + name, Big(inst)); !s)
+                            return s;
                 }
                 if (auto s = use(prim.indices, field + "/indices", Big(inst)); !s) return s;
                 // A skinned part copies its skin's influences (node + inverse bind: 17 values).
                 if (prim.attributes.count("JOINTS_0"))
                     for (int skin : skinsOfMesh_[m])
                         if (skin >= 0) {
-                            values_ += Big(g_.skins[static_cast<std::size_t>(skin)].joints.size()) * 17;
+                            values_ +=
+                                Big(g_.skins[static_cast<std::size_t>(skin)].joints.size()) * 17;
                             if (values_ > Big(limits_.maxValues()))
                                 return tooLarge(field, "the skinned parts come to " + num(values_) +
                                                            " values, more than the limit " +
@@ -203,7 +213,8 @@ class DeclaredSizes {
                 return tooLarge(field + "/joints", "the skins come to " + str(distinct.size()) +
                                                        " distinct joints, more than max_joints " +
                                                        str(limits_.maxJoints));
-            if (auto st = use(skin.inverseBindMatrices, field + "/inverseBindMatrices"); !st) return st;
+            if (auto st = use(skin.inverseBindMatrices, field + "/inverseBindMatrices"); !st)
+                return st;
         }
         return Ok{};
     }
@@ -215,7 +226,8 @@ class DeclaredSizes {
             for (const tg::AnimationChannel& ch : anim.channels) {
                 if (ch.sampler < 0 || static_cast<std::size_t>(ch.sampler) >= anim.samplers.size())
                     continue;
-                const tg::AnimationSampler& smp = anim.samplers[static_cast<std::size_t>(ch.sampler)];
+                const tg::AnimationSampler& smp =
+                    anim.samplers[static_cast<std::size_t>(ch.sampler)];
                 const std::string sfield = "/animations/" + str(a) + "/samplers/" + str(ch.sampler);
                 if (auto s = use(smp.input, sfield + "/input"); !s) return s;
                 if (auto s = use(smp.output, sfield + "/output"); !s) return s;
@@ -241,7 +253,8 @@ Status checkDeclaredTextures(const PendingImages& images, const GltfLimits& limi
         if (!size)
             return makeError(ErrorCode::Unsupported, where, field,
                              "not a PNG or JPEG image with a valid header (" +
-                                 (e.mimeType.empty() ? std::string("no MIME type") : e.mimeType) + ")");
+                                 (e.mimeType.empty() ? std::string("no MIME type") : e.mimeType) +
+                                 ")");
         const Big bytes = Big(size->width) * Big(size->height) * 4;
         total += bytes;
         if (total > Big(limits.maxTextureBytes))

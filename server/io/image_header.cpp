@@ -42,8 +42,8 @@ std::optional<ImageSize> jpegSize(const std::uint8_t* b, std::size_t size) {
         if (at + 2 > size) return std::nullopt;
         const std::size_t length = be16(b + at);
         if (length < 2 || at + length > size) return std::nullopt;
-        const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 &&
-                         marker != 0xCC;
+        const bool sof =
+            marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
         if (sof) {
             if (length < 7) return std::nullopt;
             return ImageSize{be16(b + at + 5), be16(b + at + 3)};
