@@ -3,7 +3,9 @@
 // buffer view per array), a valid SkinnedTriangle whose accessor indices are kept for targeted
 // damage, and the checks: every invariant of Model (expectConsistent), rest pose = bind pose and
 // clips that move (expectRestReproducesBindAndClipsMove), an error naming the field
-// (expectFieldError), an error or a consistent model (expectErrorOrConsistent). Header-only:
+// (expectFieldError), an error or a consistent model (expectErrorOrConsistent), and files that
+// declare far more than they hold (instancedZeroMesh: an accessor without a buffer view instanced
+// by many nodes; pngHeader: a PNG that declares any size; withBaseColorImages). Header-only:
 // everything is inline in dermis::test::gltf, so that both suites can include it.
 #pragma once
 
@@ -195,6 +197,78 @@ struct SkinnedTriangle {
               {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}}}}}});
     }
 };
+
+// --- files that declare more than they hold ---------------------------------------------------
+
+/// A GLB of a few hundred bytes: one mesh whose POSITION accessor has no buffer view (so `count`
+/// zeros, glTF 2.0 §3.6.2.1) and no indices, instanced by `instances` nodes of the scene. The
+/// shape of issue #12's 440-byte file (5.6 M elements × 16 instances).
+inline std::vector<std::uint8_t> instancedZeroMesh(std::size_t count = 5592405,
+                                                   int instances = 16) {
+    json nodes = json::array(), roots = json::array();
+    for (int i = 0; i < instances; ++i) {
+        nodes.push_back({{"mesh", 0}});
+        roots.push_back(i);
+    }
+    json doc = {{"asset", {{"version", "2.0"}}},
+                {"accessors", {{{"componentType", kFloat}, {"type", "VEC3"}, {"count", count}}}},
+                {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
+                {"nodes", nodes},
+                {"scenes", {{{"nodes", roots}}}},
+                {"scene", 0}};
+    return makeGlb(doc, {});
+}
+
+/// CRC-32 (ISO 3309, as PNG uses) of `n` bytes.
+inline std::uint32_t crc32Of(const std::uint8_t* p, std::size_t n) {
+    std::uint32_t c = 0xFFFFFFFFu;
+    for (std::size_t i = 0; i < n; ++i) {
+        c ^= p[i];
+        for (int k = 0; k < 8; ++k)
+            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
+    }
+    return c ^ 0xFFFFFFFFu;
+}
+
+/// A PNG signature, an IHDR chunk declaring `width` × `height` 8-bit RGB, then IEND: 45 bytes
+/// whose header is valid and whose pixels are missing (any decoder fails after allocating).
+inline std::vector<std::uint8_t> pngHeader(std::uint32_t width, std::uint32_t height) {
+    std::vector<std::uint8_t> out = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    auto be = [&](std::vector<std::uint8_t>& v, std::uint32_t x) {
+        for (int k = 3; k >= 0; --k)
+            v.push_back(static_cast<std::uint8_t>(x >> (8 * k)));
+    };
+    auto chunk = [&](const char* type, const std::vector<std::uint8_t>& data) {
+        be(out, static_cast<std::uint32_t>(data.size()));
+        std::vector<std::uint8_t> body(type, type + 4);
+        body.insert(body.end(), data.begin(), data.end());
+        out.insert(out.end(), body.begin(), body.end());
+        be(out, crc32Of(body.data(), body.size()));
+    };
+    std::vector<std::uint8_t> ihdr;
+    be(ihdr, width);
+    be(ihdr, height);
+    ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0}); // 8-bit, RGB, deflate, adaptive, no interlace
+    chunk("IHDR", ihdr);
+    chunk("IEND", {});
+    return out;
+}
+
+/// `t` with one base-colour texture per image of `images` (PNG bytes in buffer views): material
+/// i uses image i (material 0 is the triangle's).
+inline void withBaseColorImages(SkinnedTriangle& t,
+                                const std::vector<std::vector<std::uint8_t>>& images) {
+    json& d = t.b.doc;
+    d["images"] = json::array();
+    d["textures"] = json::array();
+    for (std::size_t i = 0; i < images.size(); ++i) {
+        const int view = t.b.view(images[i]);
+        d["images"].push_back({{"bufferView", view}, {"mimeType", "image/png"}});
+        d["textures"].push_back({{"source", i}});
+        if (i >= d["materials"].size()) d["materials"].push_back({{"name", "m" + std::to_string(i)}});
+        d["materials"][i]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", i}};
+    }
+}
 
 inline Result<Model> parseModel(const std::vector<std::uint8_t>& bytes) {
     auto parsed = parseGltf(bytes, "");

@@ -7,10 +7,15 @@
 //     character or RiggedFigure: 404 no_texture);
 //   * a multipart .gltf with its external buffer, and multipart uploads that are refused (missing
 //     buffer, a URI outside the folder, a folder in a part name, no .gltf part, not JSON); no
-//     answer to a bad upload contains a path of the server (the data folder, /tmp).
+//     answer to a bad upload contains a path of the server (the data folder, /tmp);
+//   * tiny files that declare huge models (issue #12: a zero-filled accessor instanced by 16
+//     nodes, three 16384² textures): 413 too_large naming the field, the server healthy after.
+#include "GltfTestBuilder.hpp"
 #include "HttpTestFixture.hpp"
 #include "io/gltf_loader.hpp"
 
+#include <chrono>
+#include <cstdio>
 #include <filesystem>
 
 using namespace dermis;
@@ -323,6 +328,33 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
         {{"format", "dermis.scene/1"}, {"model", figId}, {"heightmap", {{"size", {256, 256}}}}});
     EXPECT_EQ(h.del("/scenes/" + figScene).status, 204);
     EXPECT_EQ(h.del("/models/" + figId).status, 204);
+}
+
+TEST_F(ModelsHttpTest, TinyFilesThatDeclareHugeModelsAre413) {
+    Http h = http();
+    const std::size_t models = h.get("/models").js()["models"].size();
+    gltf::SkinnedTriangle textured;
+    const std::vector<std::uint8_t> huge = gltf::pngHeader(16384, 16384);
+    gltf::withBaseColorImages(textured, {huge, huge, huge});
+    const struct {
+        const char* name;
+        std::vector<std::uint8_t> glb;
+        std::string field;
+    } cases[] = {
+        {"instanced zero-filled mesh", gltf::instancedZeroMesh(),
+         "/meshes/0/primitives/0/attributes/POSITION"},
+        {"three 16384² textures", textured.b.glb(), "/images/0"},
+    };
+    for (const auto& c : cases) {
+        const auto t0 = std::chrono::steady_clock::now();
+        Reply r = h.upload("/models?name=huge", c.glb, "model/gltf-binary");
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        expectError(r, 413, c.field);
+        EXPECT_EQ(r.js()["error"]["code"], "too_large") << c.name << ": " << r;
+        std::printf("%s (%zu bytes): %d in %.3f s\n", c.name, c.glb.size(), r.status, s);
+        EXPECT_EQ(h.get("/health").status, 200) << c.name;
+    }
+    EXPECT_EQ(h.get("/models").js()["models"].size(), models); // nothing stored
 }
 
 } // namespace

@@ -350,9 +350,9 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
     app.add_option("--max-upload-mb", s.maxUploadMb, "Largest request body / upload")->check(CLI::Range(0.001, 4096.0));
     app.add_option("--max-render-side", s.limits.maxRenderSide, "Largest frame side")->check(CLI::Range(16, 8192));
     app.add_option("--max-map-side", s.limits.maxMapSide, "Largest height-map side")->check(CLI::Range(16, 4096));
-    app.add_option("--max-image-side", s.limits.maxImageSide, "Largest uploaded pattern side")->check(CLI::Range(16, 8192));
+    app.add_option("--max-image-side", s.limits.maxImageSide, "Largest uploaded pattern side; model textures above it are downscaled")->check(CLI::Range(16, 8192));
     app.add_option("--max-placements", s.limits.maxPlacements, "Most placements per scene")->check(CLI::Range(1, 100000));
-    app.add_option("--max-triangles", s.limits.maxTriangles, "Most triangles per model");
+    app.add_option("--max-triangles", s.limits.maxTriangles, "Most triangles per model (after instancing)");
     app.add_option("--max-joints", s.limits.maxJoints, "Most joints per model");
     app.add_option("--queue", s.limits.queueLength, "Renders that may wait for the GL thread")->check(CLI::Range(1, 10000));
     app.add_option("--timeout", s.limits.requestTimeoutSeconds, "Request read/write timeout (s)")->check(CLI::Range(1, 3600));

@@ -23,6 +23,7 @@
 #include <tiny_gltf.h>
 
 #include "gltf_loader.hpp"
+#include "image_header.hpp"
 
 #include "core/result.hpp"
 
@@ -83,6 +84,25 @@ Result<AccessorData> readAccessor(const tg::Model& g, int index, int type, Want 
 /// Finite and within float range, so that converting to float is defined.
 bool fitsFloat(double x);
 bool allFitFloat(const std::vector<double>& v);
+
+// ------------------------------------------------------------------------------------------------
+// Limits from declared sizes (gltf_preflight.cpp)
+
+/// ErrorCode::TooLarge from parseGltf (or `where`), naming `field`.
+Error tooLarge(const std::string& field, const std::string& what, const char* where = kWhere);
+
+/// Checks `g` against `limits` from the declared sizes only (accessor counts, node instancing,
+/// skin joint lists, animation channels) — nothing is read from buffers and nothing big is
+/// allocated. Mirrors what convertGltf will read: the meshes of the default scene's nodes (each
+/// node once), every skin, every animation channel. Indices that do not exist are skipped (the
+/// converter reports them).
+Status checkDeclaredSizes(const tg::Model& g, const GltfLimits& limits);
+
+/// Reads the declared size of every pending image (image_header.hpp) and checks the sum of
+/// width × height × 4 against limits.maxTextureBytes, before anything is decoded. Errors name
+/// "/images/<i>" and `where`; `sizes` gets one size per entry.
+Status checkDeclaredTextures(const PendingImages& images, const GltfLimits& limits,
+                             const char* where, std::vector<ImageSize>& sizes);
 
 // ------------------------------------------------------------------------------------------------
 // Conversion (gltf_convert.cpp)

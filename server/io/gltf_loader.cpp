@@ -1,7 +1,9 @@
 // glTF 2.0 loader of gltf_loader.hpp on tinygltf 2.7 (Debian's libtinygltf-dev, header only here):
 // this file holds the tinygltf implementation, the checks run before tinygltf sees the bytes, the
-// tinygltf callbacks (image capture, confined file access) and the public entry points (parseGltf,
-// loadGltfResources, loadGltfFile, loadGltfFromFiles). Accessors are read in gltf_accessors.cpp,
+// tinygltf callbacks (image capture, confined file access), texture downscaling and the public
+// entry points (parseGltf, loadGltfResources, loadGltfFile, loadGltfFromFiles). The limits on
+// declared sizes are checked in gltf_preflight.cpp, called here between tinygltf and the converter
+// and before any image is decoded. Accessors are read in gltf_accessors.cpp,
 // the glTF model is converted to a Model in gltf_convert.cpp; gltf_internal.hpp joins them.
 //
 // tinygltf parses the JSON and resolves buffers; everything then read from a buffer is validated
@@ -27,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -304,7 +307,8 @@ std::string tinygltfMessage(const std::string& err) {
 }
 
 /// parseGltf with external files from `sandbox`.
-Result<ParsedGltf> parseIn(const std::vector<std::uint8_t>& bytes, Sandbox sandbox) {
+Result<ParsedGltf> parseIn(const std::vector<std::uint8_t>& bytes, Sandbox sandbox,
+                           const GltfLimits& limits) {
     if (bytes.empty()) return parseError("", "empty input");
     if (bytes.size() > kMaxGltfBytes)
         return makeError(ErrorCode::Unsupported, kWhere, "",
@@ -336,6 +340,7 @@ Result<ParsedGltf> parseIn(const std::vector<std::uint8_t>& bytes, Sandbox sandb
                    : loader.LoadASCIIFromString(&g, &err, &warn, json,
                                                 static_cast<unsigned int>(jsonLength), base);
         if (!ok) return parseError("", tinygltfMessage(err));
+        if (auto s = checkDeclaredSizes(g, limits); !s) return s.error();
         return convertGltf(g, captured);
     } catch (const std::bad_alloc&) {
         return makeError(ErrorCode::Unsupported, kWhere, "", "out of memory");
@@ -344,19 +349,60 @@ Result<ParsedGltf> parseIn(const std::vector<std::uint8_t>& bytes, Sandbox sandb
     }
 }
 
+/// `image` shrunk (box filter: each output pixel averages the input pixels it covers) so that
+/// neither side exceeds `side`, aspect kept (each side at least 1).
+Image8 downscaleToFit(const Image8& image, int side) {
+    const double scale = double(side) / double(std::max(image.width, image.height));
+    Image8 out;
+    out.width = std::clamp(static_cast<int>(std::lround(image.width * scale)), 1, side);
+    out.height = std::clamp(static_cast<int>(std::lround(image.height * scale)), 1, side);
+    out.rgba.assign(static_cast<std::size_t>(out.width) * out.height * 4, 0);
+    auto span = [](int d, int outSide, int inSide) {
+        const int a = static_cast<int>(std::int64_t(d) * inSide / outSide);
+        const int b = static_cast<int>(std::int64_t(d + 1) * inSide / outSide);
+        return std::pair<int, int>(a, std::max(b, a + 1));
+    };
+    for (int y = 0; y < out.height; ++y) {
+        const auto [y0, y1] = span(y, out.height, image.height);
+        for (int x = 0; x < out.width; ++x) {
+            const auto [x0, x1] = span(x, out.width, image.width);
+            std::uint64_t sum[4] = {0, 0, 0, 0};
+            for (int sy = y0; sy < y1; ++sy)
+                for (int sx = x0; sx < x1; ++sx) {
+                    const std::uint8_t* p =
+                        &image.rgba[(static_cast<std::size_t>(sy) * image.width + sx) * 4];
+                    for (int c = 0; c < 4; ++c)
+                        sum[c] += p[c];
+                }
+            const std::uint64_t n = std::uint64_t(y1 - y0) * std::uint64_t(x1 - x0);
+            std::uint8_t* d = &out.rgba[(static_cast<std::size_t>(y) * out.width + x) * 4];
+            for (int c = 0; c < 4; ++c)
+                d[c] = static_cast<std::uint8_t>((sum[c] + n / 2) / n);
+        }
+    }
+    return out;
+}
+
 } // namespace
 
-Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir) {
+Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir,
+                             const GltfLimits& limits) {
     Sandbox sandbox;
     if (!baseDir.empty()) {
         std::error_code ec;
         sandbox.root = fs::weakly_canonical(fs::path(baseDir), ec);
         if (ec) sandbox.root.clear();
     }
-    return parseIn(bytes, std::move(sandbox));
+    return parseIn(bytes, std::move(sandbox), limits);
 }
 
-Status loadGltfResources(ParsedGltf& parsed) {
+Status loadGltfResources(ParsedGltf& parsed, const GltfLimits& limits) {
+    // Every declared size first: nothing is decoded when the textures are over budget.
+    std::vector<ImageSize> declared;
+    if (auto s = checkDeclaredTextures(parsed.images, limits, "dermis::loadGltfResources",
+                                       declared);
+        !s)
+        return s.error();
     for (PendingImages::Entry& e : parsed.images.entries) {
         const std::string field = "/images/" + str(e.gltfImage);
         if (e.imageIndex < 0 ||
@@ -369,26 +415,29 @@ Status loadGltfResources(ParsedGltf& parsed) {
                                                                           : ErrorCode::Parse,
                              "dermis::loadGltfResources", field,
                              "cannot decode (" + e.mimeType + "): " + image.error().message);
+        if (image->width > limits.maxImageSide || image->height > limits.maxImageSide)
+            *image = downscaleToFit(*image, std::max(1, limits.maxImageSide));
         parsed.model.images[static_cast<std::size_t>(e.imageIndex)] = std::move(*image);
     }
     parsed.images.entries.clear();
     return Ok{};
 }
 
-Result<Model> loadGltfFromFiles(const GltfFiles& files, const std::string& mainFile) {
+Result<Model> loadGltfFromFiles(const GltfFiles& files, const std::string& mainFile,
+                                const GltfLimits& limits) {
     const char* where = "dermis::loadGltfFromFiles";
     const auto it = files.find(mainFile);
     if (it == files.end())
         return makeError(ErrorCode::NotFound, where, mainFile, "not among the given files");
     Sandbox sandbox;
     sandbox.memory = &files;
-    auto parsed = parseIn(it->second, std::move(sandbox));
+    auto parsed = parseIn(it->second, std::move(sandbox), limits);
     if (!parsed) {
         Error e = parsed.error();
         e.message = std::string(where) + ": " + mainFile + ": " + e.message;
         return e;
     }
-    if (auto s = loadGltfResources(*parsed); !s) {
+    if (auto s = loadGltfResources(*parsed, limits); !s) {
         Error e = s.error();
         e.message = std::string(where) + ": " + mainFile + ": " + e.message;
         return e;
@@ -396,7 +445,7 @@ Result<Model> loadGltfFromFiles(const GltfFiles& files, const std::string& mainF
     return std::move(parsed->model);
 }
 
-Result<Model> loadGltfFile(const std::string& path) {
+Result<Model> loadGltfFile(const std::string& path, const GltfLimits& limits) {
     const char* where = "dermis::loadGltfFile";
     std::error_code ec;
     if (!fs::is_regular_file(path, ec))
@@ -412,13 +461,13 @@ Result<Model> loadGltfFile(const std::string& path) {
     if (!in) return makeError(ErrorCode::Io, where, path, "cannot read");
 
     const fs::path dir = fs::absolute(fs::path(path), ec).parent_path();
-    auto parsed = parseGltf(bytes, dir.string());
+    auto parsed = parseGltf(bytes, dir.string(), limits);
     if (!parsed) {
         Error e = parsed.error();
         e.message = std::string(where) + ": " + path + ": " + e.message;
         return e;
     }
-    if (auto s = loadGltfResources(*parsed); !s) {
+    if (auto s = loadGltfResources(*parsed, limits); !s) {
         Error e = s.error();
         e.message = std::string(where) + ": " + path + ": " + e.message;
         return e;

@@ -33,6 +33,17 @@
 // is the JSON pointer at fault, e.g. "/meshes/0/primitives/1/attributes/POSITION"; glTF 1.0, GLB
 // version 1 and unsupported required extensions give ErrorCode::Unsupported. Never a crash or an
 // out-of-bounds read.
+//
+// Limits (GltfLimits): a small file can declare a huge model — an accessor without a buffer view
+// is count zeros (glTF 2.0 §3.6.2.1), one mesh can be instanced by many nodes, a PNG of a few
+// hundred kilobytes can declare 16384² pixels. So every size is checked from what the file
+// declares BEFORE anything is allocated for it: triangles, vertices and mesh parts after
+// instancing, accessor element counts and the accessor values read in all, skin joints (step 1,
+// from the parsed JSON, before any accessor is read), and texture sizes from the PNG IHDR / JPEG
+// SOF header bytes (step 2, before any image is decoded). Past a limit: ErrorCode::TooLarge whose
+// `field` is the JSON pointer of the primitive, accessor, skin or image at fault and whose message
+// gives the declared size and the limit. Textures within the decode budget but with a side above
+// `maxImageSide` are decoded and then downscaled (box filter, aspect kept) to fit.
 #pragma once
 
 #include "core/model.hpp"
@@ -47,6 +58,30 @@ namespace dermis {
 
 /// Largest glTF/GLB file (and external resource) accepted, in bytes.
 constexpr std::size_t kMaxGltfBytes = std::size_t(1) << 30;
+
+/// What a loaded model may hold; every check uses the sizes the file declares, before allocating
+/// (see the top of this file). Defaults: the server's defaults (ServerLimits).
+struct GltfLimits {
+    /// Triangles of all loaded primitives, each counted once per node that instances its mesh.
+    std::size_t maxTriangles = 1000000;
+    /// Distinct joints of all skins (and joints listed by any one skin).
+    std::size_t maxJoints = 1024;
+    /// Mesh parts (triangle primitives × instances).
+    std::size_t maxParts = 4096;
+    /// Base-colour textures with a larger side are downscaled to fit after decoding.
+    int maxImageSide = 4096;
+    /// Σ width × height × 4 over the base-colour textures, at their declared (full) size: what
+    /// decoding allocates. Past it the model is refused, not downscaled.
+    std::size_t maxTextureBytes = std::size_t(256) << 20;
+
+    /// Vertices after instancing, and the elements of any one accessor read: 3 × maxTriangles
+    /// (at least 65536).
+    std::size_t maxElements() const;
+    /// Accessor values (elements × components) read in all, counting each use (a mesh's
+    /// attributes once per instance, skin influences per skinned part, animation channels):
+    /// 24 × maxElements().
+    std::size_t maxValues() const;
+};
 
 /// Encoded images captured by parseGltf, consumed by loadGltfResources.
 struct PendingImages {
@@ -65,15 +100,21 @@ struct ParsedGltf {
 };
 
 /// Step 1. `baseDir` resolves external URIs of a .gltf ("" for a self-contained .glb).
-Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir);
+/// Past a limit of `limits` (triangles, vertices, parts, accessor counts, values, joints):
+/// ErrorCode::TooLarge, decided from the declared sizes before any accessor is read.
+Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir,
+                             const GltfLimits& limits = {});
 
 /// Step 2. Decodes every pending image to RGBA8 (OpenImageIO, through decodeImage8) into
 /// parsed.model.images and clears parsed.images. A corrupt image is an error (field
-/// "/images/<i>"), leaving the model's images partly filled.
-Status loadGltfResources(ParsedGltf& parsed);
+/// "/images/<i>"), leaving the model's images partly filled. Before decoding anything, reads
+/// every image's declared size from its header: not a PNG or JPEG → Unsupported; the declared
+/// sizes over limits.maxTextureBytes in all → TooLarge (nothing decoded). Images with a side over
+/// limits.maxImageSide are downscaled after decoding.
+Status loadGltfResources(ParsedGltf& parsed, const GltfLimits& limits = {});
 
 /// Both steps for a file on disk.
-Result<Model> loadGltfFile(const std::string& path);
+Result<Model> loadGltfFile(const std::string& path, const GltfLimits& limits = {});
 
 /// Named files held in memory: plain file name → bytes.
 using GltfFiles = std::map<std::string, std::vector<std::uint8_t>>;
@@ -83,6 +124,7 @@ using GltfFiles = std::map<std::string, std::vector<std::uint8_t>>;
 /// only to other entries of `files` by plain name. A URI with a folder, "..", an absolute path or
 /// a name not in `files` fails like an unreadable file (Parse). Reads no file of this machine
 /// and writes none. NotFound (field `mainFile`) when `mainFile` is not in `files`.
-Result<Model> loadGltfFromFiles(const GltfFiles& files, const std::string& mainFile);
+Result<Model> loadGltfFromFiles(const GltfFiles& files, const std::string& mainFile,
+                                const GltfLimits& limits = {});
 
 } // namespace dermis

@@ -210,11 +210,15 @@ Status Service::State::loadContent() {
 }
 
 void Service::State::loadStored(std::vector<std::string>& warnings) {
+    // Stored models are loaded under the same limits as uploads, checked before allocating: a
+    // file past them (stored by an older server or configured limits since lowered) is skipped
+    // with a warning, quickly.
+    const GltfLimits gl = detail::gltfLimitsOf(limits);
     for (const Store::Blob& b : store->listBlobs("models", warnings)) {
         Result<Model> model = makeError(ErrorCode::Internal, "", "", "");
         std::size_t bytesLen = b.meta.value("bytes", std::size_t{0});
         if (b.file.size() > 5 && b.file.compare(b.file.size() - 5, 5, ".gltf") == 0) {
-            model = loadGltfFile(b.file); // a multi-file upload: resources beside it only
+            model = loadGltfFile(b.file, gl); // a multi-file upload: resources beside it only
         } else {
             auto bytes = readWholeFile(b.file);
             if (!bytes) {
@@ -222,9 +226,9 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
                 continue;
             }
             bytesLen = bytes->size();
-            auto parsed = parseGltf(*bytes, "");
+            auto parsed = parseGltf(*bytes, "", gl);
             if (parsed)
-                if (auto s = loadGltfResources(*parsed); !s) parsed = s.error();
+                if (auto s = loadGltfResources(*parsed, gl); !s) parsed = s.error();
             if (parsed) model = std::move(parsed->model);
             else model = parsed.error();
         }

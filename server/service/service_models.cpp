@@ -7,12 +7,23 @@
 #include "io/frame_io.hpp"
 #include "io/gltf_loader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
 namespace dermis {
 
 using namespace detail;
+
+GltfLimits detail::gltfLimitsOf(const ServerLimits& limits) {
+    GltfLimits g;
+    g.maxTriangles = limits.maxTriangles;
+    g.maxJoints = limits.maxJoints;
+    g.maxImageSide = limits.maxImageSide;
+    const std::size_t side = static_cast<std::size_t>(std::max(limits.maxImageSide, 1));
+    g.maxTextureBytes = 16 * side * side;
+    return g;
+}
 
 namespace {
 
@@ -62,9 +73,12 @@ Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::
     if (glb.size() < 12 || std::memcmp(glb.data(), "glTF", 4) != 0)
         return makeError(ErrorCode::Unsupported, where, "body",
                          "not a binary glTF (.glb); send a .gltf with its files as multipart/form-data");
-    auto parsed = parseGltf(glb, ""); // no base folder: no file of this machine is read
+    // No base folder: no file of this machine is read. The limits are checked from the declared
+    // sizes before anything big is allocated; checkModel below is the backstop.
+    const GltfLimits gl = gltfLimitsOf(limits_);
+    auto parsed = parseGltf(glb, "", gl);
     if (!parsed) return parsed.error();
-    if (auto s = loadGltfResources(*parsed); !s) return s.error();
+    if (auto s = loadGltfResources(*parsed, gl); !s) return s.error();
     if (auto st = checkModel(parsed->model, limits_, where); !st) return st.error();
     ModelEntry e{Store::newId("m"), sanitizeName(name),
                  std::make_shared<const Model>(std::move(parsed->model)), glb.size(), false};
@@ -94,7 +108,7 @@ Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const 
         return makeError(ErrorCode::InvalidArgument, where, "gltf",
                          "no .gltf part (name the part \"gltf\" or give it a .gltf file name)");
     // Parsed from memory: the .gltf's URIs resolve to the uploaded files only.
-    auto model = loadGltfFromFiles(named, gltfName);
+    auto model = loadGltfFromFiles(named, gltfName, gltfLimitsOf(limits_));
     if (!model) return model.error();
     if (auto st = checkModel(*model, limits_, where); !st) return st.error();
     ModelEntry e{Store::newId("m"), sanitizeName(name.empty() ? gltfName : name),

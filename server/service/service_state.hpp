@@ -14,6 +14,7 @@
 #include "service/service.hpp"
 
 #include "core/frame_plan.hpp"
+#include "io/gltf_loader.hpp"
 
 #include <atomic>
 #include <map>
@@ -65,6 +66,11 @@ struct PresenceEntry {
     std::string color;
     double expires = 0.0; ///< nowSeconds() at which it lapses
 };
+
+/// The glTF loader's limits (checked from declared sizes, before allocating) for a server's
+/// limits: its triangle and joint limits; base-colour textures downscaled to maxImageSide, the
+/// textures' decoded bytes at most 4 × maxImageSide² × 4 (four full-size RGBA8 textures).
+GltfLimits gltfLimitsOf(const ServerLimits& limits);
 
 Error bad(const std::string& field, const std::string& what);
 Error notFound(const std::string& field, const std::string& what);
