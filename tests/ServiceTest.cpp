@@ -3,6 +3,7 @@
 // (FakeRenderer.hpp). Edits, revisions and events, failed edits changing nothing, limits, frame
 // parameters, height maps, batches, reopening, locking (a render in flight blocks no reader and no
 // upload), event back-pressure (resync), and opening with broken content.
+#include "GltfTestBuilder.hpp"
 #include "ServiceFixture.hpp"
 
 #include <gtest/gtest.h>
@@ -316,6 +317,26 @@ TEST_F(ServiceTest, ReopeningRestoresScenesAndUploads) {
     EXPECT_TRUE(svc_->warnings().empty());
     EXPECT_EQ(*svc_->getScene(id), before);
     EXPECT_TRUE(svc_->patternImage((*added)["id"], 8));
+}
+
+TEST_F(ServiceTest, StoredModelsAreReloadedUnderTheLimits) {
+    // A model of one mesh instanced by 16 nodes (16000 triangles) is taken under a limit of
+    // 20000; reopened under 10000 it is skipped with a warning, checked from its declared sizes.
+    ServerLimits generous;
+    generous.maxTriangles = 20000;
+    open(generous);
+    auto added = svc_->addModel(gltf::instancedZeroMesh(3000, 16), "instanced");
+    ASSERT_TRUE(added) << added.error().message;
+    EXPECT_EQ((*added)["triangles"], 16000u);
+    const std::string id = (*added)["id"];
+    ServerLimits low;
+    low.maxTriangles = 10000;
+    open(low);
+    EXPECT_FALSE(svc_->getModel(id));
+    ASSERT_EQ(svc_->warnings().size(), 1u);
+    EXPECT_NE(svc_->warnings()[0].find("max_triangles 10000"), std::string::npos) << svc_->warnings()[0];
+    open(generous);
+    EXPECT_TRUE(svc_->getModel(id));
 }
 
 TEST_F(ServiceTest, ModelsDescribeJointsParentsAndUvLayout) {

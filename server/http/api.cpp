@@ -468,11 +468,13 @@ Result<int> Api::bind() {
         if (port <= 0)
             return makeError(ErrorCode::Io, "dermis::Api::bind", "--bind",
                              "cannot bind " + impl_->opt.bind);
+        impl_->server.widenBacklog();
         return port;
     }
     if (!impl_->server.bind_to_port(impl_->opt.bind, port))
         return makeError(ErrorCode::Io, "dermis::Api::bind", "--port",
                          "cannot bind " + impl_->opt.bind + ":" + std::to_string(port));
+    impl_->server.widenBacklog();
     return port;
 }
 

@@ -64,6 +64,7 @@ public:
         bodyBudget_ = budget;
     }
     bool overLimit() const { return overLimit_; }
+    std::size_t bodyBudget() const { return bodyBudget_; }
     bool closeAfter = false;
     /// True when bytes already received wait in the buffer.
     bool buffered() const { return off_ < len_; }
@@ -236,6 +237,11 @@ GuardedServer::~GuardedServer() {
     waitIdle(std::chrono::hours(24));
 }
 
+void GuardedServer::widenBacklog() {
+    const int sock = svr_sock_;
+    if (sock >= 0) ::listen(sock, SOMAXCONN);
+}
+
 void GuardedServer::closeAll() {
     std::lock_guard<std::mutex> lock(mutex_);
     closing_ = true;
@@ -320,12 +326,15 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
     forget(conn);
     if (strm.closeAfter) {
         // The answer was sent before the body was read: stop sending, then read (and drop) what
-        // the client still sends for a moment so that it gets the answer rather than a reset.
+        // the client still sends, at most the body's budget and 2 s, until it pauses for 200 ms,
+        // so that a client that writes all of its body before reading gets the answer rather
+        // than a reset. Nothing of it is kept.
         ::shutdown(sock, SHUT_WR);
         char drop[16384];
-        const auto until = Clock::now() + std::chrono::milliseconds(300);
+        const auto until = Clock::now() + std::chrono::seconds(2);
+        const std::size_t budget = std::max<std::size_t>(strm.bodyBudget(), 1u << 20);
         std::size_t dropped = 0;
-        while (dropped < (1u << 20) && waitFor(sock, POLLIN, msUntil(until))) {
+        while (dropped < budget && waitFor(sock, POLLIN, std::min(200, msUntil(until)))) {
             const ssize_t r = ::recv(sock, drop, sizeof drop, 0);
             if (r <= 0) break;
             dropped += static_cast<std::size_t>(r);

@@ -197,6 +197,9 @@ public:
 
     GuardedServer();
     ~GuardedServer() override;
+    /// After bind: lets the kernel queue SOMAXCONN connections not yet accepted (httplib listens
+    /// with a backlog of 5: a burst of connections otherwise waits for SYN retries, 1 s each).
+    void widenBacklog();
     /// Shuts every open connection (their threads end soon); new ones are closed at once.
     void closeAll();
     /// Waits (up to `timeout`) until no connection thread runs; true when none does.
