@@ -7,6 +7,7 @@
 //     without eviction they add 1.2 GB), with the server's default GPU cache budget;
 //   * GET /info reports the GPU cache (entries, bytes, budget), and a deleted pattern's and
 //     model's GPU objects are gone from it.
+#include "ProcessStats.hpp"
 #include "HttpTestFixture.hpp"
 
 #include <fstream>
@@ -19,11 +20,8 @@ namespace {
 
 /// Resident memory of this process (the server runs in it) in MB, from /proc/self/status.
 double rssMb() {
-    std::ifstream in("/proc/self/status");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("VmRSS:", 0) == 0) return std::atof(line.c_str() + 6) / 1024.0;
-    return -1.0;
+    const long kb = test::residentKb();
+    return kb < 0 ? -1.0 : kb / 1024.0;
 }
 
 /// A 4096² pattern as PNG bytes: flat (128 = height 0) with a dome in the middle, so that it

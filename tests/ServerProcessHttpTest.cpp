@@ -2,6 +2,7 @@
 // $DERMIS_TEST_GL): every acknowledged edit survives kill -9 and a restart on the same data
 // directory; 8 concurrent clients mixing edits and renders for 2,000 requests get no 5xx other
 // than 503 back-pressure, and the server's memory stops growing.
+#include "ProcessStats.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
@@ -78,13 +79,7 @@ public:
         return std::string((std::istreambuf_iterator<char>(in)), {});
     }
     /// Resident memory of the process in kB (from /proc), −1 if unknown.
-    long rssKb() const {
-        std::ifstream in("/proc/" + std::to_string(pid_) + "/status");
-        std::string line;
-        while (std::getline(in, line))
-            if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
-        return -1;
-    }
+    long rssKb() const { return residentKb(pid_); }
 
 private:
     pid_t pid_ = -1;

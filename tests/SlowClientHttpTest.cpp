@@ -6,6 +6,7 @@
 // a 3 MB JSON body is 413 (not read, not 415); SIGTERM with 200 slow connections open exits
 // within 2 s. The time bounds are correctness bounds (before the fix: no answer for as long as
 // the slow clients go on), not benchmarks.
+#include "ProcessStats.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
@@ -90,13 +91,7 @@ public:
         }
         return -1;
     }
-    long rssKb() const {
-        std::ifstream in("/proc/" + std::to_string(pid_) + "/status");
-        std::string line;
-        while (std::getline(in, line))
-            if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
-        return -1;
-    }
+    long rssKb() const { return residentKb(pid_); }
 
 private:
     pid_t pid_ = -1;

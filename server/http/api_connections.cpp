@@ -46,6 +46,28 @@ int msUntil(Clock::time_point t) {
 
 /// A socket stream with a head deadline, a body budget and a progress timeout (see the file
 /// comment). Reads are buffered (httplib reads the head one byte at a time).
+/// The numeric address and port of a socket's other end (`peer`) or its own; empty and 0 when
+/// the socket has none (closed, not connected).
+void addressOf(int sock, bool peer, std::string& ip, int& port) {
+    sockaddr_storage a{};
+    socklen_t n = sizeof a;
+    ip.clear();
+    port = 0;
+    auto* sa = reinterpret_cast<sockaddr*>(&a);
+    if ((peer ? ::getpeername(sock, sa, &n) : ::getsockname(sock, sa, &n)) != 0) return;
+    char text[INET6_ADDRSTRLEN] = {};
+    if (a.ss_family == AF_INET) {
+        const auto* in = reinterpret_cast<const sockaddr_in*>(&a);
+        ::inet_ntop(AF_INET, &in->sin_addr, text, sizeof text);
+        port = ntohs(in->sin_port);
+    } else if (a.ss_family == AF_INET6) {
+        const auto* in = reinterpret_cast<const sockaddr_in6*>(&a);
+        ::inet_ntop(AF_INET6, &in->sin6_addr, text, sizeof text);
+        port = ntohs(in->sin6_port);
+    }
+    ip = text;
+}
+
 class GuardedStream final : public httplib::Stream {
 public:
     GuardedStream(int sock, std::string ip, int port, int stallSeconds)
@@ -124,22 +146,7 @@ public:
         port = port_;
     }
     void get_local_ip_and_port(std::string& ip, int& port) const override {
-        sockaddr_storage a{};
-        socklen_t n = sizeof a;
-        ip.clear();
-        port = 0;
-        if (::getsockname(sock_, reinterpret_cast<sockaddr*>(&a), &n) != 0) return;
-        char text[INET6_ADDRSTRLEN] = {};
-        if (a.ss_family == AF_INET) {
-            const auto* in = reinterpret_cast<const sockaddr_in*>(&a);
-            ::inet_ntop(AF_INET, &in->sin_addr, text, sizeof text);
-            port = ntohs(in->sin_port);
-        } else if (a.ss_family == AF_INET6) {
-            const auto* in = reinterpret_cast<const sockaddr_in6*>(&a);
-            ::inet_ntop(AF_INET6, &in->sin6_addr, text, sizeof text);
-            port = ntohs(in->sin6_port);
-        }
-        ip = text;
+        addressOf(sock_, false, ip, port);
     }
     socket_t socket() const override { return sock_; }
 
@@ -159,24 +166,7 @@ private:
 thread_local GuardedStream* tCurrent = nullptr; ///< the stream of this thread's connection
 thread_local bool tRefuse = false;              ///< set while Threads runs a task inline: refuse
 
-void peerOf(int sock, std::string& ip, int& port) {
-    sockaddr_storage a{};
-    socklen_t n = sizeof a;
-    ip.clear();
-    port = 0;
-    if (::getpeername(sock, reinterpret_cast<sockaddr*>(&a), &n) != 0) return;
-    char text[INET6_ADDRSTRLEN] = {};
-    if (a.ss_family == AF_INET) {
-        const auto* in = reinterpret_cast<const sockaddr_in*>(&a);
-        ::inet_ntop(AF_INET, &in->sin_addr, text, sizeof text);
-        port = ntohs(in->sin_port);
-    } else if (a.ss_family == AF_INET6) {
-        const auto* in = reinterpret_cast<const sockaddr_in6*>(&a);
-        ::inet_ntop(AF_INET6, &in->sin6_addr, text, sizeof text);
-        port = ntohs(in->sin6_port);
-    }
-    ip = text;
-}
+void peerOf(int sock, std::string& ip, int& port) { addressOf(sock, true, ip, port); }
 
 /// Answers 503 without waiting (the socket is new: its send buffer is empty) and closes.
 void refuse(int sock) {
