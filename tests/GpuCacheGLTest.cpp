@@ -28,6 +28,14 @@ namespace {
 const std::string kCesium = std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb";
 
 /// Resident memory of this process in MB, from /proc/self/statm (pages).
+/// How much the resident memory may grow over 20 cycles: 100 MB (issue #12), plus, under
+/// AddressSanitizer, the 256 MB its quarantine keeps of freed memory (a leak of 19 × 64 MB still fails).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kRssGrowthMb = 100.0 + 256.0;
+#else
+constexpr double kRssGrowthMb = 100.0;
+#endif
+
 double rssMb() {
     std::ifstream in("/proc/self/statm");
     long size = 0, resident = 0;
@@ -94,7 +102,7 @@ TEST(GpuCacheGLTest, ByteBudgetBoundsPatternTextures) {
     const double after = rssMb();
     std::cout << "[ rss ] before " << before << " MB, after 19 more passes " << after
               << " MB, peak " << peak << " MB\n";
-    EXPECT_LT(after - before, 100.0) << "resident memory grew by " << after - before << " MB";
+    EXPECT_LT(after - before, kRssGrowthMb) << "resident memory grew by " << after - before << " MB";
     EXPECT_EQ(gl->cacheStats()->evictions, 19u);
 }
 
@@ -118,7 +126,7 @@ TEST(GpuCacheGLTest, ForgottenPatternsAreFreedAtOnce) {
     }
     const double after = rssMb();
     std::cout << "[ rss ] before " << before << " MB, after 19 more passes " << after << " MB\n";
-    EXPECT_LT(after - before, 100.0) << "resident memory grew by " << after - before << " MB";
+    EXPECT_LT(after - before, kRssGrowthMb) << "resident memory grew by " << after - before << " MB";
     EXPECT_EQ(gl->cacheStats()->forgotten, 20u);
     EXPECT_EQ(gl->cacheStats()->evictions, 0u);
     gl->forgetPattern(12345); // unknown: nothing happens

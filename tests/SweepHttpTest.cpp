@@ -146,8 +146,9 @@ TEST_F(SweepHttpTest, ClipSweepMatchesActivation) {
     // With a placement, each step's t names only it; the sheet renders with the clip.
     Reply one = h.get(s + "/sweep?clip=elbow_curl&placement=elbow_l&steps=3&format=json");
     ASSERT_EQ(one.status, 200) << one;
-    EXPECT_EQ(one.js()["placement"], "elbow_l");
-    for (const json& step : one.js()["steps"])
+    const json oneDoc = one.js();
+    EXPECT_EQ(oneDoc["placement"], "elbow_l");
+    for (const json& step : oneDoc["steps"])
         EXPECT_EQ(step["t"].size(), 1u) << step;
     Reply png = h.get(s + "/sweep?clip=elbow_curl&steps=4&size=48&msaa=1");
     ASSERT_EQ(png.status, 200) << png;
