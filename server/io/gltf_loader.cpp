@@ -20,6 +20,7 @@
 // model's folder: absolute URIs, "..", and symbolic links out of the folder are refused, and a
 // model parsed from memory without a folder may not reference files at all.
 #define TINYGLTF_IMPLEMENTATION // in this unit only; the configuration is in gltf_internal.hpp
+#include "core/preview.hpp"
 #include "gltf_internal.hpp"    // first: it includes <tiny_gltf.h>
 
 #include "gltf_loader.hpp"
@@ -349,40 +350,6 @@ Result<ParsedGltf> parseIn(const std::vector<std::uint8_t>& bytes, Sandbox sandb
     }
 }
 
-/// `image` shrunk (box filter: each output pixel averages the input pixels it covers) so that
-/// neither side exceeds `side`, aspect kept (each side at least 1).
-Image8 downscaleToFit(const Image8& image, int side) {
-    const double scale = double(side) / double(std::max(image.width, image.height));
-    Image8 out;
-    out.width = std::clamp(static_cast<int>(std::lround(image.width * scale)), 1, side);
-    out.height = std::clamp(static_cast<int>(std::lround(image.height * scale)), 1, side);
-    out.rgba.assign(static_cast<std::size_t>(out.width) * out.height * 4, 0);
-    auto span = [](int d, int outSide, int inSide) {
-        const int a = static_cast<int>(std::int64_t(d) * inSide / outSide);
-        const int b = static_cast<int>(std::int64_t(d + 1) * inSide / outSide);
-        return std::pair<int, int>(a, std::max(b, a + 1));
-    };
-    for (int y = 0; y < out.height; ++y) {
-        const auto [y0, y1] = span(y, out.height, image.height);
-        for (int x = 0; x < out.width; ++x) {
-            const auto [x0, x1] = span(x, out.width, image.width);
-            std::uint64_t sum[4] = {0, 0, 0, 0};
-            for (int sy = y0; sy < y1; ++sy)
-                for (int sx = x0; sx < x1; ++sx) {
-                    const std::uint8_t* p =
-                        &image.rgba[(static_cast<std::size_t>(sy) * image.width + sx) * 4];
-                    for (int c = 0; c < 4; ++c)
-                        sum[c] += p[c];
-                }
-            const std::uint64_t n = std::uint64_t(y1 - y0) * std::uint64_t(x1 - x0);
-            std::uint8_t* d = &out.rgba[(static_cast<std::size_t>(y) * out.width + x) * 4];
-            for (int c = 0; c < 4; ++c)
-                d[c] = static_cast<std::uint8_t>((sum[c] + n / 2) / n);
-        }
-    }
-    return out;
-}
-
 } // namespace
 
 Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir,
@@ -416,7 +383,7 @@ Status loadGltfResources(ParsedGltf& parsed, const GltfLimits& limits) {
                              "dermis::loadGltfResources", field,
                              "cannot decode (" + e.mimeType + "): " + image.error().message);
         if (image->width > limits.maxImageSide || image->height > limits.maxImageSide)
-            *image = downscaleToFit(*image, std::max(1, limits.maxImageSide));
+            *image = downsizeImage(*image, std::max(1, limits.maxImageSide));
         parsed.model.images[static_cast<std::size_t>(e.imageIndex)] = std::move(*image);
     }
     parsed.images.entries.clear();
