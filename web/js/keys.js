@@ -26,6 +26,7 @@ export const SHORTCUTS = [
   ["S", "solo in the 3D view"],
   ["P", "place tool: click the model in 3D to add a placement there"],
   ["Tab", "switch texture / 3D (in the views)"],
+  ["T / V / L", "go to the texture view / the 3D view / the placements list"],
   ["Space", "play / pause the clip"],
   ["Ctrl+Z / Ctrl+Shift+Z", "undo / redo (server reverts)"],
   ["Esc", "cancel a drag; clear the selection"],
@@ -87,6 +88,9 @@ function onKey(e, { dlg, fitTexture }) {
   else if ((k === "h" || k === "H") && sel.length) toggleEnabled(sel);
   else if ((k === "s" || k === "S") && sel.length) toggleSolo(sel);
   else if (k === "p" || k === "P") setPlaceTool(!placeToolOn());
+  else if (k === "t" || k === "T") focusView("texture");
+  else if (k === "v" || k === "V") focusView("3d");
+  else if (k === "l" || k === "L") document.querySelector('#placementList button[tabindex="0"]')?.focus();
   else if (k === " " && !(document.activeElement && document.activeElement.tagName === "BUTTON")) togglePlay();
   else if (k === "0") fitTexture();
   else handled = false;
@@ -112,6 +116,15 @@ export function switchView() {
   set({ layoutMode: next });
   ws.dataset.layout = next;
   (next === "texture" ? document.getElementById("uv") : document.getElementById("frameStage")).focus();
+}
+
+/// Focuses the texture view ("texture") or the 3D view ("3d"), showing it if the layout hides it.
+function focusView(which) {
+  if (store.layoutMode !== "both" && store.layoutMode !== which) {
+    set({ layoutMode: which });
+    document.querySelector(".workspace").dataset.layout = which;
+  }
+  document.getElementById(which === "texture" ? "uv" : "frameStage").focus();
 }
 
 function selectNext(dir) {

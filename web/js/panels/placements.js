@@ -1,7 +1,8 @@
 // Placements panel: one row per placement — pattern thumbnail, label (or id), lint badge, enabled
 // toggle (H), solo (S) — in document order; drag a row to reorder (PUT of the document with the
-// new order); click selects in both views (Shift adds). Rows are buttons: Tab reaches them, Enter
-// selects, Alt+↑/↓ moves the selection in the list.
+// new order); click selects in both views (Shift adds). The list is one tab stop (roving focus, on
+// the selected row): ↑/↓, Home and End move to a row and select it, Alt+↑/↓ moves the row in the
+// document; H and S toggle the focused selection as everywhere.
 
 import { store, on, set, whenIdle } from "../store.js";
 import { patternImagePath } from "../images.js";
@@ -12,9 +13,10 @@ let list, count;
 
 export function initPlacements(section) {
   section.innerHTML = `<h2>Placements <span class="badge" id="placementCount">0</span></h2>
-    <ul class="list" id="placementList" aria-label="placements"></ul>`;
+    <ul class="list" id="placementList" aria-label="placements" data-roving></ul>`;
   list = section.querySelector("#placementList");
   count = section.querySelector("#placementCount");
+  list.addEventListener("keydown", onListKey);
   on("selection lint solo", render);
   on("doc", () => whenIdle("placements", render, 0)); // not on every step of a drag
 }
@@ -46,8 +48,23 @@ export async function reorder(id, beforeId) {
   await putScene({ ...store.doc, placements: ps });
 }
 
+/// ↑/↓, Home and End on a row: the row before/after (first/last) is selected and focused.
+function onListKey(e) {
+  if (e.altKey || e.ctrlKey || e.metaKey || e.shiftKey) return;
+  const rows = [...list.querySelectorAll("li")];
+  const i = rows.findIndex((li) => li.contains(document.activeElement));
+  const j = i < 0 ? undefined : { ArrowUp: i - 1, ArrowDown: i + 1, Home: 0, End: rows.length - 1 }[e.key];
+  if (j === undefined) return;
+  e.preventDefault();
+  e.stopPropagation(); // arrows here walk the list instead of nudging the selection
+  const id = rows[Math.min(rows.length - 1, Math.max(0, j))].dataset.placement;
+  set({ selection: [id] });
+  list.querySelector(`li[data-placement="${CSS.escape(id)}"] .name`)?.focus();
+}
+
 function render() {
   if (!store.doc) return;
+  const hadFocus = list.contains(document.activeElement);
   const lintCount = new Map();
   for (const f of store.lint) if (f.placement) lintCount.set(f.placement, (lintCount.get(f.placement) || 0) + 1);
   count.textContent = String(store.doc.placements.length);
@@ -96,6 +113,12 @@ function render() {
     });
     list.append(li);
   }
+  // One tab stop: the (first) selected row's name, else the first row's; the toggles are reached
+  // by H and S (their buttons stay clickable and labelled).
+  const stop = (list.querySelector("li.selected") || list.querySelector("li"));
+  for (const b of list.querySelectorAll("button")) b.tabIndex = -1;
+  if (stop) stop.querySelector(".name").tabIndex = 0;
+  if (hadFocus && stop) stop.querySelector(".name").focus();
   const sel = list.querySelector("li.selected");
   if (sel) sel.scrollIntoView({ block: "nearest" });
 }
