@@ -65,6 +65,10 @@ function draw() {
     return;
   }
   const ids = store.doc.placements.map((p) => p.id).filter((id) => data.placements[id]);
+  // Lanes of 12 px (labels readable at 11 px): the strip grows with the placements up to 200 px,
+  // then lanes shrink. Setting the height redraws through the ResizeObserver.
+  const wantH = Math.round(Math.min(200, Math.max(110, 12 + ids.length * 12)));
+  if (Math.abs(wantH - H) > 1) { canvas.style.height = `${wantH}px`; return; }
   const lw = labelW(W), lane = Math.max(3, (H - 12) / Math.max(ids.length, 1));
   const n = data.times.length;
   const X = (i) => lw + (i / Math.max(n - 1, 1)) * (W - lw);
@@ -78,9 +82,11 @@ function draw() {
       g.fillRect(X(i), y, (W - lw) / n + 1, lane - 1);
     }
     if (lane >= 6) {
-      g.font = `${Math.min(10, Math.floor(lane))}px system-ui, sans-serif`;
-      g.fillStyle = selected ? "#ffb454" : "#8d99a8";
-      g.fillText(id, 4, y + Math.min(lane - 1, 9));
+      g.font = `${Math.min(11, Math.floor(lane - 1))}px system-ui, sans-serif`;
+      g.fillStyle = selected ? "#ffb454" : "#b8c2cf";
+      g.textBaseline = "middle";
+      g.fillText(id, 4, y + (lane - 1) / 2, lw - 10);
+      g.textBaseline = "alphabetic";
     }
   });
   for (const f of data.flags) {
