@@ -29,9 +29,10 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # npm packages of the tests (pinned by package-lock.json), installed once per lock change:
-# the Khronos glTF validator and playwright-core (drives Debian's Chromium in the editor tests).
+# the Khronos glTF validator, playwright-core (drives Debian's Chromium in the editor tests), ajv
+# (OpenAPI) and kubernetes-models (the farm's Kubernetes manifests).
 here="$(cd "$(dirname "$0")/.." && pwd)"
-for dir in "$here/tests/gltf-validator" "$here/tests/web" "$here/tests/openapi"; do
+for dir in "$here/tests/gltf-validator" "$here/tests/web" "$here/tests/openapi" "$here/tests/k8s"; do
   if [ -f "$dir/package-lock.json" ] &&
      { [ ! -d "$dir/node_modules" ] ||
        [ "$dir/package-lock.json" -nt "$dir/node_modules/.package-lock.json" ]; }; then
