@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <map>
 #include <set>
 #include <string>
@@ -98,4 +99,18 @@ TEST(FrameRangeTest, BadShardsNameTheOptionAndTheVariable) {
     auto garbage = dermis::parseShard("auto/4", envOf({{"JOB_COMPLETION_INDEX", "x1"}}));
     ASSERT_FALSE(garbage.ok());
     EXPECT_NE(garbage.error().message.find("JOB_COMPLETION_INDEX"), std::string::npos);
+}
+
+TEST(FrameRangeTest, FramePathsLikePrintf) {
+    for (const char* pattern : {"out/frame_%04d.png", "f%d.jpg", "f%6d.png", "x_%012d"}) {
+        for (int k : {0, 7, 123, 99999}) {
+            char expected[256];
+            std::snprintf(expected, sizeof expected, pattern, k);
+            EXPECT_EQ(dermis::framePath(pattern, k), expected) << pattern << " " << k;
+        }
+    }
+    EXPECT_EQ(dermis::framePath("still.png", 3), "still.png");
+    EXPECT_FALSE(dermis::hasFrameField("still.png"));
+    EXPECT_FALSE(dermis::hasFrameField("100%.png"));
+    EXPECT_TRUE(dermis::hasFrameField("f_%04d.png"));
 }

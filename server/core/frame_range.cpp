@@ -97,4 +97,36 @@ std::vector<int> shardFrames(const FrameRange& range, const Shard& shard) {
     return frames;
 }
 
+namespace {
+
+/// The first "%[0][width]d" in `s`: its position and length (npos when there is none).
+std::pair<std::size_t, std::size_t> findFrameField(const std::string& s) {
+    for (std::size_t i = s.find('%'); i != std::string::npos; i = s.find('%', i + 1)) {
+        std::size_t j = i + 1;
+        while (j < s.size() && j - i <= 3 && s[j] >= '0' && s[j] <= '9') ++j;
+        if (j < s.size() && s[j] == 'd') return {i, j + 1 - i};
+    }
+    return {std::string::npos, 0};
+}
+
+} // namespace
+
+bool hasFrameField(const std::string& pattern) {
+    return findFrameField(pattern).first != std::string::npos;
+}
+
+std::string framePath(const std::string& pattern, int index) {
+    const auto [at, length] = findFrameField(pattern);
+    if (at == std::string::npos) return pattern;
+    const std::string spec = pattern.substr(at + 1, length - 2); // between '%' and 'd'
+    const bool zeros = !spec.empty() && spec[0] == '0';
+    const std::size_t width = spec.empty() ? 0 : static_cast<std::size_t>(std::stoi(spec));
+    std::string digits = std::to_string(index < 0 ? -static_cast<long long>(index) : index);
+    const std::size_t signWidth = index < 0 ? 1 : 0;
+    if (digits.size() + signWidth < width)
+        digits.insert(0, width - digits.size() - signWidth, zeros ? '0' : ' ');
+    if (index < 0) digits.insert(zeros ? 0 : digits.find_first_not_of(' '), 1, '-');
+    return pattern.substr(0, at) + digits + pattern.substr(at + length);
+}
+
 } // namespace dermis

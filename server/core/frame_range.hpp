@@ -53,4 +53,11 @@ Result<Shard> parseShard(std::string_view spec, const EnvLookup& env,
 /// The frame numbers of `range` that `shard` renders, ascending: k with k mod N = I.
 std::vector<int> shardFrames(const FrameRange& range, const Shard& shard);
 
+/// `pattern` with its first printf-style integer field (%d, %4d, %04d) replaced by `index`
+/// ("out/frame_%04d.png", 7 → "out/frame_0007.png"); `pattern` unchanged when it has none.
+std::string framePath(const std::string& pattern, int index);
+
+/// True when `pattern` has a field framePath replaces.
+bool hasFrameField(const std::string& pattern);
+
 } // namespace dermis
