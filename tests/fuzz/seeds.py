@@ -5,9 +5,11 @@ Usage: seeds.py SOURCE_DIR SHARED_MODELS_DIR OUT
 
   gltf_fuzz:  every .glb / .gltf under SHARED_MODELS_DIR and SOURCE_DIR/models; each .glb also as
               a .gltf (JSON): with its binary chunk as a base64 data URI when the file is at most
-              1 MB, else the JSON alone (its buffer then has no data: an error case, still a seed).
+              1 MB, else the JSON alone (its buffer then has no data: an error case, still a seed);
+              GLBs up to 256 KB without textures also with a tiny PNG base-colour texture added.
   image_fuzz: SOURCE_DIR/patterns/*.png, the images embedded in those glTF files (PNG and JPEG
-              textures), and tiny hand-made BMP and TGA images.
+              textures), tiny PNGs (grey 8/16-bit, grey+alpha, RGB, RGBA) and tiny BMP and TGA
+              images made here.
   scene_fuzz: SOURCE_DIR/examples/*.json and SOURCE_DIR/models/*.scene.json.
 Plus tests/fuzz/regressions/<target>/* (inputs that once found a bug) for each target.
 
@@ -21,6 +23,7 @@ import json
 import os
 import struct
 import sys
+import zlib
 
 
 def put(out, target, data):
@@ -55,6 +58,10 @@ def gltf_seeds(out, paths):
         if not parts:
             continue
         doc, binary = parts
+        # Small models without a texture: also with a tiny PNG one (the decode and downscale path).
+        if len(data) <= (256 << 10) and not doc.get("images") and doc.get("buffers"):
+            for image in tiny_pngs()[2:]:
+                put(out, "gltf_fuzz", textured_glb(doc, binary, image))
         # Embedded images: image seeds.
         for image in doc.get("images", []):
             view = image.get("bufferView")
@@ -71,7 +78,55 @@ def gltf_seeds(out, paths):
         put(out, "gltf_fuzz", json.dumps(doc).encode("utf-8"))
 
 
+def png(width, height, depth, colour, pixels):
+    """A PNG of raw scanline bytes `pixels` (filter byte 0 added per row)."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    row = len(pixels) // height
+    raw = b"".join(b"\x00" + pixels[r * row : (r + 1) * row] for r in range(height))
+    ihdr = struct.pack(">IIBBBBB", width, height, depth, colour, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+
+
+def tiny_pngs():
+    """Small PNGs of the kinds patterns and textures come in: grey 8/16-bit, grey+alpha, RGB, RGBA."""
+    n = 8
+    ramp = bytes((x * 32 + y * 4) & 0xFF for y in range(n) for x in range(n))
+    return [
+        png(n, n, 8, 0, ramp),
+        png(n, n, 16, 0, b"".join(struct.pack(">H", v * 257) for v in ramp)),
+        png(n, n, 8, 4, b"".join(bytes([v, 255 - v]) for v in ramp)),
+        png(n, n, 8, 2, b"".join(bytes([v, 128, 255 - v]) for v in ramp)),
+        png(n, n, 8, 6, b"".join(bytes([v, 128, 255 - v, 200]) for v in ramp)),
+    ]
+
+
+def textured_glb(doc, binary, image):
+    """`doc`/`binary` of a GLB with `image` (PNG bytes) added as the first material's base-colour
+    texture (a material is added when there is none), as GLB bytes."""
+    doc = json.loads(json.dumps(doc))
+    pad = (-len(binary)) % 4
+    offset = len(binary) + pad
+    binary = binary + b"\x00" * pad + image + b"\x00" * ((-len(image)) % 4)
+    doc["buffers"][0]["byteLength"] = len(binary)
+    doc.setdefault("bufferViews", []).append({"buffer": 0, "byteOffset": offset, "byteLength": len(image)})
+    doc["images"] = [{"bufferView": len(doc["bufferViews"]) - 1, "mimeType": "image/png"}]
+    doc["textures"] = [{"source": 0}]
+    if not doc.get("materials"):
+        doc["materials"] = [{}]
+        for mesh in doc.get("meshes", []):
+            for prim in mesh.get("primitives", []):
+                prim["material"] = 0
+    doc["materials"][0].setdefault("pbrMetallicRoughness", {})["baseColorTexture"] = {"index": 0}
+    text = json.dumps(doc).encode("utf-8")
+    text += b" " * ((-len(text)) % 4)
+    body = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
+    return b"glTF" + struct.pack("<II", 2, 12 + len(body)) + body
+
+
 def tiny_images(out):
+    for image in tiny_pngs():
+        put(out, "image_fuzz", image)
     # 2×2 24-bit BMP (rows padded to 4 bytes).
     rows = (b"\x00\x80\xff" * 2 + b"\x00\x00") * 2
     bmp = b"BM" + struct.pack("<IHHI", 54 + len(rows), 0, 0, 54)
