@@ -8,11 +8,14 @@
 // limits, and with the server's defaults (10⁶ triangles, 256 MB of texture) that is slow and
 // can pass libFuzzer's -rss_limit_mb without any bug. What counts as a bug: a crash, a sanitizer
 // report (memory, UB, leak), or a hang; an Error return is the expected answer to bad bytes.
-// Built only with -DDERMIS_FUZZ=ON (tests/fuzz/CMakeLists.txt); run with `make fuzz`.
+// Built only with -DDERMIS_FUZZ=ON (tests/fuzz/CMakeLists.txt); run with `make fuzz`. With
+// DERMIS_FUZZ_VERBOSE set, each input's outcome is printed (to check what a seed reaches).
 #include "io/gltf_loader.hpp"
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -29,11 +32,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     limits.maxTextureBytes = std::size_t(32) << 20;
 
     const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
-    const std::string main = binary ? "m.glb" : "m.gltf";
+    const std::string mainFile = binary ? "m.glb" : "m.gltf";
     dermis::GltfFiles files;
-    files[main] = std::vector<std::uint8_t>(data, data + size);
+    files[mainFile] = std::vector<std::uint8_t>(data, data + size);
     files["b.bin"] = companion;
-    auto model = dermis::loadGltfFromFiles(files, main, limits);
+    auto model = dermis::loadGltfFromFiles(files, mainFile, limits);
+    static const bool verbose = std::getenv("DERMIS_FUZZ_VERBOSE") != nullptr;
+    if (verbose)
+        std::fprintf(stderr, "gltf_fuzz: %s\n",
+                     model ? ("loaded, " + std::to_string(model->parts.size()) + " parts, " +
+                              std::to_string(model->images.size()) + " images")
+                                 .c_str()
+                           : model.error().message.c_str());
     if (model) {
         // A loaded model honours the limits it was loaded with.
         for (const auto& img : model->images)

@@ -6,7 +6,8 @@ Usage: seeds.py SOURCE_DIR SHARED_MODELS_DIR OUT
   gltf_fuzz:  every .glb / .gltf under SHARED_MODELS_DIR and SOURCE_DIR/models; each .glb also as
               a .gltf (JSON): with its binary chunk as a base64 data URI when the file is at most
               1 MB, else the JSON alone (its buffer then has no data: an error case, still a seed);
-              GLBs up to 256 KB without textures also with a tiny PNG base-colour texture added.
+              GLBs up to 256 KB without textures also with a tiny PNG base-colour texture added;
+              three small hand-made .gltf documents (minimal_gltfs).
   image_fuzz: SOURCE_DIR/patterns/*.png, the images embedded in those glTF files (PNG and JPEG
               textures), tiny PNGs (grey 8/16-bit, grey+alpha, RGB, RGBA) and tiny BMP and TGA
               images made here.
@@ -124,6 +125,53 @@ def textured_glb(doc, binary, image):
     return b"glTF" + struct.pack("<II", 2, 12 + len(body)) + body
 
 
+def minimal_gltfs():
+    """Small hand-made .gltf documents (fast to mutate): a triangle with its buffer as a data URI,
+    the same reading gltf_fuzz's companion file "b.bin" (1 KiB of counting bytes) as indices,
+    positions and a two-key animation, and a two-joint skinned triangle."""
+    pos = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+    base = {
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,"
+                     + base64.b64encode(pos).decode("ascii")}],
+    }
+    external = json.loads(json.dumps(base))
+    external["buffers"] = [{"byteLength": 1024, "uri": "b.bin"}]
+    external["bufferViews"] = [{"buffer": 0, "byteOffset": 0, "byteLength": 3},
+                               {"buffer": 0, "byteOffset": 8, "byteLength": 36}]
+    external["accessors"] = [{"bufferView": 1, "componentType": 5121, "count": 3, "type": "VEC3",
+                              "normalized": True},
+                             {"bufferView": 0, "componentType": 5121, "count": 3, "type": "SCALAR"},
+                             {"bufferView": 1, "componentType": 5126, "count": 2, "type": "SCALAR"},
+                             {"bufferView": 1, "componentType": 5126, "count": 2, "type": "VEC3"}]
+    external["meshes"][0]["primitives"][0] = {"attributes": {"POSITION": 0}, "indices": 1}
+    external["extensionsUsed"] = ["KHR_mesh_quantization"]
+    external["animations"] = [{"channels": [{"sampler": 0, "target": {"node": 0, "path": "translation"}}],
+                               "samplers": [{"input": 2, "output": 3, "interpolation": "STEP"}]}]
+    skinned = json.loads(json.dumps(base))
+    data = pos + struct.pack("<12B", 0, 1, 0, 0, 0, 1, 0, 0, 1, 0, 0, 0)
+    data += struct.pack("<12f", 1, 0, 0, 0, 0.5, 0.5, 0, 0, 0, 1, 0, 0)
+    skinned["buffers"] = [{"byteLength": len(data), "uri": "data:application/octet-stream;base64,"
+                           + base64.b64encode(data).decode("ascii")}]
+    skinned["bufferViews"] = [{"buffer": 0, "byteLength": 36},
+                              {"buffer": 0, "byteOffset": 36, "byteLength": 12},
+                              {"buffer": 0, "byteOffset": 48, "byteLength": 48}]
+    skinned["accessors"] += [{"bufferView": 1, "componentType": 5121, "count": 3, "type": "VEC4"},
+                             {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC4"}]
+    skinned["meshes"][0]["primitives"][0]["attributes"].update({"JOINTS_0": 1, "WEIGHTS_0": 2})
+    skinned["nodes"] = [{"mesh": 0, "skin": 0}, {"children": [2], "translation": [0, 1, 0]},
+                        {"rotation": [0, 0, 0.7071068, 0.7071068]}]
+    skinned["scenes"] = [{"nodes": [0, 1]}]
+    skinned["skins"] = [{"joints": [1, 2]}]
+    return [json.dumps(d).encode("utf-8") for d in (base, external, skinned)]
+
+
 def tiny_images(out):
     for image in tiny_pngs():
         put(out, "image_fuzz", image)
@@ -147,6 +195,8 @@ def main():
         + glob.glob(os.path.join(source, "models", "*.glb"))
     )
     gltf_seeds(out, models)
+    for doc in minimal_gltfs():
+        put(out, "gltf_fuzz", doc)
     for png in sorted(glob.glob(os.path.join(source, "patterns", "*.png"))):
         with open(png, "rb") as f:
             put(out, "image_fuzz", f.read())
