@@ -402,12 +402,12 @@ TEST(ConnectionLimitsHttpTest, HeadTimeoutClosesATricklingHead) {
     EXPECT_TRUE(got.empty() || got.rfind("HTTP/1.1 408", 0) == 0) << got;
 }
 
-/// `n` connections, 50 ms apart (so that the server admits them in this order).
+/// `n` connections, 100 ms apart (so that the server admits them in this order).
 std::vector<int> openConnections(int port, int n) {
     std::vector<int> socks;
     for (int i = 0; i < n; ++i) {
         if (const int s = connectTo(port); s >= 0) socks.push_back(s);
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
     return socks;
 }
@@ -422,7 +422,7 @@ TEST(ConnectionLimitsHttpTest, PerAddressCapRefusesAFifthWhileFourAreBusy) {
     for (int s : busy)
         ASSERT_TRUE(sendAll(s, "POST /api/v1/scenes HTTP/1.1\r\nHost: t\r\nContent-Type: "
                                "application/json\r\nContent-Length: 100\r\n\r\n{\"model\": "));
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::this_thread::sleep_for(std::chrono::seconds(1)); // every head is read: four busy
 
     const int fifth = connectTo(server.port());
     ASSERT_GE(fifth, 0);
@@ -435,7 +435,7 @@ TEST(ConnectionLimitsHttpTest, PerAddressCapRefusesAFifthWhileFourAreBusy) {
     // One of the four goes: a new connection is answered.
     ::close(busy[0]);
     busy.erase(busy.begin());
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::this_thread::sleep_for(std::chrono::seconds(1));
     auto [status, took] = timedHealth(server.port());
     EXPECT_EQ(status, 200);
     EXPECT_LT(took, 1.0);
@@ -449,7 +449,7 @@ TEST(ConnectionLimitsHttpTest, PerAddressCapClosesTheOldestIdleConnection) {
     // Four idle connections (nothing sent yet): a fifth is answered, the oldest idle one goes.
     std::vector<int> idle = openConnections(server.port(), 4);
     ASSERT_EQ(idle.size(), 4u);
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
     auto [status, took] = timedHealth(server.port());
     EXPECT_EQ(status, 200);
     EXPECT_LT(took, 1.0);
