@@ -1,10 +1,12 @@
 # Dermis — convenience entry points. Everything goes through CMake; see README.md.
 BUILD ?= build
 ASAN_BUILD ?= build-asan
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 60
 JOBS ?= 2
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-asan run offline bench loadbench authorbench patterns character clean format
+.PHONY: all deps build test test-asan fuzz run offline bench loadbench authorbench patterns character clean format
 
 all: build
 
@@ -29,6 +31,15 @@ test-asan: deps
 	# GL suites: memory errors are checked, leaks are not — Mesa's OSMesa leaves allocations made
 	# from llvmpipe's JIT code (no module to suppress by) alive at exit.
 	cd $(ASAN_BUILD) && ASAN_OPTIONS=detect_leaks=0:suppressions=$(CURDIR)/tests/asan.supp UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS) -L gl
+
+# libFuzzer targets (tests/fuzz: glTF loader, image decoders, scene documents) under ASan + UBSan,
+# in a clang build tree of their own, FUZZ_SECONDS each; fails on any crash, leak or timeout
+# (inputs in $(FUZZ_BUILD)/artifacts). See README "Fuzzing".
+fuzz: deps
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DDERMIS_FUZZ=ON -DDERMIS_BUILD_TESTS=OFF -DDERMIS_BUILD_BENCHMARKS=OFF $(CMAKE_FLAGS)
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target dermis-fuzz
+	bash tests/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
 
 # Installs, builds and runs the product's main job: the HTTP render server on 127.0.0.1:8080
 # with the built-in character and pattern set (data in out/data; Ctrl-C stops it).
@@ -64,4 +75,4 @@ format:
 	clang-format -i $$(git ls-files '*.cpp' '*.hpp')
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) out
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) out

@@ -12,6 +12,7 @@ PKGS=(
   libcpp-httplib-dev nginx
   chromium
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-dev python3
 )
 missing=()
 for p in "${PKGS[@]}"; do

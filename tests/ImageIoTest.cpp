@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -255,4 +257,49 @@ TEST(ImageIoTest, OversizedPatternsAreRejected) {
     ASSERT_FALSE(img.ok());
     EXPECT_EQ(img.error().code, ErrorCode::InvalidArgument);
     EXPECT_NE(img.error().message.find("larger than the limit"), std::string::npos);
+}
+
+// Found by tests/fuzz/image_fuzz (kept in tests/fuzz/regressions/image_fuzz): a 58-byte GIF
+// whose screen is 65535² made OpenImageIO's GIF reader throw std::length_error out of
+// ImageInput::create, through readHeightImageFromMemory (a 500 for a pattern upload, a crash
+// for any caller without a handler). Bad bytes are an error, never an exception.
+TEST(ImageIoTest, CorruptGifIsAnErrorNotAnException) {
+    const std::vector<std::uint8_t> gif = {
+        0x47, 0x49, 0x46, 0x7e, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xe8, 0x32, 0x00, 0x00, 0x00,
+        0x3d, 0x28, 0x00, 0x00, 0x74, 0x67, 0x61, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00, 0x01, 0x00,
+        0x18, 0x00, 0x00, 0x00, 0x00, 0x00, 0x10, 0x00, 0x00, 0x00, 0x13, 0x0b, 0x00, 0x00, 0xed,
+        0xf4, 0x00, 0x00, 0x00, 0x00, 0x00, 0x80, 0xff, 0x00, 0x80, 0xff, 0x00, 0x00};
+    Result<HeightImage> img = makeError(ErrorCode::Internal, "", "", "not run");
+    EXPECT_NO_THROW(img = readHeightImageFromMemory(gif));
+    ASSERT_FALSE(img.ok());
+    EXPECT_NE(img.error().code, ErrorCode::Internal);
+    Result<Image8> rgba = makeError(ErrorCode::Internal, "", "", "not run");
+    EXPECT_NO_THROW(rgba = decodeImage8(gif));
+    EXPECT_FALSE(rgba.ok());
+}
+
+// Also from image_fuzz: OpenImageIO decodes a GIF's whole screen in open(), so a 35-byte GIF
+// declaring a 16000² screen cost 1.3 GB and 2 s before the side limit refused it (20000²
+// here: past decodeImage8's limit too). The screen
+// size is now checked from the header first: refused, nothing allocated.
+TEST(ImageIoTest, GifScreenPastTheLimitIsRefusedFromItsHeader) {
+    std::vector<std::uint8_t> gif = {0x47, 0x49, 0x46, 0x38, 0x39, 0x61, 0x01, 0x00, 0x01,
+                                     0x00, 0x80, 0x00, 0x00, 0x00, 0x00, 0x00, 0xff, 0xff,
+                                     0xff, 0x2c, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x01,
+                                     0x00, 0x00, 0x02, 0x02, 0x44, 0x01, 0x00, 0x3b};
+    auto small = readHeightImageFromMemory(gif); // as made: 1×1, decodes
+    ASSERT_TRUE(small.ok()) << small.error().message;
+    EXPECT_EQ(small->width, 1);
+    gif[6] = gif[8] = 0x20, gif[7] = gif[9] = 0x4e; // 20000 × 20000
+    rusage before{}, after{};
+    ::getrusage(RUSAGE_SELF, &before);
+    auto big = readHeightImageFromMemory(gif);
+    auto bigRgba = decodeImage8(gif);
+    ::getrusage(RUSAGE_SELF, &after);
+    ASSERT_FALSE(big.ok());
+    EXPECT_EQ(big.error().code, ErrorCode::InvalidArgument);
+    EXPECT_NE(big.error().message.find("20000x20000"), std::string::npos) << big.error().message;
+    EXPECT_FALSE(bigRgba.ok());
+    const long grewMb = (after.ru_maxrss - before.ru_maxrss) / 1024;
+    EXPECT_LT(grewMb, 256) << "peak memory grew by " << grewMb << " MB for a 35-byte file";
 }

@@ -4,7 +4,12 @@
 // Content-Length of 10 GB is answered 413 at once; a chunked upload past --max-upload-mb is
 // answered 413 and closed before the client has sent it all (the server's memory stays small);
 // a 3 MB JSON body is 413 (not read, not 415); SIGTERM with 200 slow connections open exits
-// within 2 s. The time bounds are correctness bounds (before the fix: no answer for as long as
+// within 2 s. ConnectionLimitsHttpTest: each connection limit set by its `serve` option on a server
+// of its own — --head-timeout 1 closes a head trickling a byte every 300 ms after ~1 s while a
+// normal client is answered; --max-connections-per-address 4 refuses a fifth connection (503)
+// while four are busy, serves it when four are idle (the oldest idle one is closed), and serves
+// a new one once one of the four has gone; --timeout 2 resets a connection whose 64 MB answer is
+// never read. The time bounds are correctness bounds (before the fix: no answer for as long as
 // the slow clients go on), not benchmarks.
 #include "ProcessStats.hpp"
 #include "TestFiles.hpp"
@@ -25,7 +30,9 @@
 #include <chrono>
 #include <csignal>
 #include <fstream>
+#include <string>
 #include <thread>
+#include <vector>
 
 using namespace dermis::test;
 using Clock = std::chrono::steady_clock;
@@ -36,10 +43,11 @@ double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-/// A dermis-server child process on a free port (--max-upload-mb 2: JSON bodies up to 2 MB too).
+/// A dermis-server child process on a free port (--max-upload-mb 2: JSON bodies up to 2 MB too),
+/// with `extra` options after those.
 class Server {
 public:
-    explicit Server(const TempDir& dir) {
+    explicit Server(const TempDir& dir, std::vector<std::string> extra = {}) {
         const std::string log = dir / "server.log";
         const std::string data = dir / "data";
         pid_ = ::fork();
@@ -50,9 +58,14 @@ public:
             const char* gl = std::getenv("DERMIS_TEST_GL");
             const char* exe = std::getenv("DERMIS_TEST_SERVER_EXE"); // another build, to compare
             if (!exe || !*exe) exe = DERMIS_SERVER_EXE;
-            ::execl(exe, exe, "serve", "--port", "0", "--data",
-                    data.c_str(), "--gl", gl && *gl ? gl : "auto", "--max-upload-mb", "2",
-                    static_cast<char*>(nullptr));
+            std::vector<std::string> args = {exe, "serve", "--port", "0", "--data", data,
+                                             "--gl", gl && *gl ? gl : "auto",
+                                             "--max-upload-mb", "2"};
+            args.insert(args.end(), extra.begin(), extra.end());
+            std::vector<char*> argv;
+            for (std::string& a : args) argv.push_back(a.data());
+            argv.push_back(nullptr);
+            ::execv(exe, argv.data());
             ::_exit(127);
         }
         for (int i = 0; i < 1200 && port_ == 0 && pid_ > 0; ++i) {
@@ -338,6 +351,174 @@ TEST_F(SlowClientHttpTest, SigtermWithTwoHundredSlowHeadsExitsWithinTwoSeconds) 
     std::printf("[ measured ] SIGTERM with 200 slow heads open: exit after %.3f s\n", took);
     EXPECT_GE(took, 0.0) << "dermis-server did not exit within 10 s of SIGTERM";
     EXPECT_LT(took, 2.0);
+}
+
+// --- Connection limits set by `serve` options, each on a server of its own started with a small
+// value: --head-timeout, --max-connections-per-address, --timeout (the write timeout). With the
+// defaults (10 s, 256, 30 s) each of these tests fails: nothing is closed within its bounds.
+
+/// Sends `head` one byte every 300 ms while watching the connection; returns the seconds from
+/// `t0` until the server closed it or answered (408), or -1 when neither happened within `limit`.
+/// Meanwhile, once, a normal client must be answered 200 within 1 s.
+double trickleHead(int port, int s, Clock::time_point t0, double limit, std::string& got) {
+    const std::string head = "GET /api/v1/health HTTP/1.1\r\nHost: t\r\nX-Slow: " +
+                             std::string(64, 'a');
+    bool normalChecked = false;
+    for (std::size_t k = 0; secondsSince(t0) < limit; ++k) {
+        if (k < head.size()) (void)::send(s, &head[k], 1, MSG_NOSIGNAL | MSG_DONTWAIT);
+        pollfd p{s, POLLIN, 0};
+        if (::poll(&p, 1, 300) > 0) {
+            char buf[4096];
+            const ssize_t n = ::recv(s, buf, sizeof buf, 0);
+            if (n <= 0) return secondsSince(t0);
+            got.append(buf, static_cast<std::size_t>(n));
+            if (got.rfind("HTTP/1.1 408", 0) == 0) return secondsSince(t0);
+        }
+        if (!normalChecked && secondsSince(t0) > 0.3) {
+            normalChecked = true;
+            auto [status, took] = timedHealth(port);
+            EXPECT_EQ(status, 200) << "a normal client beside the trickling head";
+            EXPECT_LT(took, 1.0);
+        }
+    }
+    return -1;
+}
+
+TEST(ConnectionLimitsHttpTest, HeadTimeoutClosesATricklingHead) {
+    TempDir dir;
+    Server server(dir, {"--head-timeout", "1"});
+    ASSERT_GT(server.port(), 0) << "dermis-server did not start";
+    const auto t0 = Clock::now();
+    const int s = connectTo(server.port());
+    ASSERT_GE(s, 0);
+    std::string got;
+    const double closedAfter = trickleHead(server.port(), s, t0, 8.0, got);
+    ::close(s);
+    std::printf("[ measured ] --head-timeout 1, one head byte per 300 ms: closed after %.2f s\n",
+                closedAfter);
+    EXPECT_GE(closedAfter, 0.0) << "still open after 8 s; received: " << got;
+    EXPECT_LT(closedAfter, 5.0);
+    EXPECT_GT(closedAfter, 0.8) << "closed before its head deadline";
+    EXPECT_TRUE(got.empty() || got.rfind("HTTP/1.1 408", 0) == 0) << got;
+}
+
+/// `n` connections, 100 ms apart (so that the server admits them in this order).
+std::vector<int> openConnections(int port, int n) {
+    std::vector<int> socks;
+    for (int i = 0; i < n; ++i) {
+        if (const int s = connectTo(port); s >= 0) socks.push_back(s);
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    return socks;
+}
+
+TEST(ConnectionLimitsHttpTest, PerAddressCapRefusesAFifthWhileFourAreBusy) {
+    TempDir dir;
+    Server server(dir, {"--max-connections-per-address", "4"});
+    ASSERT_GT(server.port(), 0) << "dermis-server did not start";
+    // Four connections in the middle of a request: the head announced a body, half of it came.
+    std::vector<int> busy = openConnections(server.port(), 4);
+    ASSERT_EQ(busy.size(), 4u);
+    for (int s : busy)
+        ASSERT_TRUE(sendAll(s, "POST /api/v1/scenes HTTP/1.1\r\nHost: t\r\nContent-Type: "
+                               "application/json\r\nContent-Length: 100\r\n\r\n{\"model\": "));
+    std::this_thread::sleep_for(std::chrono::seconds(1)); // every head is read: four busy
+
+    const int fifth = connectTo(server.port());
+    ASSERT_GE(fifth, 0);
+    sendAll(fifth, "GET /api/v1/health HTTP/1.1\r\nHost: t\r\n\r\n");
+    const Answer refused = readAnswer(fifth, 3.0);
+    ::close(fifth);
+    EXPECT_EQ(refused.status, 503) << refused.text;
+    EXPECT_TRUE(refused.closed);
+
+    // One of the four goes: a new connection is answered.
+    ::close(busy[0]);
+    busy.erase(busy.begin());
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    auto [status, took] = timedHealth(server.port());
+    EXPECT_EQ(status, 200);
+    EXPECT_LT(took, 1.0);
+    for (int s : busy) ::close(s);
+}
+
+TEST(ConnectionLimitsHttpTest, PerAddressCapClosesTheOldestIdleConnection) {
+    TempDir dir;
+    Server server(dir, {"--max-connections-per-address", "4"});
+    ASSERT_GT(server.port(), 0) << "dermis-server did not start";
+    // Four idle connections (nothing sent yet): a fifth is answered, the oldest idle one goes.
+    std::vector<int> idle = openConnections(server.port(), 4);
+    ASSERT_EQ(idle.size(), 4u);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    auto [status, took] = timedHealth(server.port());
+    EXPECT_EQ(status, 200);
+    EXPECT_LT(took, 1.0);
+    const Answer oldest = readAnswer(idle[0], 2.0);
+    EXPECT_TRUE(oldest.closed) << "the oldest idle connection was not closed";
+    EXPECT_EQ(oldest.text, "");
+    for (std::size_t k = 1; k < idle.size(); ++k) {
+        pollfd p{idle[k], POLLIN, 0};
+        EXPECT_EQ(::poll(&p, 1, 0), 0) << "connection " << k << " was closed too";
+    }
+    // The survivors still work.
+    sendAll(idle[3], "GET /api/v1/health HTTP/1.1\r\nHost: t\r\nConnection: close\r\n\r\n");
+    EXPECT_EQ(readAnswer(idle[3], 3.0).status, 200);
+    for (int s : idle) ::close(s);
+}
+
+/// One request on a fresh connection ("Connection: close"), the whole answer.
+Answer request(int port, const std::string& method, const std::string& path,
+               const std::string& body = "") {
+    const int s = connectTo(port);
+    if (s < 0) return {};
+    sendAll(s, method + " " + path + " HTTP/1.1\r\nHost: t\r\nConnection: close\r\n" +
+                   (body.empty() ? std::string()
+                                 : "Content-Type: application/json\r\nContent-Length: " +
+                                       std::to_string(body.size()) + "\r\n") +
+                   "\r\n" + body);
+    Answer a = readAnswer(s, 60.0);
+    ::close(s);
+    return a;
+}
+
+TEST(ConnectionLimitsHttpTest, AnswerNeverReadIsDroppedAfterTheWriteTimeout) {
+    TempDir dir;
+    Server server(dir, {"--timeout", "2"});
+    ASSERT_GT(server.port(), 0) << "dermis-server did not start";
+    // A scene with a 4096² height map: its f32 bump map is 64 MB, far more than socket buffers.
+    const Answer created = request(server.port(), "POST", "/api/v1/scenes",
+                                   R"({"default_patterns": true, "heightmap": {"size": [4096, 4096]}})");
+    ASSERT_EQ(created.status, 201) << created.text;
+    const auto doc = nlohmann::json::parse(created.text.substr(created.text.find("\r\n\r\n") + 4));
+    const std::string id = doc.value("id", "");
+    ASSERT_FALSE(id.empty()) << created.text;
+
+    const int s = connectTo(server.port());
+    ASSERT_GE(s, 0);
+    const int small = 4096;
+    ::setsockopt(s, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);
+    sendAll(s, "GET /api/v1/scenes/" + id + "/heightmaps/bump?format=f32 HTTP/1.1\r\nHost: t\r\n\r\n");
+    // Read only until the head has come (the map is made), then stop reading.
+    const Answer head = readAnswer(s, 60.0, false);
+    ASSERT_EQ(head.status, 200) << head.text.substr(0, 300);
+    const auto lengthAt = head.text.find("Content-Length: ");
+    ASSERT_NE(lengthAt, std::string::npos) << head.text.substr(0, 300);
+    const std::size_t length = std::stoull(head.text.substr(lengthAt + 16));
+    EXPECT_EQ(length, std::size_t(4096) * 4096 * 4);
+    std::this_thread::sleep_for(std::chrono::seconds(5)); // 2 s of no progress, and a margin
+
+    // The server has given up: the connection is reset (what was still queued is dropped), so
+    // reading now ends at once, long before the answer's end. (With the default --timeout of
+    // 30 s the server would still be waiting, and all of it would come.)
+    const Answer rest = readAnswer(s, 5.0);
+    ::close(s);
+    const std::size_t bodyGot = head.text.size() - (head.text.find("\r\n\r\n") + 4) + rest.text.size();
+    std::printf("[ measured ] --timeout 2, a 64 MB answer never read: dropped after %zu of %zu bytes\n",
+                bodyGot, length);
+    EXPECT_TRUE(rest.closed);
+    EXPECT_LT(bodyGot, length) << "the whole answer came: the server never gave up";
+    // The server itself is fine.
+    EXPECT_EQ(timedHealth(server.port()).first, 200);
 }
 
 } // namespace

@@ -270,6 +270,7 @@ struct ServeArgs {
     dermis::ServerLimits limits;
     double maxUploadMb = 64;
     double gpuCacheMb = static_cast<double>(dermis::kDefaultGpuCacheBytes >> 20);
+    dermis::ApiOptions api; ///< connection limits (head deadline, per-address and total caps)
 };
 
 int runServe(ServeArgs a) {
@@ -303,7 +304,7 @@ int runServe(ServeArgs a) {
         if (!created) return fail(created.error());
     }
     const std::string firstScene = (*service)->listScenes()["scenes"][0]["id"].get<std::string>();
-    ApiOptions opt;
+    ApiOptions opt = a.api;
     opt.bind = a.bind;
     opt.port = a.port;
     opt.token = a.token;
@@ -355,7 +356,21 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
     app.add_option("--max-triangles", s.limits.maxTriangles, "Most triangles per model (after instancing)");
     app.add_option("--max-joints", s.limits.maxJoints, "Most joints per model");
     app.add_option("--queue", s.limits.queueLength, "Renders that may wait for the GL thread")->check(CLI::Range(1, 10000));
-    app.add_option("--timeout", s.limits.requestTimeoutSeconds, "Request read/write timeout (s)")->check(CLI::Range(1, 3600));
+    app.add_option("--timeout", s.limits.requestTimeoutSeconds,
+                   "Request read/write timeout (s): a body read or an answer written must make "
+                   "progress within it (a client that stops reading is dropped)")
+        ->check(CLI::Range(1, 3600));
+    app.add_option("--head-timeout", s.api.headSeconds,
+                   "Seconds a connection has to send a whole request head (line and headers); "
+                   "past it the connection is closed")
+        ->check(CLI::Range(1, 3600));
+    app.add_option("--max-connections-per-address", s.api.maxConnectionsPerAddress,
+                   "Connections open at once from one peer address; past it the address's oldest "
+                   "idle one is closed, or the new one answered 503 when none is idle")
+        ->check(CLI::Range(1, 65536));
+    app.add_option("--max-connections", s.api.maxConnections,
+                   "Connections open at once in all (one thread each); past it: 503, closed")
+        ->check(CLI::Range(1, 65536));
 }
 
 } // namespace

@@ -169,7 +169,7 @@ namespace {
 /// (Gram–Schmidt, so that a slightly skewed float matrix still gives a rotation).
 glm::dquat restWorldRotationD(const Model& model, int n) {
     const auto world = worldMatrices(model, restPose(model));
-    glm::dmat3 m(glm::dmat4(world[static_cast<std::size_t>(n)]));
+    glm::dmat3 m{glm::dmat4(world[static_cast<std::size_t>(n)])};
     m[0] = glm::normalize(m[0]);
     m[1] = glm::normalize(m[1] - glm::dot(m[1], m[0]) * m[0]);
     m[2] = glm::cross(m[0], m[1]) * (glm::dot(glm::cross(m[0], m[1]), m[2]) < 0 ? -1.0 : 1.0);

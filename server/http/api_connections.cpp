@@ -10,7 +10,9 @@
 //   * every body is counted while it streams (GuardedStream): past bodyLimit(req) the read fails,
 //     the answer is 413 and the connection is closed (Content-Length past it is refused before
 //     any of the body is read, in Api's pre-routing handler);
-//   * every read and write must make progress within Limits::stallSeconds;
+//   * every read and write must make progress within Limits::stallSeconds (serve --timeout); a
+//     connection whose answer could not be written for that long (the client stopped reading)
+//     is reset, which frees what the kernel still holds for it;
 //   * closeAll() (Api::stop) shuts every connection, so stopping never waits for a slow client.
 #include "http/api_internal.hpp"
 
@@ -20,6 +22,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstring>
 #include <thread>
 
@@ -136,10 +139,16 @@ public:
     }
 
     ssize_t write(const char* ptr, std::size_t size) override {
-        if (!waitFor(sock_, POLLOUT, stallMs_)) return -1;
+        if (!waitFor(sock_, POLLOUT, stallMs_)) {
+            writeStalled_ = true;
+            return -1;
+        }
         const ssize_t r = ::send(sock_, ptr, size, MSG_NOSIGNAL);
+        if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) writeStalled_ = true;
         return r < 0 ? -1 : r;
     }
+    /// An answer could not be written for stallSeconds: the client stopped reading.
+    bool writeStalled() const { return writeStalled_; }
 
     void get_remote_ip_and_port(std::string& ip, int& port) const override {
         ip = ip_;
@@ -161,6 +170,7 @@ private:
     Clock::time_point headDeadline_{};
     std::size_t bodyBudget_ = 0, bodyRead_ = 0;
     bool overLimit_ = false;
+    bool writeStalled_ = false;
 };
 
 thread_local GuardedStream* tCurrent = nullptr; ///< the stream of this thread's connection
@@ -330,7 +340,15 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
             dropped += static_cast<std::size_t>(r);
         }
     }
-    ::shutdown(sock, SHUT_RDWR);
+    if (strm.writeStalled()) {
+        // The client stopped reading: reset rather than close, so that the kernel drops what is
+        // still queued for it at once (a graceful close would keep up to the socket's send
+        // buffer, megabytes, in an orphaned socket probing a zero window for minutes).
+        const linger abort{1, 0};
+        ::setsockopt(sock, SOL_SOCKET, SO_LINGER, &abort, sizeof abort);
+    } else {
+        ::shutdown(sock, SHUT_RDWR);
+    }
     ::close(sock);
     return ret;
 }

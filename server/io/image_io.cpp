@@ -37,6 +37,9 @@ std::string sniffName(const std::vector<std::uint8_t>& b) {
     return "mem.tga"; // TGA has no magic number
 }
 
+/// Largest side decodeImage8 decodes (glTF textures; the loader's budget is checked before).
+constexpr int kMaxDecodeSide = 16384;
+
 Error oiioError(const char* where, const std::string& field, const std::string& what) {
     std::string detail = OIIO::geterror();
     return makeError(ErrorCode::Parse, where, field, detail.empty() ? what : what + " (" + detail + ")");
@@ -88,14 +91,11 @@ Result<HeightImage> readHeight(ImageInput& in, const char* where, const std::str
     return img;
 }
 
-/// Opens encoded bytes through an in-memory proxy (OpenImageIO's "oiio:ioproxy" open config) and
-/// calls `fn` on the open image. Nothing is written anywhere (issue #12.8: a scratch file in the
-/// system temp folder outlived a kill -9); a plugin that cannot read from memory is Unsupported.
+/// Opens encoded bytes named `name` (sniffName) through an in-memory proxy and calls `fn` on the
+/// open image; withOpenedMemory's body (may throw what the plugins throw).
 template <class Fn>
-auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where, Fn&& fn)
-    -> decltype(fn(std::declval<ImageInput&>())) {
-    if (bytes.empty()) return makeError(ErrorCode::Parse, where, "", "empty image data");
-    const std::string name = sniffName(bytes);
+auto openMemory(const std::vector<std::uint8_t>& bytes, const char* where, const std::string& name,
+                Fn& fn) -> decltype(fn(std::declval<ImageInput&>())) {
     OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
     OIIO::Filesystem::IOProxy* proxyPtr = &proxy;
     ImageSpec config;
@@ -117,6 +117,38 @@ auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where,
     return fn(*in);
 }
 
+/// Opens encoded bytes through an in-memory proxy (OpenImageIO's "oiio:ioproxy" open config) and
+/// calls `fn` on the open image. Nothing is written anywhere (issue #12.8: a scratch file in the
+/// system temp folder outlived a kill -9); a plugin that cannot read from memory is Unsupported.
+/// OpenImageIO's GIF reader allocates and decodes the whole canvas (the logical screen) in
+/// open(), before any spec can be checked: a GIF whose screen has a side over `maxSide` is
+/// refused from its header (a 35-byte GIF declaring 16000² cost 1.3 GB and 2 s; found by
+/// tests/fuzz/image_fuzz). Exceptions thrown by the plugins on corrupt data (a GIF screen of
+/// 65535² threw std::length_error out of ImageInput::create) become Parse errors; running out of
+/// memory, TooLarge.
+template <class Fn>
+auto withOpenedMemory(const std::vector<std::uint8_t>& bytes, const char* where, int maxSide,
+                      Fn&& fn) -> decltype(fn(std::declval<ImageInput&>())) {
+    if (bytes.empty()) return makeError(ErrorCode::Parse, where, "", "empty image data");
+    const std::string name = sniffName(bytes);
+    if (name == "mem.gif" && bytes.size() >= 10) {
+        const int w = bytes[6] | bytes[7] << 8, h = bytes[8] | bytes[9] << 8;
+        if (w > maxSide || h > maxSide)
+            return makeError(ErrorCode::InvalidArgument, where, "",
+                             "GIF declares a " + std::to_string(w) + "x" + std::to_string(h) +
+                                 " screen, larger than the limit of " + std::to_string(maxSide) +
+                                 " per side");
+    }
+    try {
+        return openMemory(bytes, where, name, fn);
+    } catch (const std::bad_alloc&) {
+        return makeError(ErrorCode::TooLarge, where, "", "not enough memory to decode the image");
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Parse, where, "",
+                         std::string("corrupt image data (") + e.what() + ")");
+    }
+}
+
 } // namespace
 
 Result<HeightImage> readHeightImage(const std::string& path) {
@@ -131,15 +163,15 @@ Result<HeightImage> readHeightImage(const std::string& path) {
 
 Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes) {
     const char* where = "dermis::readHeightImageFromMemory";
-    return withOpenedMemory(bytes, where,
+    return withOpenedMemory(bytes, where, kMaxPatternSize,
                             [&](ImageInput& in) { return readHeight(in, where, ""); });
 }
 
 Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes) {
     const char* where = "dermis::decodeImage8";
-    return withOpenedMemory(bytes, where, [&](ImageInput& in) -> Result<Image8> {
+    return withOpenedMemory(bytes, where, kMaxDecodeSide, [&](ImageInput& in) -> Result<Image8> {
         const ImageSpec& spec = in.spec();
-        if (auto s = checkSpec(where, "", spec, 16384); !s) return s.error();
+        if (auto s = checkSpec(where, "", spec, kMaxDecodeSide); !s) return s.error();
         const int nc = std::min(spec.nchannels, 4);
         std::vector<std::uint8_t> px(static_cast<std::size_t>(spec.width) * spec.height * nc);
         if (!in.read_image(0, 0, 0, nc, TypeDesc::UINT8, px.data()))
