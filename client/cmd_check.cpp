@@ -72,6 +72,12 @@ void writeJunit(const std::string& path, const std::string& suite, const std::ve
     writeFileAtomically(path, x.str());
 }
 
+std::string fixed3(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3f", v);
+    return buf;
+}
+
 std::string percent(double f) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.3f%%", f * 100.0);
@@ -148,7 +154,7 @@ void addCheckCommand(CLI::App& app, Context& ctx) {
                             std::string png;
                             if (encodePng(cmp.diff, png, error)) writeFileAtomically(diffPath, png);
                             r.message = percent(cmp.fraction) + " of the pixels differ by more than " + nlohmann::json(threshold).dump() +
-                                        " (allowed " + percent(fraction) + ", largest difference " + nlohmann::json(cmp.maxDifference).dump() +
+                                        " (allowed " + percent(fraction) + ", largest difference " + fixed3(cmp.maxDifference) +
                                         "); diff image " + diffPath;
                         }
                     }
