@@ -91,14 +91,14 @@ private:
     std::string log_;
 };
 
-struct Run {
+struct ClientRun {
     int code = -1;
     std::string out, err;
     json js() const { return json::parse(out, nullptr, false); }
     std::string firstLine() const { return out.substr(0, out.find('\n')); }
 };
 
-std::ostream& operator<<(std::ostream& os, const Run& r) {
+std::ostream& operator<<(std::ostream& os, const ClientRun& r) {
     return os << "exit " << r.code << "\n--- stdout\n" << r.out << "--- stderr\n" << r.err;
 }
 
@@ -120,16 +120,16 @@ protected:
 
     /// The shell command running the client with `args` (the server through DERMIS_SERVER).
     static std::string command(const std::vector<std::string>& args) {
-        std::string cmd = "DERMIS_SERVER=" + url() + " " + quote(kClient);
+        std::string cmd = "env DERMIS_SERVER=" + url() + " " + quote(kClient);
         for (const auto& a : args) cmd += " " + quote(a);
         return cmd;
     }
     /// Runs the client to completion; stdout and stderr kept apart (stdout is a file, not a tty).
-    static Run dermis(const std::vector<std::string>& args) {
+    static ClientRun dermis(const std::vector<std::string>& args) {
         static int n = 0;
         const std::string out = *dir_ / ("out" + std::to_string(n) + ".txt"), err = *dir_ / ("err" + std::to_string(n) + ".txt");
         ++n;
-        Run r;
+        ClientRun r;
         const int status = std::system((command(args) + " >" + quote(out) + " 2>" + quote(err)).c_str());
         r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
         r.out = slurp(out);
@@ -137,7 +137,7 @@ protected:
         return r;
     }
     static std::string newScene() {
-        Run r = dermis({"scene", "create", "--default-patterns"});
+        ClientRun r = dermis({"scene", "create", "--default-patterns"});
         EXPECT_EQ(r.code, 0) << r;
         return r.firstLine();
     }
@@ -157,26 +157,26 @@ std::vector<std::string> filesIn(const std::string& dir) {
 }
 
 TEST_F(ClientHttpTest, HealthInfoModelsAndPatterns) {
-    Run health = dermis({"health"});
+    ClientRun health = dermis({"health"});
     EXPECT_EQ(health.code, 0) << health;
     EXPECT_EQ(health.out, "ok\n");
-    Run info = dermis({"--json", "info"});
+    ClientRun info = dermis({"--json", "info"});
     ASSERT_EQ(info.code, 0) << info;
     EXPECT_EQ(info.js()["name"], "dermis-server");
-    Run infoTable = dermis({"info"});
+    ClientRun infoTable = dermis({"info"});
     EXPECT_NE(infoTable.out.find("limits.max_batch_frames"), std::string::npos) << infoTable;
 
-    Run list = dermis({"model", "list"});
+    ClientRun list = dermis({"model", "list"});
     ASSERT_EQ(list.code, 0) << list;
     EXPECT_EQ(list.out.rfind("ID", 0), 0u) << list;
     EXPECT_NE(list.out.find("builtin:default"), std::string::npos) << list;
-    Run show = dermis({"model", "show", "builtin:default"});
+    ClientRun show = dermis({"model", "show", "builtin:default"});
     ASSERT_EQ(show.code, 0) << show;
     EXPECT_NE(show.out.find("elbow_curl"), std::string::npos) << show;
 
     // Content-addressed: the same bytes twice give the same id.
-    Run up1 = dermis({"model", "upload", kRiggedFigure, "--name", "fig"});
-    Run up2 = dermis({"--json", "model", "upload", kRiggedFigure});
+    ClientRun up1 = dermis({"model", "upload", kRiggedFigure, "--name", "fig"});
+    ClientRun up2 = dermis({"--json", "model", "upload", kRiggedFigure});
     ASSERT_EQ(up1.code, 0) << up1;
     ASSERT_EQ(up2.code, 0) << up2;
     const std::string id = up1.firstLine();
@@ -184,17 +184,17 @@ TEST_F(ClientHttpTest, HealthInfoModelsAndPatterns) {
     EXPECT_EQ(up2.js()["id"], id);
     EXPECT_EQ(up2.js()["name"], "fig");
     EXPECT_NE(dermis({"model", "list"}).out.find(id), std::string::npos);
-    Run rm = dermis({"model", "rm", id});
+    ClientRun rm = dermis({"model", "rm", id});
     EXPECT_EQ(rm.code, 0) << rm;
-    Run rm2 = dermis({"model", "rm", id});
+    ClientRun rm2 = dermis({"model", "rm", id});
     EXPECT_EQ(rm2.code, 1) << rm2;
     EXPECT_EQ(rm2.err, "dermis: error: dermis::Service: id: no model \"" + id + "\" (id)\n") << rm2;
 
-    Run pup = dermis({"pattern", "upload", kSource + "/patterns/crease.png", "--name", "my crease"});
+    ClientRun pup = dermis({"pattern", "upload", kSource + "/patterns/crease.png", "--name", "my crease"});
     ASSERT_EQ(pup.code, 0) << pup;
     const std::string pid = pup.firstLine();
     EXPECT_EQ(pid.rfind("p_", 0), 0u) << pup;
-    Run plist = dermis({"pattern", "list"});
+    ClientRun plist = dermis({"pattern", "list"});
     EXPECT_NE(plist.out.find(pid), std::string::npos) << plist;
     EXPECT_NE(plist.out.find("my crease"), std::string::npos) << plist;
     EXPECT_EQ(dermis({"pattern", "rm", pid}).code, 0);
@@ -205,11 +205,11 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
     const std::string sid = newScene();
     ASSERT_EQ(sid.rfind("s_", 0), 0u) << sid;
     EXPECT_NE(dermis({"scene", "list"}).out.find(sid), std::string::npos);
-    Run get = dermis({"scene", "get", sid});
+    ClientRun get = dermis({"scene", "get", sid});
     ASSERT_EQ(get.code, 0) << get;
     EXPECT_EQ(get.js()["format"], "dermis.scene/1");
 
-    Run pose = dermis({"pose", "set", sid, "--clip", "elbow_curl", "--time", "0.5", "forearm.l=0,0,30", "hand.l=0,0,0,1"});
+    ClientRun pose = dermis({"pose", "set", sid, "--clip", "elbow_curl", "--time", "0.5", "forearm.l=0,0,30", "hand.l=0,0,0,1"});
     ASSERT_EQ(pose.code, 0) << pose;
     EXPECT_EQ(pose.out, sid + " r2\n");
     json doc = dermis({"scene", "get", sid}).js();
@@ -223,7 +223,8 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
                       "axis=x", "theta_max=120"})
                   .out,
               sid + " r4\n");
-    EXPECT_EQ(dermis({"placement", "mirror", sid, "extra"}).code, 0);
+    ClientRun mirror = dermis({"placement", "mirror", sid, "elbow_l"});
+    EXPECT_EQ(mirror.code, 0) << mirror;
     EXPECT_EQ(dermis({"placement", "rm", sid, "extra"}).out, sid + " r6\n");
     doc = dermis({"scene", "get", sid}).js();
     json elbow;
@@ -231,13 +232,13 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
         if (p["id"] == "elbow_l") elbow = p;
     EXPECT_EQ(elbow["h"], 1.5);
     EXPECT_EQ(elbow["label"], "left elbow");
-    EXPECT_EQ(doc["placements"].size(), 19u) << "18 + the mirror twin of the removed one";
+    EXPECT_EQ(doc["placements"].size(), 19u) << "18 + elbow_l's mirror twin";
 
-    Run history = dermis({"--json", "scene", "history", sid});
+    ClientRun history = dermis({"--json", "scene", "history", sid});
     ASSERT_EQ(history.code, 0) << history;
     EXPECT_EQ(history.js()["revision"], 6);
     EXPECT_EQ(history.js()["revisions"][0]["op"], "delete placement extra");
-    EXPECT_NE(dermis({"scene", "history", sid}).out.find("mirror placement extra"), std::string::npos);
+    EXPECT_NE(dermis({"scene", "history", sid}).out.find("mirror placement elbow_l"), std::string::npos);
     EXPECT_EQ(dermis({"scene", "revert", sid, "1"}).out, sid + " r7\n");
     EXPECT_EQ(dermis({"scene", "get", sid}).js()["placements"].size(), 18u);
 
@@ -246,7 +247,7 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
     ASSERT_EQ(dermis({"scene", "export", sid, "-o", file}).code, 0);
     EXPECT_EQ(json::parse(slurp(file)), dermis({"scene", "get", sid}).js());
     EXPECT_EQ(dermis({"scene", "put", sid, file, "--if-revision", "7"}).out, sid + " r8\n");
-    Run stale = dermis({"scene", "put", sid, file, "--if-revision", "7"});
+    ClientRun stale = dermis({"scene", "put", sid, file, "--if-revision", "7"});
     EXPECT_EQ(stale.code, 1) << stale;
     EXPECT_EQ(dermis({"scene", "apply", file, "--id", sid}).code, 0);
     EXPECT_EQ(dermis({"--json", "scene", "get", sid}).js()["revision"], 8) << "unchanged: no new revision";
@@ -256,7 +257,7 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
     writeText(file2, changed.dump());
     EXPECT_EQ(dermis({"scene", "apply", file2, "--id", sid}).out, sid + "\n");
     EXPECT_EQ(dermis({"--json", "scene", "get", sid}).js()["revision"], 9);
-    Run created = dermis({"scene", "apply", file2});
+    ClientRun created = dermis({"scene", "apply", file2});
     ASSERT_EQ(created.code, 0) << created;
     EXPECT_NE(created.firstLine(), sid);
     EXPECT_EQ(dermis({"scene", "rm", created.firstLine(), sid}).code, 0);
@@ -266,7 +267,7 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
 TEST_F(ClientHttpTest, FramesMapsLintAndWatch) {
     const std::string sid = newScene();
     const std::string png = *dir_ / "frames/one.png", jpg = *dir_ / "frames/one.jpg";
-    Run frame = dermis({"frame", sid, "-o", png, "--width", "64", "--height", "48", "--yaw", "30"});
+    ClientRun frame = dermis({"frame", sid, "-o", png, "--width", "64", "--height", "48", "--yaw", "30"});
     ASSERT_EQ(frame.code, 0) << frame;
     const std::string bytes = slurp(png);
     ASSERT_GT(bytes.size(), 24u);
@@ -280,16 +281,16 @@ TEST_F(ClientHttpTest, FramesMapsLintAndWatch) {
     ASSERT_EQ(dermis({"frame", sid, "-o", jpg, "--width", "64", "--height", "64"}).code, 0);
     EXPECT_EQ(static_cast<unsigned char>(slurp(jpg)[0]), 0xFF);
     EXPECT_FALSE(fs::exists(png + ".dermis-part"));
-    Run maps = dermis({"maps", sid, "bump", "-o", *dir_ / "frames/bump.png"});
+    ClientRun maps = dermis({"maps", sid, "bump", "-o", *dir_ / "frames/bump.png"});
     ASSERT_EQ(maps.code, 0) << maps;
     EXPECT_EQ(slurp(*dir_ / "frames/bump.png").substr(1, 3), "PNG");
     ASSERT_EQ(dermis({"maps", sid, "displacement", "-o", *dir_ / "frames/disp.f32"}).code, 0);
     EXPECT_EQ(fs::file_size(*dir_ / "frames/disp.f32") % 4, 0u);
 
-    Run lint = dermis({"lint", sid});
+    ClientRun lint = dermis({"lint", sid});
     EXPECT_EQ(lint.code, 0) << lint;
     EXPECT_NE(lint.out.find("SEVERITY"), std::string::npos) << lint;
-    Run lintJson = dermis({"--json", "lint", sid});
+    ClientRun lintJson = dermis({"--json", "lint", sid});
     EXPECT_TRUE(lintJson.js().is_array()) << lintJson;
 
     // watch: hello, then the change made while it listens, as JSON lines.
@@ -320,25 +321,25 @@ TEST_F(ClientHttpTest, BadArgumentsServerErrorsAndNoServer) {
              {"pose", "set", "s_0000000000000000", "forearm.l=1,2"},
              {"--timeout", "-1", "health"},
              {"--server", "ftp://x", "health"}}) {
-        Run r = dermis(args);
+        ClientRun r = dermis(args);
         EXPECT_EQ(r.code, 2) << testing::PrintToString(args) << "\n" << r;
         EXPECT_EQ(r.err.rfind("dermis: error: ", 0), 0u) << r;
     }
-    Run bad = dermis({"pose", "set", "s_0000000000000000", "forearm.l=1,2"});
+    ClientRun bad = dermis({"pose", "set", "s_0000000000000000", "forearm.l=1,2"});
     EXPECT_EQ(bad.err, "dermis: error: joint forearm.l: expected x,y,z degrees or a quaternion x,y,z,w, got \"1,2\" (forearm.l=1,2)\n");
 
-    Run missing = dermis({"scene", "get", "s_0000000000000000"});
+    ClientRun missing = dermis({"scene", "get", "s_0000000000000000"});
     EXPECT_EQ(missing.code, 1) << missing;
     EXPECT_EQ(missing.err, "dermis: error: dermis::Service: id: no scene \"s_0000000000000000\" (id)\n");
     const std::string sid = newScene();
-    Run invalid = dermis({"placement", "set", sid, "elbow_l", "h=-5"});
+    ClientRun invalid = dermis({"placement", "set", sid, "elbow_l", "h=-5"});
     EXPECT_EQ(invalid.code, 1) << invalid;
     EXPECT_NE(invalid.err.find("(/placements/"), std::string::npos) << invalid;
-    Run noFrames = dermis({"frame", sid, "-o", *dir_ / "huge.png", "--width", "100000"});
+    ClientRun noFrames = dermis({"frame", sid, "-o", *dir_ / "huge.png", "--width", "100000"});
     EXPECT_EQ(noFrames.code, 1) << noFrames;
     EXPECT_FALSE(fs::exists(*dir_ / "huge.png"));
 
-    Run down = dermis({"--server", "http://127.0.0.1:1", "--retries", "0", "health"});
+    ClientRun down = dermis({"--server", "http://127.0.0.1:1", "--retries", "0", "health"});
     EXPECT_EQ(down.code, 3) << down;
     EXPECT_EQ(down.err, "dermis: error: cannot connect to http://127.0.0.1:1: connection refused or host unreachable (--server)\n");
 }
@@ -353,7 +354,7 @@ TEST_F(ClientHttpTest, RenderResumeAfterKillWritesExactlyTheRest) {
         return args;
     };
     const std::string full = *dir_ / "full", part = *dir_ / "part";
-    Run whole = dermis(renderTo(full, {}));
+    ClientRun whole = dermis(renderTo(full, {}));
     ASSERT_EQ(whole.code, 0) << whole;
     ASSERT_EQ(filesIn(full).size(), 101u);
     EXPECT_NE(whole.out.find("frame 0 " + full + "/frame_0000.png"), std::string::npos) << "a log line per frame when piped";
@@ -382,8 +383,9 @@ TEST_F(ClientHttpTest, RenderResumeAfterKillWritesExactlyTheRest) {
     }
     ASSERT_GE(before.size(), 5u);
     ASSERT_LT(before.size(), 101u) << "the client must be killed mid-range";
+    std::cout << "killed after " << before.size() << " of 101 frames\n";
 
-    Run resumed = dermis(renderTo(part, {"--resume"}));
+    ClientRun resumed = dermis(renderTo(part, {"--resume"}));
     ASSERT_EQ(resumed.code, 0) << resumed;
     const std::size_t rest = 101 - before.size();
     EXPECT_NE(resumed.out.find("rendered " + std::to_string(rest) + " frames of 101 (" + std::to_string(before.size()) + " skipped, 0 failed)"),
@@ -432,7 +434,7 @@ TEST_F(ClientHttpTest, ProgressLineOnlyOnATerminal) {
     EXPECT_EQ(text.find("frame 0 "), std::string::npos) << "no log lines on a terminal";
     EXPECT_EQ(filesIn(*dir_ / "tty").size(), 11u);
     // Piped: log lines, no '\r'.
-    Run piped = dermis({"render", sid, "--frames", "0:1:0.1", "--size", "64x64", "--out", *dir_ / "piped/f_%04d.jpg"});
+    ClientRun piped = dermis({"render", sid, "--frames", "0:1:0.1", "--size", "64x64", "--out", *dir_ / "piped/f_%04d.jpg"});
     ASSERT_EQ(piped.code, 0) << piped;
     EXPECT_EQ(piped.out.find('\r'), std::string::npos);
     EXPECT_NE(piped.out.find("frame 10 "), std::string::npos) << piped;
@@ -441,7 +443,7 @@ TEST_F(ClientHttpTest, ProgressLineOnlyOnATerminal) {
 TEST_F(ClientHttpTest, CheckPassesFailsWhenAPlacementMovesAndUpdates) {
     const std::string cases = kSource + "/tests/check/cases.json", refs = kSource + "/tests/check/refs";
     const std::string junit = *dir_ / "check/ok.xml";
-    Run ok = dermis({"check", cases, "--refs", refs, "--junit", junit, "--out", *dir_ / "check/ok"});
+    ClientRun ok = dermis({"check", cases, "--refs", refs, "--junit", junit, "--out", *dir_ / "check/ok"});
     ASSERT_EQ(ok.code, 0) << ok;
     EXPECT_NE(ok.out.find("4 passed, 0 failed"), std::string::npos) << ok;
     EXPECT_NE(slurp(junit).find("tests=\"4\" failures=\"0\""), std::string::npos) << slurp(junit);
@@ -458,7 +460,7 @@ TEST_F(ClientHttpTest, CheckPassesFailsWhenAPlacementMovesAndUpdates) {
     json checks = json::parse(slurp(cases));
     checks["defaults"]["scene"] = "moved.scene.json";
     writeText(work + "/cases.json", checks.dump());
-    Run moved = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--junit", work + "/report.xml", "--out", work + "/out"});
+    ClientRun moved = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--junit", work + "/report.xml", "--out", work + "/out"});
     EXPECT_EQ(moved.code, 4) << moved;
     EXPECT_NE(moved.out.find("FAIL elbow_curl.png"), std::string::npos) << moved;
     EXPECT_NE(moved.out.find("PASS stand.png"), std::string::npos) << moved;
@@ -469,20 +471,20 @@ TEST_F(ClientHttpTest, CheckPassesFailsWhenAPlacementMovesAndUpdates) {
     EXPECT_EQ(slurp(work + "/out/diff/elbow_curl.png").substr(1, 3), "PNG");
     EXPECT_TRUE(fs::exists(work + "/out/actual/elbow_curl.png"));
 
-    Run update = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--update", "--out", work + "/out2"});
+    ClientRun update = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--update", "--out", work + "/out2"});
     EXPECT_EQ(update.code, 0) << update;
     EXPECT_NE(update.out.find("UPDATED elbow_curl.png"), std::string::npos) << update;
     EXPECT_EQ(slurp(work + "/refs/stand.png"), slurp(refs + "/stand.png")) << "matching references stay";
-    Run again = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--out", work + "/out3"});
+    ClientRun again = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--out", work + "/out3"});
     EXPECT_EQ(again.code, 0) << again;
 
     // A missing reference fails (and names --update); a malformed checks file is a usage error.
     fs::remove(work + "/refs/squat_1.png");
-    Run noRef = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--out", work + "/out4"});
+    ClientRun noRef = dermis({"check", work + "/cases.json", "--refs", work + "/refs", "--out", work + "/out4"});
     EXPECT_EQ(noRef.code, 4) << noRef;
     EXPECT_NE(noRef.out.find("run with --update"), std::string::npos) << noRef;
     writeText(work + "/bad.json", R"({"cases": [{"time": 0}]})");
-    Run badFile = dermis({"check", work + "/bad.json", "--refs", work + "/refs"});
+    ClientRun badFile = dermis({"check", work + "/bad.json", "--refs", work + "/refs"});
     EXPECT_EQ(badFile.code, 2) << badFile;
     EXPECT_NE(badFile.err.find("(/cases/0/name)"), std::string::npos) << badFile;
 }
