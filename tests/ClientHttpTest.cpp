@@ -453,7 +453,7 @@ TEST_F(ClientHttpTest, CheckPassesFailsWhenAPlacementMovesAndUpdates) {
     const std::string work = *dir_ / "check/moved";
     fs::create_directories(work);
     fs::copy(refs, work + "/refs");
-    json scene = json::parse(slurp(kSource + "/tests/check/default.scene.json"));
+    json scene = json::parse(slurp(kSource + "/models/default.scene.json"));
     for (auto& p : scene["placements"])
         if (p["id"] == "elbow_l") p["center"] = {0.2899, 0.62};
     writeText(work + "/moved.scene.json", scene.dump());
