@@ -23,7 +23,18 @@ nlohmann::json readJsonFile(const std::string& path, const std::string& field) {
 
 std::string scenePath(const std::string& id) { return "/scenes/" + httplib::detail::encode_query_param(id); }
 
+namespace {
+
+struct SystemOptions {
+    std::string scene;
+    bool strict = false;
+    int count = 0;
+};
+
+} // namespace
+
 void addSystemCommands(CLI::App& app, Context& ctx) {
+    auto o = std::make_shared<SystemOptions>();
     CLI::App* health = app.add_subcommand("health", "Is the server up? (GET /health; no token needed)");
     health->callback([&ctx] {
         ctx.action = [&ctx] {
@@ -59,13 +70,11 @@ void addSystemCommands(CLI::App& app, Context& ctx) {
     });
 
     auto* lint = app.add_subcommand("lint", "What may be wrong with a scene (GET /scenes/{id}/lint)");
-    static std::string lintScene;
-    static bool lintStrict = false;
-    lint->add_option("scene", lintScene, "Scene id")->required();
-    lint->add_flag("--strict", lintStrict, "Exit 1 when there is a warning");
-    lint->callback([&ctx] {
-        ctx.action = [&ctx] {
-            auto j = ctx.http().getJson(scenePath(lintScene) + "/lint");
+    lint->add_option("scene", o->scene, "Scene id")->required();
+    lint->add_flag("--strict", o->strict, "Exit 1 when there is a warning");
+    lint->callback([&ctx, o] {
+        ctx.action = [&ctx, o] {
+            auto j = ctx.http().getJson(scenePath(o->scene) + "/lint");
             bool warned = false;
             std::vector<std::vector<std::string>> rows;
             for (const auto& f : j) {
@@ -75,23 +84,21 @@ void addSystemCommands(CLI::App& app, Context& ctx) {
             if (ctx.global.json) printJson(j);
             else if (rows.empty()) std::cout << "no findings\n";
             else printTable({"SEVERITY", "CODE", "PLACEMENT", "MESSAGE"}, rows);
-            return lintStrict && warned ? kExitServerSaidNo : kExitOk;
+            return o->strict && warned ? kExitServerSaidNo : kExitOk;
         };
     });
 
     auto* watch = app.add_subcommand("watch", "Print a scene's events as JSON lines as they happen (server-sent events)");
-    static std::string watchScene;
-    static int watchCount = 0;
-    watch->add_option("scene", watchScene, "Scene id")->required();
-    watch->add_option("--count", watchCount, "Stop after this many events (the hello event counts; 0 = until the scene is deleted or Ctrl-C)")
+    watch->add_option("scene", o->scene, "Scene id")->required();
+    watch->add_option("--count", o->count, "Stop after this many events (the hello event counts; 0 = until the scene is deleted or Ctrl-C)")
         ->check(CLI::NonNegativeNumber);
-    watch->callback([&ctx] {
-        ctx.action = [&ctx] {
+    watch->callback([&ctx, o] {
+        ctx.action = [&ctx, o] {
             std::string buffer;
             int seen = 0;
             bool done = false;
             ctx.http().stream(
-                "GET", scenePath(watchScene) + "/events", "", "", [](int, const httplib::Headers&) { return true; },
+                "GET", scenePath(o->scene) + "/events", "", "", [](int, const httplib::Headers&) { return true; },
                 [&](const char* data, std::size_t n) {
                     if (g_interrupted) return false;
                     buffer.append(data, n);
@@ -113,7 +120,7 @@ void addSystemCommands(CLI::App& app, Context& ctx) {
                             auto j = nlohmann::json::parse(payload, nullptr, false);
                             if (j.is_object() && j.value("type", "") == "deleted") done = true;
                         }
-                        if (done || (watchCount > 0 && seen >= watchCount)) return false;
+                        if (done || (o->count > 0 && seen >= o->count)) return false;
                     }
                     return true;
                 });

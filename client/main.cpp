@@ -72,7 +72,9 @@ int main(int argc, char** argv) {
     }
     installSigint();
     try {
-        return ctx.action();
+        const int code = ctx.action();
+        // Commands that do not poll the flag finish their request (and its atomic write) first.
+        return g_interrupted && code == kExitOk ? kExitInterrupted : code;
     } catch (const CliError& e) {
         std::cout << std::flush;
         std::cerr << "dermis: error: " << e.what() << (e.field.empty() ? "" : " (" + e.field + ")") << "\n";
