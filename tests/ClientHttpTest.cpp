@@ -57,7 +57,8 @@ std::string slurp(const std::string& path) {
 /// dermis-server serving a fresh data folder on a free port; killed on destruction.
 class ServerProcess {
 public:
-    explicit ServerProcess(const std::string& dir) : log_(dir + "/server.log") {
+    /// `token`: the server's --token ("" = none).
+    explicit ServerProcess(const std::string& dir, const std::string& token = "") : log_(dir + "/server.log") {
         fs::create_directories(dir + "/data");
         pid_ = ::fork();
         if (pid_ == 0) {
@@ -65,8 +66,13 @@ public:
             ::dup2(fd, 1);
             ::dup2(fd, 2);
             const std::string data = dir + "/data", gl = backend();
-            ::execl(DERMIS_SERVER_EXE, DERMIS_SERVER_EXE, "serve", "--port", "0", "--data", data.c_str(), "--gl", gl.c_str(),
-                    static_cast<char*>(nullptr));
+            ::unsetenv("DERMIS_TOKEN");
+            if (token.empty())
+                ::execl(DERMIS_SERVER_EXE, DERMIS_SERVER_EXE, "serve", "--port", "0", "--data", data.c_str(), "--gl", gl.c_str(),
+                        static_cast<char*>(nullptr));
+            else
+                ::execl(DERMIS_SERVER_EXE, DERMIS_SERVER_EXE, "serve", "--port", "0", "--data", data.c_str(), "--gl", gl.c_str(),
+                        "--token", token.c_str(), static_cast<char*>(nullptr));
             ::_exit(127);
         }
         for (int i = 0; i < 600 && port_ == 0; ++i) {
@@ -120,7 +126,7 @@ protected:
 
     /// The shell command running the client with `args` (the server through DERMIS_SERVER).
     static std::string command(const std::vector<std::string>& args) {
-        std::string cmd = "env DERMIS_SERVER=" + url() + " " + quote(kClient);
+        std::string cmd = "env -u DERMIS_TOKEN DERMIS_SERVER=" + url() + " " + quote(kClient);
         for (const auto& a : args) cmd += " " + quote(a);
         return cmd;
     }
@@ -199,6 +205,39 @@ TEST_F(ClientHttpTest, HealthInfoModelsAndPatterns) {
     EXPECT_NE(plist.out.find("my crease"), std::string::npos) << plist;
     EXPECT_EQ(dermis({"pattern", "rm", pid}).code, 0);
     EXPECT_EQ(dermis({"--json", "pattern", "list"}).js()["patterns"].dump().find(pid), std::string::npos);
+}
+
+TEST_F(ClientHttpTest, GltfWithItsFilesUploadsAsMultipart) {
+    const auto [gltf, bin] = triangleGltf("tri.bin");
+    writeText(*dir_ / "tri.gltf", gltf);
+    writeText(*dir_ / "tri.bin", bin);
+    ClientRun up = dermis({"--json", "model", "upload", *dir_ / "tri.gltf", *dir_ / "tri.bin"});
+    ASSERT_EQ(up.code, 0) << up;
+    EXPECT_EQ(up.js()["triangles"], 1);
+    EXPECT_EQ(up.js()["name"], "tri");
+    ClientRun again = dermis({"model", "upload", *dir_ / "tri.gltf", *dir_ / "tri.bin"});
+    EXPECT_EQ(again.firstLine(), up.js()["id"]) << again;
+    ClientRun missing = dermis({"model", "upload", *dir_ / "tri.gltf"});
+    EXPECT_EQ(missing.code, 1) << missing;
+    EXPECT_EQ(dermis({"model", "rm", up.js()["id"]}).code, 0);
+}
+
+TEST_F(ClientHttpTest, TokenFromTheOptionOrTheEnvironment) {
+    TempDir dir;
+    ServerProcess guarded(dir.str(), "s3cret");
+    ASSERT_GT(guarded.port(), 0) << guarded.log();
+    const std::string server = "http://127.0.0.1:" + std::to_string(guarded.port());
+    ClientRun health = dermis({"--server", server, "health"});
+    EXPECT_EQ(health.code, 0) << health << "(/health needs no token)";
+    ClientRun without = dermis({"--server", server, "model", "list"});
+    EXPECT_EQ(without.code, 1) << without;
+    EXPECT_NE(without.err.find("dermis: error: "), std::string::npos) << without;
+    ClientRun wrong = dermis({"--server", server, "--token", "nope", "model", "list"});
+    EXPECT_EQ(wrong.code, 1) << wrong;
+    ClientRun right = dermis({"--server", server, "--token", "s3cret", "model", "list"});
+    EXPECT_EQ(right.code, 0) << right;
+    const int env = std::system(("DERMIS_TOKEN=s3cret " + quote(kClient) + " --server " + server + " model list >/dev/null").c_str());
+    EXPECT_TRUE(WIFEXITED(env) && WEXITSTATUS(env) == 0);
 }
 
 TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
