@@ -9,7 +9,7 @@ PKGS=(
   libopenimageio-dev
   libpng-dev zlib1g-dev libturbojpeg0-dev
   python3-glad libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6
-  libcpp-httplib-dev nginx
+  libcpp-httplib-dev libssl-dev nginx bsdutils
   chromium
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-dev python3

@@ -13,6 +13,7 @@
 #include "GltfTestBuilder.hpp"
 #include "HttpTestFixture.hpp"
 #include "io/gltf_loader.hpp"
+#include "io/sha256.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -358,3 +359,45 @@ TEST_F(ModelsHttpTest, TinyFilesThatDeclareHugeModelsAre413) {
 }
 
 } // namespace
+
+// Issue #14: uploads are content-addressed. The same .glb twice answers 200 with the first id
+// ("m_" + the first 16 hex digits of the bytes' SHA-256) and stores no copy; a multipart .gltf
+// with its files likewise; other bytes get another id; after a delete the bytes upload anew (201).
+TEST_F(ModelsHttpTest, SameBytesUploadTwiceGiveTheSameId) {
+    Http h = http();
+    const auto glb = readBytes(kRiggedFigure);
+    const std::size_t before = h.get("/models").js()["models"].size();
+    Reply first = h.upload("/models?name=fig", glb, "model/gltf-binary");
+    ASSERT_EQ(first.status, 201) << first;
+    const std::string id = first.js()["id"];
+    EXPECT_EQ(id, "m_" + toHex(sha256(glb)).substr(0, 16));
+    Reply again = h.upload("/models?name=other", glb, "model/gltf-binary");
+    ASSERT_EQ(again.status, 200) << again;
+    EXPECT_EQ(again.js()["id"], id);
+    EXPECT_EQ(again.js()["name"], "fig") << "the stored model, unchanged";
+    EXPECT_EQ(h.get("/models").js()["models"].size(), before + 1) << "no copy";
+    Reply cesium = h.upload("/models", readBytes(kCesiumMan), "model/gltf-binary");
+    ASSERT_EQ(cesium.status, 201) << cesium;
+    EXPECT_NE(cesium.js()["id"], id);
+
+    auto post = [&](const httplib::MultipartFormDataItems& items) {
+        httplib::Client cli("127.0.0.1", server_->port());
+        auto r = cli.Post((std::string(kApi) + "/models?name=tri").c_str(), items);
+        return r ? std::make_pair(r->status, json::parse(r->body, nullptr, false)) : std::make_pair(0, json());
+    };
+    const auto [gltf, bin] = triangleGltf("tri.bin");
+    auto [s1, j1] = post({{"gltf", gltf, "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}});
+    auto [s2, j2] = post({{"gltf", gltf, "tri.gltf", ""}, {"buffer", bin, "tri.bin", ""}});
+    EXPECT_EQ(s1, 201) << j1;
+    EXPECT_EQ(s2, 200) << j2;
+    EXPECT_EQ(j1["id"], j2["id"]);
+    EXPECT_EQ(j1["id"].get<std::string>().size(), 18u);
+
+    // Deleted, the same bytes are a new upload again (same id: the id is the content's).
+    EXPECT_EQ(h.del("/models/" + id).status, 204);
+    Reply after = h.upload("/models", glb, "model/gltf-binary");
+    EXPECT_EQ(after.status, 201) << after;
+    EXPECT_EQ(after.js()["id"], id);
+    for (const std::string m : {id, cesium.js()["id"].get<std::string>(), j1["id"].get<std::string>()})
+        EXPECT_EQ(h.del("/models/" + m).status, 204) << m;
+}

@@ -5,6 +5,7 @@
 //     scene's alias map, 409 while in use, 204 once unused (an alias no placement names is
 //     dropped); previews of tall patterns keep the aspect ratio.
 #include "HttpTestFixture.hpp"
+#include "io/sha256.hpp"
 
 using namespace dermis;
 using namespace dermis::test;
@@ -146,3 +147,25 @@ TEST_F(PatternsHttpTest, StaleAliasDoesNotBlockDeletion) {
 }
 
 } // namespace
+
+// Issue #14: pattern uploads are content-addressed: the same image bytes twice answer 200 with the
+// first id ("p_" + 16 hex digits of their SHA-256), one entry listed; other bytes another id.
+TEST_F(PatternsHttpTest, SameBytesUploadTwiceGiveTheSameId) {
+    Http h = http();
+    const auto png = domePng();
+    const std::size_t before = h.get("/patterns").js()["patterns"].size();
+    Reply first = h.upload("/patterns?name=dome", png, "image/png");
+    ASSERT_EQ(first.status, 201) << first;
+    const std::string id = first.js()["id"];
+    EXPECT_EQ(id, "p_" + toHex(sha256(png)).substr(0, 16));
+    Reply again = h.upload("/patterns?name=dome2", png, "image/png");
+    ASSERT_EQ(again.status, 200) << again;
+    EXPECT_EQ(again.js()["id"], id);
+    EXPECT_EQ(again.js()["name"], "dome");
+    EXPECT_EQ(h.get("/patterns").js()["patterns"].size(), before + 1);
+    Reply third = h.upload("/patterns", readBytes(std::string(DERMIS_SOURCE_DIR) + "/patterns/crease.png"), "image/png");
+    ASSERT_EQ(third.status, 201) << third;
+    EXPECT_NE(third.js()["id"], id);
+    EXPECT_EQ(h.del("/patterns/" + id).status, 204);
+    EXPECT_EQ(h.del("/patterns/" + third.js()["id"].get<std::string>()).status, 204);
+}

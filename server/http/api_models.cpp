@@ -20,23 +20,25 @@ void installModelRoutes(RouteTable& t) {
                     name.size() > 5 && name.compare(name.size() - 5, 5, ".gltf") == 0;
                 if (field == "gltf" || (gltfName.empty() && isGltf)) gltfName = name;
             }
-            auto r = a.svc.addModelFiles(files, gltfName, req.get_param_value("name"));
+            bool existing = false;
+            auto r = a.svc.addModelFiles(files, gltfName, req.get_param_value("name"), &existing);
             if (!r) return sendError(res, r.error());
-            return sendJson(res, 201, *r);
+            return sendJson(res, existing ? 200 : 201, *r); // 200: these bytes were uploaded before
         }
         if (!hasContentType(req, {"model/gltf-binary", "application/octet-stream"}))
             return sendError(res, 415, "unsupported",
                              "dermis-server: body: expected Content-Type model/gltf-binary, or "
                              "multipart/form-data with a .gltf and its files",
                              "body");
-        auto r = a.svc.addModel(bytesOf(req.body), req.get_param_value("name"));
+        bool existing = false;
+        auto r = a.svc.addModel(bytesOf(req.body), req.get_param_value("name"), &existing);
         if (!r) {
             Error e = r.error();
             if (e.field.empty() && e.code == ErrorCode::Parse)
                 e.field = "body"; // undecodable bytes
             return sendError(res, e);
         }
-        sendJson(res, 201, *r);
+        sendJson(res, existing ? 200 : 201, *r); // 200: these bytes were uploaded before
     });
     t.add("GET", "/models/{id}", [](Api::Impl& a, const Req& req, Res& res) {
         auto r = a.svc.getModel(req.matches[1]);

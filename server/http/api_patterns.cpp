@@ -10,14 +10,15 @@ void installPatternRoutes(RouteTable& t) {
         if (!hasContentType(req, {"image/*", "application/octet-stream"}))
             return sendError(res, 415, "unsupported",
                              "dermis-server: body: expected an image Content-Type", "body");
-        auto r = a.svc.addPattern(bytesOf(req.body), req.get_param_value("name"));
+        bool existing = false;
+        auto r = a.svc.addPattern(bytesOf(req.body), req.get_param_value("name"), &existing);
         if (!r) {
             Error e = r.error();
             if (e.code == ErrorCode::Parse)
                 return sendError(res, 415, "unsupported", e.message, "body");
             return sendError(res, e);
         }
-        sendJson(res, 201, *r);
+        sendJson(res, existing ? 200 : 201, *r); // 200: these bytes were uploaded before
     });
     t.add("GET", "/patterns/{id}/image", [](Api::Impl& a, const Req& req, Res& res) {
         std::optional<int> size;

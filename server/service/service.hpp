@@ -169,12 +169,21 @@ public:
 
     // --- models
     nlohmann::json listModels() const;
-    Result<nlohmann::json> addModel(const std::vector<std::uint8_t>& glb, const std::string& name);
+    /// Uploads are content-addressed: the id is "m_" + the first 16 hex digits of the SHA-256 of
+    /// the bytes (contentModelId), and bytes uploaded before answer the existing model's summary
+    /// unchanged (its first name kept) with `*existing` set to true (when given) instead of
+    /// storing a copy. Models stored with random ids by earlier versions keep those ids.
+    Result<nlohmann::json> addModel(const std::vector<std::uint8_t>& glb, const std::string& name,
+                                    bool* existing = nullptr);
     /// A .gltf (`gltfName`, one of `files`) with its external buffers and images as the other
     /// files. File names must be plain ([A-Za-z0-9._ -]); the loader reads only these files.
+    /// Content-addressed like addModel over the files (names and bytes, contentModelId).
     Result<nlohmann::json> addModelFiles(const std::vector<UploadFile>& files,
-                                         const std::string& gltfName, const std::string& name);
+                                         const std::string& gltfName, const std::string& name,
+                                         bool* existing = nullptr);
     Result<nlohmann::json> getModel(const std::string& id) const;
+    /// The summary of model `id` when it is loaded (as listModels has it), else nullopt.
+    std::optional<nlohmann::json> storedModel(const std::string& id) const;
     Status deleteModel(const std::string& id);
     /// The UV wireframe (core uvEdges): {"id", "edge_count", "edges": [u0,v0,u1,v1, …],
     /// "convention"} (json), or a size×size PNG (core rasterizeUvEdges).
@@ -190,7 +199,10 @@ public:
 
     // --- patterns
     nlohmann::json listPatterns() const;
-    Result<nlohmann::json> addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name);
+    /// Content-addressed like addModel: "p_" + 16 hex digits of the SHA-256 of the bytes; the same
+    /// bytes again answer the existing pattern with `*existing` set.
+    Result<nlohmann::json> addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name,
+                                      bool* existing = nullptr);
     /// A grey PNG preview whose longer side is `size` pixels, the aspect kept (core heightPreview).
     /// Fails: size outside [1, 2048] (InvalidArgument, "size"), an unknown pattern (NotFound, "id").
     Result<EncodedImage> patternImage(const std::string& id, int size) const;

@@ -6,6 +6,7 @@
 #include "core/uv_layout.hpp"
 #include "io/frame_io.hpp"
 #include "io/gltf_loader.hpp"
+#include "io/sha256.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -57,7 +58,29 @@ json modelSummary(const ModelEntry& e) {
             {"bytes", e.bytes}};
 }
 
+/// The content address of a .glb: "m_" + 16 hex digits of its SHA-256.
+std::string glbId(const std::vector<std::uint8_t>& glb) { return Store::contentId("m", toHex(sha256(glb))); }
+
+/// The content address of a .gltf with its files: the SHA-256 over the main file's name, then
+/// each file in name order as name, NUL, decimal size, NUL, bytes.
+std::string gltfFilesId(const GltfFiles& named, const std::string& gltfName) {
+    Sha256 h;
+    h.update("gltf-files\n" + gltfName + '\n');
+    for (const auto& [name, bytes] : named) {
+        h.update(name + '\0' + std::to_string(bytes.size()) + '\0');
+        h.update(bytes.data(), bytes.size());
+    }
+    return Store::contentId("m", toHex(h.finish()));
+}
+
 } // namespace
+
+std::optional<json> Service::storedModel(const std::string& id) const {
+    std::shared_lock<std::shared_mutex> lock(state_->mutex);
+    auto it = state_->models.find(id);
+    if (it == state_->models.end()) return std::nullopt;
+    return modelSummary(it->second);
+}
 
 json Service::listModels() const {
     std::shared_lock<std::shared_mutex> lock(state_->mutex);
@@ -67,12 +90,21 @@ json Service::listModels() const {
     return {{"models", out}};
 }
 
-Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::string& name) {
+Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::string& name,
+                               bool* existing) {
     const char* where = "dermis::Service::addModel";
+    if (existing) *existing = false;
     if (glb.size() > limits_.maxUploadBytes) return bodyTooLarge(limits_, where);
     if (glb.size() < 12 || std::memcmp(glb.data(), "glTF", 4) != 0)
         return makeError(ErrorCode::Unsupported, where, "body",
                          "not a binary glTF (.glb); send a .gltf with its files as multipart/form-data");
+    // Content-addressed: the same bytes again answer the stored model (two identical uploads at
+    // the same moment may both store it: same id, same bytes, the later name kept).
+    const std::string id = glbId(glb);
+    if (auto known = storedModel(id)) {
+        if (existing) *existing = true;
+        return *known;
+    }
     // No base folder: no file of this machine is read. The limits are checked from the declared
     // sizes before anything big is allocated; checkModel below is the backstop.
     const GltfLimits gl = gltfLimitsOf(limits_);
@@ -80,17 +112,17 @@ Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::
     if (!parsed) return parsed.error();
     if (auto s = loadGltfResources(*parsed, gl); !s) return s.error();
     if (auto st = checkModel(parsed->model, limits_, where); !st) return st.error();
-    ModelEntry e{Store::newId("m"), sanitizeName(name),
-                 std::make_shared<const Model>(std::move(parsed->model)), glb.size(), false};
-    const std::string id = e.id;
+    ModelEntry e{id, sanitizeName(name), std::make_shared<const Model>(std::move(parsed->model)),
+                 glb.size(), false};
     return state_->addModelEntry(std::move(e), [&](Store& store, const json& meta) {
         return store.putBlob("models", id, "glb", glb, meta);
     });
 }
 
 Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const std::string& gltfName,
-                                    const std::string& name) {
+                                    const std::string& name, bool* existing) {
     const char* where = "dermis::Service::addModelFiles";
+    if (existing) *existing = false;
     std::size_t total = 0;
     for (const UploadFile& f : files) {
         total += f.bytes.size();
@@ -107,13 +139,17 @@ Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const 
     if (gltfName.empty() || !named.count(gltfName))
         return makeError(ErrorCode::InvalidArgument, where, "gltf",
                          "no .gltf part (name the part \"gltf\" or give it a .gltf file name)");
+    const std::string id = gltfFilesId(named, gltfName);
+    if (auto known = storedModel(id)) {
+        if (existing) *existing = true;
+        return *known;
+    }
     // Parsed from memory: the .gltf's URIs resolve to the uploaded files only.
     auto model = loadGltfFromFiles(named, gltfName, gltfLimitsOf(limits_));
     if (!model) return model.error();
     if (auto st = checkModel(*model, limits_, where); !st) return st.error();
-    ModelEntry e{Store::newId("m"), sanitizeName(name.empty() ? gltfName : name),
+    ModelEntry e{id, sanitizeName(name.empty() ? gltfName : name),
                  std::make_shared<const Model>(std::move(*model)), total, false};
-    const std::string id = e.id;
     return state_->addModelEntry(std::move(e), [&](Store& store, const json& meta) {
         return store.putBlobFolder("models", id, named, gltfName, meta);
     });

@@ -4,6 +4,7 @@
 #include "core/preview.hpp"
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
+#include "io/sha256.hpp"
 
 #include <algorithm>
 
@@ -58,11 +59,25 @@ json Service::listPatterns() const {
     return {{"patterns", out}};
 }
 
-Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name) {
+Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const std::string& name,
+                                 bool* existing) {
     const char* where = "dermis::Service::addPattern";
+    if (existing) *existing = false;
     if (bytes.size() > limits_.maxUploadBytes)
         return makeError(ErrorCode::TooLarge, where, "body",
                          "larger than " + std::to_string(limits_.maxUploadBytes) + " bytes");
+    // Content-addressed: the same bytes again answer the stored pattern (two identical uploads at
+    // the same moment may both store it: same id, same bytes, the later name kept).
+    const std::string id = Store::contentId("p", toHex(sha256(bytes)));
+    {
+        std::shared_lock<std::shared_mutex> lock(state_->mutex);
+        auto known = state_->patterns.find(id);
+        if (known != state_->patterns.end()) {
+            auto img = state_->images.find(id);
+            if (existing) *existing = true;
+            return patternSummary(known->second, img == state_->images.end() ? nullptr : &img->second->pixels);
+        }
+    }
     auto img = readHeightImageFromMemory(bytes);
     if (!img) return img.error();
     if (img->width > limits_.maxImageSide || img->height > limits_.maxImageSide)
@@ -70,7 +85,7 @@ Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const s
                          "image is " + std::to_string(img->width) + "x" + std::to_string(img->height) +
                              ", the limit is " + std::to_string(limits_.maxImageSide) + " per side");
     PatternEntry e;
-    e.id = Store::newId("p");
+    e.id = id;
     e.name = sanitizeName(name);
     e.bytes = bytes.size();
     auto stored = makePatternImage(std::move(*img));

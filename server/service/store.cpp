@@ -53,6 +53,10 @@ std::string Store::newId(const std::string& prefix) {
     return prefix + "_" + buf;
 }
 
+std::string Store::contentId(const std::string& prefix, const std::string& digestHex) {
+    return prefix + "_" + digestHex.substr(0, 16);
+}
+
 bool Store::isGeneratedId(const std::string& id, char prefix) {
     if (id.size() != 18 || id[0] != prefix || id[1] != '_') return false;
     for (std::size_t i = 2; i < id.size(); ++i)

@@ -11,7 +11,9 @@
 //   scenes/<id>.json     ({"id", "revision", "scene"}: the current revision)
 //   scenes/<id>.history/ (r<N>.json per kept revision, index.jsonl: one line per revision)
 // Ids are generated ("m_…", "p_…", "s_…": 16 hex digits) — never taken from a client — so no file
-// name comes from a request. Thread-safe: the caller serialises mutations (Service's lock).
+// name comes from a request. Scene ids are random; model and pattern ids are content addresses
+// (contentId: the first 16 hex digits of the SHA-256 of the uploaded bytes), so one upload of the
+// same bytes is stored once. Random model and pattern ids of earlier versions stay valid. Thread-safe: the caller serialises mutations (Service's lock).
 #pragma once
 
 #include "core/result.hpp"
@@ -34,6 +36,9 @@ public:
 
     /// A fresh id: `prefix` + "_" + 16 random hex digits.
     static std::string newId(const std::string& prefix);
+    /// A content address: `prefix` + "_" + the first 16 hex digits of `digestHex` (a SHA-256 in
+    /// lower-case hex, io/sha256 toHex), so it has the shape of newId's ids.
+    static std::string contentId(const std::string& prefix, const std::string& digestHex);
     /// True for ids this store generates (prefix "m", "p" or "s").
     static bool isGeneratedId(const std::string& id, char prefix);
 

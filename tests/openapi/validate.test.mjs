@@ -222,6 +222,9 @@ try {
   // models: a .glb, a .gltf with its buffer as multipart parts, details, UV layout, delete
   const glb = readFileSync(join(source, "../shared/models/RiggedFigure/RiggedFigure.glb"));
   const uploaded = (await api("POST", "/models", { query: "name=RiggedFigure", body: { raw: glb, type: "model/gltf-binary" }, expect: 201 })).json();
+  // Content-addressed (issue #14): the same bytes again answer 200 with the same id.
+  const again = (await api("POST", "/models", { query: "name=copy", body: { raw: glb, type: "model/gltf-binary" }, expect: 200 })).json();
+  assert.equal(again.id, uploaded.id);
   await api("POST", "/models", { body: { raw: "not a model", type: "text/plain" }, expect: 415 });
   const jsonLength = glb.readUInt32LE(12);
   const gltf = JSON.parse(glb.subarray(20, 20 + jsonLength).toString("utf8"));
@@ -248,6 +251,7 @@ try {
   // patterns
   const png = readFileSync(join(source, "patterns/crease.png"));
   const pattern = (await api("POST", "/patterns", { query: "name=my%20crease", body: { raw: png, type: "image/png" }, expect: 201 })).json();
+  assert.equal((await api("POST", "/patterns", { body: { raw: png, type: "image/png" }, expect: 200 })).json().id, pattern.id);
   await api("POST", "/patterns", { body: { raw: "junk", type: "image/png" }, expect: 415 });
   const patterns = (await api("GET", "/patterns", { expect: 200 })).json().patterns;
   assert.ok(patterns.some((p) => p.builtin) && patterns.some((p) => p.id === pattern.id));

@@ -1,0 +1,175 @@
+// frame (one frame to a file), maps (height and normal maps), render (an animation range through
+// the batch route, each frame written atomically as its part arrives; --resume skips frames whose
+// file exists — a file exists only complete, as it is renamed into place).
+#include "batch.hpp"
+#include "commands.hpp"
+#include "frames.hpp"
+#include "http_client.hpp"
+#include "output.hpp"
+
+#include <filesystem>
+#include <iostream>
+
+namespace dermis::cli {
+
+namespace {
+
+struct FrameOptions {
+    std::string id, sceneFile, out, frames, size, view = "shaded", map, format;
+    double time = -1, yaw = 0, pitch = 0, distance = 0;
+    int width = 0, height = 0, msaa = 0, revision = 0, batch = 100;
+    bool hasYaw = false, hasPitch = false, hasDistance = false, resume = false;
+};
+
+/// "WxH" → [W, H]; CliError exit 2 (field --size) otherwise.
+nlohmann::json parseSize(const std::string& size) {
+    int w = 0, h = 0;
+    char tail = 0;
+    if (std::sscanf(size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1)
+        throw usageError("expected WxH, got \"" + size + "\"", "--size");
+    return {w, h};
+}
+
+void addCameraOptions(CLI::App* cmd, const std::shared_ptr<FrameOptions>& o) {
+    cmd->add_option("--yaw", o->yaw, "Camera yaw, degrees");
+    cmd->add_option("--pitch", o->pitch, "Camera pitch, degrees (-90 … 90)");
+    cmd->add_option("--distance", o->distance, "Camera distance (default: the scene's, auto frames the model)");
+}
+
+} // namespace
+
+void addRenderCommands(CLI::App& app, Context& ctx) {
+    auto o = std::make_shared<FrameOptions>();
+
+    CLI::App* frame = app.add_subcommand("frame", "Render one frame of a scene to a file (.png or .jpg: the format from the extension)");
+    frame->add_option("id", o->id, "Scene id")->required();
+    frame->add_option("-o,--out", o->out, "Output file (.png, .jpg, .jpeg)")->required();
+    frame->add_option("--width", o->width, "Width in pixels (default the scene's render.size)")->check(CLI::PositiveNumber);
+    frame->add_option("--height", o->height, "Height in pixels")->check(CLI::PositiveNumber);
+    frame->add_option("--time", o->time, "Seconds into the pose's clip")->check(CLI::NonNegativeNumber);
+    frame->add_option("--msaa", o->msaa, "Samples: 1, 2 or 4")->check(CLI::IsMember({1, 2, 4}));
+    frame->add_option("--view", o->view, "shaded, or bump / displacement / normal")
+        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
+    frame->add_option("--revision", o->revision, "The scene as it was at this revision")->check(CLI::PositiveNumber);
+    addCameraOptions(frame, o);
+    frame->callback([&ctx, o, frame] {
+        ctx.action = [&ctx, o, frame] {
+            const std::string format = imageFormatOf(o->out);
+            if (format.empty()) throw usageError("the file name must end in .png, .jpg or .jpeg", "--out");
+            std::vector<std::pair<std::string, std::string>> q = {{"format", format}};
+            if (o->width) q.push_back({"width", std::to_string(o->width)});
+            if (o->height) q.push_back({"height", std::to_string(o->height)});
+            if (o->time >= 0) q.push_back({"time", nlohmann::json(o->time).dump()});
+            if (o->msaa) q.push_back({"msaa", std::to_string(o->msaa)});
+            if (o->view != "shaded") q.push_back({"view", o->view});
+            if (o->revision) q.push_back({"revision", std::to_string(o->revision)});
+            if (frame->count("--yaw")) q.push_back({"yaw", nlohmann::json(o->yaw).dump()});
+            if (frame->count("--pitch")) q.push_back({"pitch", nlohmann::json(o->pitch).dump()});
+            if (frame->count("--distance")) q.push_back({"distance", nlohmann::json(o->distance).dump()});
+            Reply r = ctx.http().get(scenePath(o->id) + "/frame?" + queryString(q));
+            writeFileAtomically(o->out, r.body);
+            if (!ctx.global.json) std::cout << o->out << "\n";
+            else printJson({{"file", o->out}, {"bytes", r.body.size()}, {"backend", r.header("X-Dermis-Backend")}});
+            return kExitOk;
+        };
+    });
+
+    CLI::App* maps = app.add_subcommand("maps", "Write a scene's bump or displacement height map, or its normal map (format from the extension: .png, .exr, .f32)");
+    maps->add_option("id", o->id, "Scene id")->required();
+    maps->add_option("map", o->map, "bump, displacement or normal")->required()->check(CLI::IsMember({"bump", "displacement", "normal"}));
+    maps->add_option("-o,--out", o->out, "Output file: .png (16-bit grey; normal: 8-bit RGB), .exr, .f32 (raw floats)")->required();
+    maps->callback([&ctx, o] {
+        ctx.action = [&ctx, o] {
+            const std::string ext = extensionOf(o->out);
+            std::string format;
+            if (ext == "png") format = o->map == "normal" ? "png" : "png16";
+            else if (ext == "exr") format = "exr";
+            else if (ext == "f32" && o->map != "normal") format = "f32";
+            else throw usageError("the file name must end in .png, .exr" + std::string(o->map == "normal" ? "" : " or .f32"), "--out");
+            Reply r = ctx.http().get(scenePath(o->id) + "/heightmaps/" + o->map + "?format=" + format);
+            writeFileAtomically(o->out, r.body);
+            if (!ctx.global.json) std::cout << o->out << "\n";
+            else printJson({{"file", o->out}, {"bytes", r.body.size()}});
+            return kExitOk;
+        };
+    });
+
+    CLI::App* render = app.add_subcommand("render", "Render an animation range to files through the batch route (POST /render), each frame written as it arrives");
+    render->add_option("id", o->id, "Scene id (or --scene-file)");
+    render->add_option("--scene-file", o->sceneFile, "A scene document to render instead of a stored scene")->check(CLI::ExistingFile);
+    render->add_option("--frames", o->frames, "A:B:STEP in seconds: frame k at A + k·STEP (as dermis-server render)")->required();
+    render->add_option("-o,--out", o->out, "File pattern with a %04d-style field, e.g. out/frame_%04d.png (.png or .jpg)")->required();
+    render->add_option("--size", o->size, "WxH (overrides the scene's render.size)");
+    render->add_option("--view", o->view, "shaded, or bump / displacement / normal")
+        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
+    render->add_flag("--resume", o->resume, "Skip frames whose file exists (files appear only complete)");
+    render->add_option("--batch", o->batch, "Frames per request (default 100; the server allows limits.max_batch_frames)")
+        ->check(CLI::Range(1, 100000));
+    render->callback([&ctx, o] {
+        ctx.action = [&ctx, o] {
+            if (o->id.empty() == o->sceneFile.empty()) throw usageError("give a scene id or --scene-file, not both", "id");
+            const std::string format = imageFormatOf(o->out);
+            if (format.empty()) throw usageError("the file name must end in .png, .jpg or .jpeg", "--out");
+            const std::vector<double> times = parseFrameRange(o->frames, "--frames");
+            if (times.size() > 1 && framePath(o->out, 0) == o->out)
+                throw usageError("a frame range needs a %04d-style field in the file name", "--out");
+            nlohmann::json scene = o->sceneFile.empty() ? ctx.http().getJson(scenePath(o->id))["scene"]
+                                                        : readJsonFile(o->sceneFile, "--scene-file");
+            if (!o->size.empty()) scene["render"]["size"] = parseSize(o->size);
+
+            std::vector<std::size_t> pending;
+            for (std::size_t k = 0; k < times.size(); ++k)
+                if (!o->resume || !std::filesystem::exists(framePath(o->out, static_cast<int>(k)))) pending.push_back(k);
+            const std::size_t skipped = times.size() - pending.size();
+            Progress progress("frames", pending.size(), stdoutIsTerminal() && !ctx.global.json);
+            std::vector<std::size_t> failed;
+            std::vector<std::string> failures;
+            bool interrupted = false;
+            std::size_t next = 0;
+            while (next < pending.size() && !interrupted) {
+                const std::size_t count = std::min(pending.size() - next, static_cast<std::size_t>(o->batch));
+                nlohmann::json frames = nlohmann::json::array();
+                for (std::size_t j = 0; j < count; ++j) frames.push_back({{"time", times[pending[next + j]]}});
+                BatchOutcome r = renderBatch(ctx.http(), scene, frames, format, o->view, [&](std::size_t j, std::string bytes) {
+                    const std::size_t k = pending[next + j];
+                    const std::string path = framePath(o->out, static_cast<int>(k));
+                    writeFileAtomically(path, bytes);
+                    if (!ctx.global.json) progress.step("frame " + std::to_string(k) + " " + path);
+                    return true;
+                });
+                interrupted = r.interrupted;
+                if (r.failedFrame >= 0) {
+                    // The stream ended at that frame: note it and go on after it.
+                    failed.push_back(pending[next + static_cast<std::size_t>(r.failedFrame)]);
+                    failures.push_back(r.failure);
+                    if (!ctx.global.json) progress.step("frame " + std::to_string(failed.back()) + " failed: " + r.failure, true);
+                    next += static_cast<std::size_t>(r.failedFrame) + 1;
+                } else {
+                    next += r.received;
+                }
+            }
+            progress.finish();
+            const std::size_t written = next - failed.size();
+            const double seconds = progress.seconds();
+            if (ctx.global.json) {
+                printJson({{"frames", times.size()}, {"written", written}, {"skipped", skipped}, {"failed", failed},
+                           {"interrupted", interrupted}, {"seconds", seconds},
+                           {"frames_per_second", seconds > 0 ? double(written) / seconds : 0.0}});
+            } else {
+                char line[200];
+                std::snprintf(line, sizeof line, "rendered %zu frames of %zu (%zu skipped, %zu failed) in %.2f s, %.1f frames/s", written,
+                              times.size(), skipped, failed.size(), seconds, seconds > 0 ? double(written) / seconds : 0.0);
+                std::cout << line << "\n";
+            }
+            for (std::size_t f = 0; f < failed.size(); ++f)
+                std::cerr << "dermis: error: frame " << failed[f] << ": " << failures[f] << "\n";
+            if (interrupted) {
+                std::cerr << "dermis: interrupted: " << written << " frames written, run again with --resume for the rest\n";
+                return kExitInterrupted;
+            }
+            return failed.empty() ? kExitOk : kExitFramesFailed;
+        };
+    });
+}
+
+} // namespace dermis::cli
