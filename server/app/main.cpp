@@ -1,6 +1,6 @@
 // dermis-server — command line entry point. The offline commands:
 //   dermis-server bake   --scene S.json --out DIR [--time T] [--threads N] [--png] [--gpu] [--normals] [--gl B]
-//   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH]
+//   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH] [--msaa N]
 //                        [--view V] [--heightmaps] [--gl B]
 //   dermis-server info   [--gl B]
 //   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B]

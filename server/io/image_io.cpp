@@ -8,6 +8,7 @@
 #include "io/oiio_loader.hpp"
 
 #include <png.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
@@ -167,6 +168,13 @@ bool writeGrey16(png_structp png, png_infop info, PngWriteJob* job, int w, int h
     png_set_IHDR(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), 16,
                  PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                  PNG_FILTER_TYPE_DEFAULT);
+    // As OpenImageIO's PNG writer wrote these files before (the committed pattern library is
+    // reproduced byte for byte): an oFFs chunk of (0, 0) pixels, zlib level 6, libpng's
+    // adaptive filtering, zlib's default strategy (libpng's own default for filtered rows is
+    // Z_FILTERED).
+    png_set_oFFs(png, info, 0, 0, PNG_OFFSET_PIXEL);
+    png_set_compression_level(png, 6);
+    png_set_compression_strategy(png, Z_DEFAULT_STRATEGY);
     png_write_info(png, info);
     png_set_swap(png); // host-order samples → big-endian
     png_write_image(png, job->rows.data());
