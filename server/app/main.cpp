@@ -1,6 +1,6 @@
 // dermis-server — command line entry point. The offline commands:
 //   dermis-server bake   --scene S.json --out DIR [--time T] [--threads N] [--png] [--gpu] [--normals] [--gl B]
-//   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH]
+//   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH] [--msaa N]
 //                        [--view V] [--heightmaps] [--gl B]
 //   dermis-server info   [--gl B]
 //   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B]
@@ -11,6 +11,7 @@
 #include "gl/renderer.hpp"
 #include "core/frame_plan.hpp"
 #include "io/frame_io.hpp"
+#include "io/frame_queue.hpp"
 #include "io/image_io.hpp"
 #include "io/scene_files.hpp"
 #include "http/api.hpp"
@@ -23,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <regex>
 #include <csignal>
@@ -120,6 +122,7 @@ int runBake(const BakeArgs& a) {
 struct RenderArgs {
     std::string scene, out, gl = "auto", frames, size, content, view = "shaded";
     double time = 0.0;
+    int msaa = 0; ///< 0: the scene's render.msaa
     bool hasTime = false, heightmaps = false;
 };
 
@@ -185,6 +188,7 @@ int runRender(const RenderArgs& a) {
     }
     FrameOverrides overrides;
     overrides.view = frameViewFromString(a.view).value_or(FrameView::Shaded); // checked by CLI11
+    if (a.msaa) overrides.msaa = a.msaa;
     if (!a.size.empty()) {
         int w = 0, h = 0;
         char tail = 0;
@@ -194,8 +198,13 @@ int runRender(const RenderArgs& a) {
         overrides.width = w;
         overrides.height = h;
     }
+    // The GL context starts (EGL, shader compilation) on the renderer's thread while this thread
+    // loads and parses the scene, its model and patterns: the two take similar time cold.
+    auto rendererStart = std::async(std::launch::async, [&] { return Renderer::create(backendOf(a.gl)); });
     auto loaded = loadSceneFile(a.scene, a.content.empty() ? dermisContentDir() : a.content);
+    auto renderer = rendererStart.get();
     if (!loaded) return fail(loaded.error());
+    if (!renderer) return fail(renderer.error());
     if (!animation) times = {a.hasTime ? a.time : loaded->scene.pose.time};
     // The one range check of render settings (size included) runs in planFrame; "--size" is named
     // when the size it set is out of range.
@@ -207,11 +216,12 @@ int runRender(const RenderArgs& a) {
         return e;
     };
 
-    auto renderer = Renderer::create(backendOf(a.gl));
-    if (!renderer) return fail(renderer.error());
     auto model = std::make_shared<const Model>(std::move(loaded->model));
     const RenderSettings* used = nullptr;
     RenderSettings last;
+    // Frames are encoded and written on a worker while the next one renders (at most two waiting:
+    // bounded memory). Each file's bytes are those of the sequential path (deterministic encoders).
+    FrameWriteQueue writer(1, 2);
     for (std::size_t k = 0; k < times.size(); ++k) {
         overrides.time = times[k];
         auto plan = planFrame(loaded->scene, *model, loaded->images, loaded->base, overrides);
@@ -223,16 +233,23 @@ int runRender(const RenderArgs& a) {
         auto result = (*renderer)->renderFrame(request);
         if (!result) return fail(result.error());
         const std::string path = animation ? framePath(a.out, static_cast<int>(k)) : a.out;
-        if (auto s = createFolderOf(path); !s) return fail(s.error());
-        if (auto s = writeFrame(path, result->image); !s) return fail(s.error());
-        if (a.heightmaps && result->maps) {
-            const std::string stem = withoutExtension(path);
-            if (auto s = writeFloatImage(stem + ".bump.exr", result->maps->bump); !s)
-                return fail(s.error());
-            if (auto s = writeFloatImage(stem + ".displacement.exr", result->maps->displacement); !s)
-                return fail(s.error());
-        }
+        auto frame = std::make_shared<FrameResult>(std::move(*result));
+        const bool heightmaps = a.heightmaps;
+        auto job = [path, frame, heightmaps]() -> Status {
+            if (auto s = createFolderOf(path); !s) return s;
+            if (auto s = writeFrame(path, frame->image); !s) return s;
+            if (heightmaps && frame->maps) {
+                const std::string stem = withoutExtension(path);
+                if (auto s = writeFloatImage(stem + ".bump.exr", frame->maps->bump); !s) return s;
+                if (auto s = writeFloatImage(stem + ".displacement.exr", frame->maps->displacement); !s)
+                    return s;
+            }
+            return Ok{};
+        };
+        if (auto s = times.size() == 1 ? job() : writer.push(std::move(job)); !s)
+            return fail(s.error());
     }
+    if (auto s = writer.finish(); !s) return fail(s.error());
     std::cout << "rendered " << times.size() << (times.size() == 1 ? " frame" : " frames") << " of "
               << used->size[0] << "x" << used->size[1] << " with "
               << (*renderer)->info().backend << " (" << (*renderer)->info().renderer << ") to "
@@ -420,6 +437,8 @@ int main(int argc, char** argv) {
                           "Animation range A:B:STEP in seconds (frame k at A + k·STEP)")
         ->excludes(timeOpt);
     renderCmd->add_option("--size", render.size, "Frame size WxH (overrides render.size)");
+    renderCmd->add_option("--msaa", render.msaa, "Samples per pixel 1, 2 or 4 (overrides render.msaa)")
+        ->check(CLI::IsMember({1, 2, 4}));
     renderCmd->add_option("--view", render.view,
                           "shaded (default), or unlit: bump / displacement height as grey, normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));

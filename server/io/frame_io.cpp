@@ -1,4 +1,4 @@
-// Frame encoders (libpng, libjpeg-turbo, OpenImageIO for EXR) and file writing. See frame_io.hpp
+// Frame encoders (zlib for PNG, libjpeg-turbo, the OpenImageIO module for EXR) and file writing. See frame_io.hpp
 // for the formats and failure modes.
 //
 // PNG settings, measured on 1024² RGBA frames on the 2-core development machine (median of 7):
@@ -13,9 +13,8 @@
 #include "frame_io.hpp"
 
 #include "io/atomic_file.hpp"
+#include "io/oiio_loader.hpp"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <png.h>
 #include <turbojpeg.h>
 #include <zlib.h>
@@ -160,20 +159,14 @@ Result<std::vector<std::uint8_t>> encodeExr(const Image8& img) {
         px[k + 2] = lut[img.rgba[k + 2]];
         px[k + 3] = img.rgba[k + 3] / 255.0f;
     }
-    std::vector<unsigned char> buf;
-    OIIO::Filesystem::IOVecOutput proxy(buf);
-    auto out = OIIO::ImageOutput::create("frame.exr", &proxy);
-    if (!out) {
-        std::string detail = OIIO::geterror();
-        return makeError(ErrorCode::Unsupported, where, "format",
-                         "OpenImageIO has no EXR writer" +
-                             (detail.empty() ? "" : " (" + detail + ")"));
-    }
-    OIIO::ImageSpec spec(img.width, img.height, 4, OIIO::TypeDesc::HALF);
-    if (!out->open("frame.exr", spec) || !out->write_image(OIIO::TypeDesc::FLOAT, px.data()) ||
-        !out->close())
-        return makeError(ErrorCode::Io, where, "", "cannot encode EXR: " + out->geterror());
-    return std::vector<std::uint8_t>(buf.begin(), buf.end());
+    auto api = oiio::oiioApi();
+    if (!api) return api.error();
+    const char* names[] = {"R", "G", "B", "A"};
+    std::vector<std::uint8_t> out;
+    oiio::OiioFailure f;
+    if (!(*api)->encodeExr(img.width, img.height, 4, names, px.data(), true, out, f))
+        return makeError(f.code, where, f.field, f.what);
+    return out;
 }
 
 } // namespace

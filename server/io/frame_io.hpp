@@ -1,6 +1,7 @@
-// Dermis io shell — rendered frames out: fast PNG (libpng) and JPEG (libjpeg-turbo) encoders to
-// memory for the server's responses, linear-light EXR through OpenImageIO, and writing any of
-// them to a file by extension.
+// Dermis io shell — rendered frames out: fast PNG (zlib) and JPEG (libjpeg-turbo) encoders to
+// memory for the server's responses, linear-light EXR through OpenImageIO in the module
+// libdermis_oiio.so (loaded on first EXR, oiio_loader.hpp), and writing any of them to a file by
+// extension.
 //
 // Frames are dermis::Image8: 8-bit RGBA, row 0 = top of the picture, colours sRGB-encoded, alpha
 // straight (not premultiplied) and stored as is in every format (EXR included: RGB are not
@@ -11,7 +12,8 @@
 // field ("image", "image.rgba"); a bad argument → InvalidArgument naming it ("quality", the path
 // for an unknown extension); a file that cannot be created, written or renamed into place →
 // ErrorCode::Io with the path as `field`; an encoder's internal failure → ErrorCode::Io (for
-// EXR, ErrorCode::Unsupported when OpenImageIO has no EXR writer); undecodable bytes in
+// EXR, ErrorCode::Unsupported when OpenImageIO has no EXR writer, ErrorCode::Unavailable when
+// the module cannot be loaded); undecodable bytes in
 // decodeFrame → ErrorCode::Parse.
 #pragma once
 

@@ -3,7 +3,8 @@
 //   1. parseGltf: bytes → Model (nodes, joints, mesh parts, materials, clips). Embedded or
 //      buffer-view images are captured as encoded bytes (tinygltf's image-loader hook) but not
 //      decoded.
-//   2. loadGltfResources: decodes the captured images with OpenImageIO into Model::images.
+//   2. loadGltfResources: decodes the captured images (decodeImage8: PNG and JPEG directly,
+//      other formats through the OpenImageIO module) into Model::images.
 // loadGltfFile does both for a file on disk (external .bin/.png resolved beside the .gltf),
 // loadGltfFromFiles for a .gltf and its files held in memory (an upload).
 //
@@ -105,9 +106,9 @@ struct ParsedGltf {
 Result<ParsedGltf> parseGltf(const std::vector<std::uint8_t>& bytes, const std::string& baseDir,
                              const GltfLimits& limits = {});
 
-/// Step 2. Decodes every pending image to RGBA8 (OpenImageIO, through decodeImage8) into
-/// parsed.model.images and clears parsed.images. A corrupt image is an error (field
-/// "/images/<i>"), leaving the model's images partly filled. Before decoding anything, reads
+/// Step 2. Decodes every pending image to RGBA8 (decodeImage8: libpng / libjpeg-turbo, else the
+/// OpenImageIO module) into parsed.model.images and clears parsed.images. A corrupt image is an
+/// error (field "/images/<i>"), leaving the model's images partly filled. Before decoding anything, reads
 /// every image's declared size from its header: not a PNG or JPEG → Unsupported; the declared
 /// sizes over limits.maxTextureBytes in all → TooLarge (nothing decoded). Images with a side over
 /// limits.maxImageSide are downscaled after decoding.

@@ -1,6 +1,11 @@
-// Dermis io shell — pattern images in, float height maps out (to memory or to a file), through
-// OpenImageIO. Encoded bytes are decoded from memory only (an IOProxy), never through a file;
-// a format whose plugin cannot read from memory is Unsupported.
+// Dermis io shell — pattern images in, float height maps out (to memory or to a file). PNG and
+// JPEG are decoded directly (libpng, libjpeg-turbo: image_decode.hpp) and 16-bit PNGs written
+// with libpng; every other format (EXR in and out, TIFF, BMP, HDR, WebP, GIF, TGA, PSD, CMYK
+// JPEG, and PNGs with alpha read from a file) goes through OpenImageIO in the module
+// libdermis_oiio.so, loaded on first use (oiio_loader.hpp): when it cannot be loaded those
+// formats fail with ErrorCode::Unavailable naming the module. Encoded bytes are decoded from
+// memory only (an IOProxy for OpenImageIO), never through a file; a format whose plugin cannot
+// read from memory is Unsupported.
 //
 // Value mapping of SPEC §2: 16-bit unsigned L = clamp((v − 32768)/32767, −1, 1); 8-bit unsigned
 // L = clamp((v − 128)/127, −1, 1); half/float/double images as they are, clamped to [−1, 1]; any
@@ -30,11 +35,13 @@ Result<HeightImage> readHeightImage(const std::string& path);
 Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes);
 
 /// Encodes a height map in memory as a single-channel ("Y") 32-bit float OpenEXR, row 0 first,
-/// values as they are. InvalidArgument for an empty or inconsistent image; Unsupported when
-/// OpenImageIO cannot write EXR to memory.
+/// values as they are, through the OpenImageIO module with its default compression.
+/// InvalidArgument for an empty or inconsistent image; Unsupported when OpenImageIO cannot write
+/// EXR to memory; Unavailable when the module cannot be loaded.
 Result<std::vector<std::uint8_t>> encodeFloatExr(const HeightImage& image);
 /// Encodes a height map in memory as a 16-bit grey PNG with the inverse of the 16-bit mapping:
-/// v = round(32768 + 32767·clamp(L, −1, 1)) (L = 0 → 32768; NaN → 32768). Same failures.
+/// v = round(32768 + 32767·clamp(L, −1, 1)) (L = 0 → 32768; NaN → 32768), with libpng's
+/// default compression. InvalidArgument for an empty or inconsistent image.
 Result<std::vector<std::uint8_t>> encodeHeight16Png(const HeightImage& image);
 /// The raw map: width·height little-endian IEEE-754 float32 values, row 0 first, no header
 /// (the server's `f32` format). InvalidArgument for an empty or inconsistent image.
@@ -45,7 +52,8 @@ Status writeFloatImage(const std::string& path, const HeightImage& image);
 /// encodeHeight16Png to a file, replaced whole.
 Status writeHeight16Png(const std::string& path, const HeightImage& image);
 
-/// Decodes an encoded image (PNG, JPEG, …) to RGBA8 (grey → RGB, missing alpha → 255).
+/// Decodes an encoded image (PNG, JPEG, …) to RGBA8 (grey → RGB, missing alpha → 255, alpha
+/// unassociated, 16-bit samples rounded to 8 bits), PNG and JPEG without the module.
 Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes);
 
 } // namespace dermis
