@@ -13,6 +13,7 @@
 #include "frame_io.hpp"
 
 #include "io/atomic_file.hpp"
+#include "io/webp_encode.hpp"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
@@ -185,6 +186,7 @@ std::optional<FrameFormat> frameFormatFromPath(const std::string& path) {
     if (ext == ".png") return FrameFormat::Png;
     if (ext == ".jpg" || ext == ".jpeg") return FrameFormat::Jpeg;
     if (ext == ".exr") return FrameFormat::Exr;
+    if (ext == ".webp") return FrameFormat::Webp;
     return std::nullopt;
 }
 
@@ -265,6 +267,8 @@ Result<std::vector<std::uint8_t>> encodeFrame(const Image8& img, FrameFormat f) 
         return encodeJpeg(img, 90);
     case FrameFormat::Exr:
         return encodeExr(img);
+    case FrameFormat::Webp:
+        return encodeWebpLossless(img, true);
     }
     return makeError(ErrorCode::InvalidArgument, "dermis::encodeFrame", "format",
                      "unknown frame format");
@@ -275,7 +279,7 @@ Status writeFrame(const std::string& path, const Image8& img) {
     const auto format = frameFormatFromPath(path);
     if (!format)
         return makeError(ErrorCode::InvalidArgument, where, path,
-                         "unknown frame format: the extension must be .png, .jpg, .jpeg or .exr");
+                         "unknown frame format: the extension must be .png, .jpg, .jpeg, .exr or .webp");
     if (auto s = checkFrame(where, img); !s) return s.error();
     auto bytes = encodeFrame(img, *format);
     if (!bytes) return bytes.error();
