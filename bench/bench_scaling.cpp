@@ -13,7 +13,7 @@
 //   triangles: the character midpoint-subdivided 0–3 times (≈ 4.3k, 17k, 69k, 276k);
 //   joints: the character's, 200 (withSyntheticJoints).
 // Frame time = pose + plan + height maps + skin pass + readback (no encode: see "encoders"), the
-// pose moving along the squat clip so the height pass never hits its cache. Median of 5
+// pose moving along the squat clip so the height pass never hits its cache. Median of 7
 // repetitions after a warm-up (3 for the big cases), so the run stays within a few minutes on two
 // cores with llvmpipe.
 #include "bench_parts.hpp"
@@ -87,7 +87,7 @@ int benchScaling(Renderer& renderer, const DefaultScene& ds, nlohmann::json& out
         scene.render.msaa = 1;
         scene.heightmapSize = {c.mapSize, c.mapSize};
         const bool big = c.placements >= 1000 || c.mapSize >= 4096 || c.subdivisions >= 3;
-        const int repeat = big ? 3 : 5;
+        const int repeat = big ? 3 : 7;
         for (bool cpuMaps : {false, true}) {
             std::vector<double> total, heights;
             for (int r = 0; r <= repeat; ++r) {
