@@ -2,8 +2,9 @@
 //
 // One series per variable, the others at the default (15 placements, 1024² maps, the default
 // character ≈ 4.3k triangles and its joints, 1024² frame, MSAA off), each with GPU height maps
-// (the GL height pass) and CPU height maps (bakeHeightMapsInto on all hardware threads, then
-// uploaded):
+// (the renderer's height pass: the GL pass, or on a software rasterizer the CPU bake when the
+// footprints cover more than two map areas, see RendererOptions) and CPU height maps
+// (bakeHeightMapsInto on all hardware threads, then uploaded):
 //   placements 15, 100, 1000 — synthetic placements built from the scene's 15 (same patterns and
 //     footprint sizes, centres and rotations spread over the UV square, every one active, its t
 //     moving every frame), given to the renderer directly: more than a scene document allows
@@ -90,6 +91,7 @@ int benchScaling(Renderer& renderer, const DefaultScene& ds, nlohmann::json& out
         const int repeat = big ? 3 : 7;
         for (bool cpuMaps : {false, true}) {
             std::vector<double> total, heights;
+            const std::size_t onCpuBefore = renderer.stats().heightPassesOnCpu;
             for (int r = 0; r <= repeat; ++r) {
                 const auto t0 = std::chrono::steady_clock::now();
                 FrameOverrides overrides;
@@ -131,6 +133,9 @@ int benchScaling(Renderer& renderer, const DefaultScene& ds, nlohmann::json& out
                                   {"frame_ms", round2(medianMs(total))},
                                   {"repetitions", total.size()}};
             if (cpuMaps) row["cpu_bake_ms"] = round2(medianMs(heights));
+            // GPU rows on a software rasterizer: whether the renderer baked the big passes on the
+            // CPU (RendererOptions::softwareCpuBakeCoverage).
+            else row["gl_pass_baked_on_cpu"] = renderer.stats().heightPassesOnCpu > onCpuBefore;
             out.push_back(row);
             std::cerr << "scaling: " << row.dump() << "\n";
         }
