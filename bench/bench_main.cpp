@@ -252,7 +252,7 @@ int main(int argc, char** argv) {
         if (gpu) {
             if (int rc = benchFrames(**renderer, *ds, repeat, cases); rc != 0) return rc;
             encoders = nlohmann::json::array();
-            if (int rc = benchEncoders(**renderer, *ds, std::max(3, repeat / 3), encoders); rc != 0)
+            if (int rc = benchEncoders(**renderer, *ds, std::max(5, repeat), encoders); rc != 0)
                 return rc;
         }
         if (scaling) {

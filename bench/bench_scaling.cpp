@@ -8,8 +8,8 @@
 //   placements 15, 100, 1000 — synthetic placements built from the scene's 15 (same patterns and
 //     footprint sizes, centres and rotations spread over the UV square, every one active, its t
 //     moving every frame), given to the renderer directly: more than a scene document allows
-//     (kMaxPlacements); the coverage of the map grows with the count (≈ 0.35× the map's area at
-//     15, ≈ 23× at 1000);
+//     (kMaxPlacements); the coverage of the map grows with the count (Σ footprint areas ≈ 0.07 map
+//     areas at 15, ≈ 4.8 at 1000);
 //   map size 512², 1024², 2048², 4096²;
 //   triangles: the character midpoint-subdivided 0–3 times (≈ 4.3k, 17k, 69k, 276k);
 //   joints: the character's, 200 (withSyntheticJoints).

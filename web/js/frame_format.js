@@ -2,16 +2,16 @@
 // that this browser can show, from the encode times dermis-bench measures (README "Encoders",
 // 512² frame on the 2-core reference machine).
 //
-// While a gesture runs (a drag, a slider) frames are previews: JPEG (quality 90), ≈ 10× faster
+// While a gesture runs (a drag, a slider) frames are previews: JPEG (quality 90), 4–15× faster
 // to encode than any lossless format and 4× smaller. Otherwise frames are lossless: the faster of
 // PNG and lossless WebP that the browser decodes — WebP is probed once at start-up by decoding a
 // 1×1 lossless WebP with createImageBitmap (no network). PNG's multi-threaded encoder measures
-// faster than libwebp's fastest lossless preset there (WebP is ≈ 15% smaller), so PNG is asked
-// for today; update LOSSLESS_ENCODE_MS if the figures change. The default format (png) is left
+// faster than libwebp's fastest lossless preset there (WebP is 17% smaller at 512²), so PNG is
+// asked for today; update LOSSLESS_ENCODE_MS if the figures change. The default format (png) is left
 // out of the URL, so frame URLs stay as they were.
 
 /// Median encode milliseconds of a 512² frame per lossless format (dermis-bench "encoders").
-export const LOSSLESS_ENCODE_MS = { png: 5.5, webp: 13.0 };
+export const LOSSLESS_ENCODE_MS = { png: 8.0, webp: 9.5 };
 
 // A 1×1 lossless WebP (VP8L), opaque white.
 const TINY_WEBP = "UklGRhoAAABXRUJQVlA4TA0AAAAvAAAAEAcQERGIiP4HAA==";
