@@ -1,7 +1,8 @@
 // dermis-bench — prints JSON figures (median milliseconds) for the paper's headline scenario.
 // Usage: dermis-bench [--repeat N] [--gl auto|egl-device|egl-surfaceless|osmesa] [--no-gpu]
-//                     [--no-cpu]   (--no-gpu: only the CPU cases; --no-cpu: only the frames)
-//   (default 15 repetitions after one warm-up run)
+//                     [--no-cpu] [--scaling | --only-scaling]
+//   (--no-gpu: only the CPU cases; --no-cpu: only the frames; default 15 repetitions after one
+//   warm-up run; --scaling adds part 4, --only-scaling runs only part 4)
 //
 // 1. cpu_heightmaps: 15 placements in texture space, CPU height maps at 1024² and 2048², one
 //    thread and all threads. Patterns are synthetic 512² smooth height fields (the built-in
@@ -11,11 +12,17 @@
 //    along the squat clip: height pass, skin pass, readback, PNG encode and total, at 512² and
 //    1024², MSAA off and 4x, with GPU height maps and with CPU height maps (the paper's "CPU"
 //    configuration). Stages are separated by glFinish.
+// 3. encoders (JSON "encoders"): PNG, JPEG, lossless WebP and EXR encode time and size of a
+//    512² and a 1024² frame of that scene (bench_encoders.cpp).
+// 4. scaling (JSON "scaling"): frame time against placements, map size, triangles and joints,
+//    GPU and CPU height maps (bench_scaling.cpp; bench/plot_scaling.py draws docs/scaling.png).
 #include "core/heightmap.hpp"
 #include "gl/renderer.hpp"
 #include "core/frame_plan.hpp"
 #include "io/frame_io.hpp"
 #include "io/scene_files.hpp"
+#include "bench_common.hpp"
+#include "bench_parts.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -29,6 +36,7 @@
 #include <thread>
 
 using namespace dermis;
+using namespace dermis::bench;
 
 namespace {
 
@@ -47,38 +55,32 @@ HeightImage makePattern(int n, unsigned seed) {
     return img;
 }
 
-double medianMs(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
-double round2(double v) { return std::round(v * 100) / 100; }
+} // namespace
 
-double msSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-/// The per-frame loop on the default character; appends one result per configuration.
-int benchFrames(GlBackend backend, int repeat, nlohmann::json& cases, nlohmann::json& gpuInfo) {
-    auto renderer = Renderer::create(backend);
-    if (!renderer) {
-        std::cerr << renderer.error().message << "\n";
-        return 1;
-    }
-    const RendererInfo& info = (*renderer)->info();
-    gpuInfo = {{"backend", info.backend}, {"gl_renderer", info.renderer}, {"gl_version", info.version}};
+Result<DefaultScene> dermis::bench::loadDefaultScene() {
     auto loaded = loadSceneFile(dermisContentDir() + "/models/default.scene.json");
-    if (!loaded) {
-        std::cerr << loaded.error().message << "\n";
-        return 1;
-    }
-    Scene scene = loaded->scene;
-    if (scene.placements.size() > 15) scene.placements.resize(15);
-    scene.heightmapSize = {1024, 1024};
-    scene.pose.animation = "squat";
+    if (!loaded) return loaded.error();
+    DefaultScene ds;
+    ds.scene = loaded->scene;
+    if (ds.scene.placements.size() > 15) ds.scene.placements.resize(15);
+    ds.scene.heightmapSize = {1024, 1024};
+    ds.scene.pose.animation = "squat";
+    ds.images = loaded->images;
     auto model = std::make_shared<const Model>(std::move(loaded->model));
     const int clip = model->findClip("squat");
-    const double duration = clip >= 0 ? model->clips[static_cast<std::size_t>(clip)].duration : 1.0;
+    ds.clipDuration = clip >= 0 ? model->clips[static_cast<std::size_t>(clip)].duration : 1.0;
+    ds.model = std::move(model);
+    return ds;
+}
+
+namespace {
+
+/// The per-frame loop on the default character; appends one result per configuration.
+int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann::json& cases) {
+    Scene scene = ds.scene;
+    const auto& model = ds.model;
+    const double duration = ds.clipDuration;
     HeightMaps cpuHeights; // reused: no per-frame allocation
     for (bool cpuMaps : {false, true})
         for (int size : {512, 1024})
@@ -93,7 +95,7 @@ int benchFrames(GlBackend backend, int repeat, nlohmann::json& cases, nlohmann::
                         const auto t0 = std::chrono::steady_clock::now();
                         FrameOverrides overrides;
                         overrides.time = duration * (r % 8) / 8.0; // the pose moves every frame
-                        auto plan = planFrame(scene, *model, loaded->images, nullptr, overrides);
+                        auto plan = planFrame(scene, *model, ds.images, nullptr, overrides);
                         if (!plan) {
                             std::cerr << plan.error().message << "\n";
                             return 1;
@@ -111,7 +113,7 @@ int benchFrames(GlBackend backend, int repeat, nlohmann::json& cases, nlohmann::
                             request.heights.reset();
                             request.cpuMaps = &cpuHeights;
                         }
-                        auto result = (*renderer)->renderFrame(request);
+                        auto result = renderer.renderFrame(request);
                         if (!result) {
                             std::cerr << result.error().message << "\n";
                             return 1;
@@ -157,7 +159,7 @@ int benchFrames(GlBackend backend, int repeat, nlohmann::json& cases, nlohmann::
 
 int main(int argc, char** argv) {
     int repeat = 15;
-    bool gpu = true, cpu = true;
+    bool gpu = true, cpu = true, scaling = false;
     GlBackend backend = GlBackend::Auto;
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
@@ -173,8 +175,14 @@ int main(int argc, char** argv) {
             gpu = false;
         } else if (std::strcmp(argv[i], "--no-cpu") == 0) {
             cpu = false;
+        } else if (std::strcmp(argv[i], "--scaling") == 0) {
+            scaling = true;
+        } else if (std::strcmp(argv[i], "--only-scaling") == 0) {
+            scaling = true;
+            gpu = cpu = false;
         } else {
-            std::cerr << "usage: dermis-bench [--repeat N] [--gl BACKEND] [--no-gpu]\n";
+            std::cerr << "usage: dermis-bench [--repeat N] [--gl BACKEND] [--no-gpu] [--no-cpu] "
+                         "[--scaling | --only-scaling]\n";
             return 2;
         }
     }
@@ -227,12 +235,37 @@ int main(int argc, char** argv) {
                              {"repetitions", ms.size()}});
         }
     nlohmann::json gpuInfo = nullptr;
-    if (gpu)
-        if (int rc = benchFrames(backend, repeat, cases, gpuInfo); rc != 0) return rc;
+    nlohmann::json encoders = nullptr, scalingOut = nullptr;
+    if (gpu || scaling) {
+        auto renderer = Renderer::create(backend);
+        if (!renderer) {
+            std::cerr << renderer.error().message << "\n";
+            return 1;
+        }
+        const RendererInfo& info = (*renderer)->info();
+        gpuInfo = {{"backend", info.backend}, {"gl_renderer", info.renderer}, {"gl_version", info.version}};
+        auto ds = loadDefaultScene();
+        if (!ds) {
+            std::cerr << ds.error().message << "\n";
+            return 1;
+        }
+        if (gpu) {
+            if (int rc = benchFrames(**renderer, *ds, repeat, cases); rc != 0) return rc;
+            encoders = nlohmann::json::array();
+            if (int rc = benchEncoders(**renderer, *ds, std::max(5, repeat), encoders); rc != 0)
+                return rc;
+        }
+        if (scaling) {
+            scalingOut = nlohmann::json::array();
+            if (int rc = benchScaling(**renderer, *ds, scalingOut); rc != 0) return rc;
+        }
+    }
     nlohmann::json out = {{"benchmark", "dermis"},
                           {"hardware_threads", hw},
                           {"gl", gpuInfo},
-                          {"results", cases}};
+                          {"results", cases},
+                          {"encoders", encoders},
+                          {"scaling", scalingOut}};
     std::cout << out.dump(2) << "\n";
     return 0;
 }

@@ -6,7 +6,7 @@
 layout(std140, binding = 0) uniform HeightPassBlock {
     vec4 u_centerScale;  // footprint centre (u, v), footprint size (u, v) in UV units
     vec4 u_rotation;     // cos(rotation), sin(rotation), quad margin (s units, x and y)
-    vec4 u_drive;        // h, t, 0, 0
+    vec4 u_drive;        // h, t, gain(t) or offset(t) (dermis::deformConstant), 0
     ivec4 u_mode;        // model (0 scale, 1 bias), target (0 bump, 1 displacement), response, 0
     vec4 u_mapSize;      // map width, height, pattern width, height (texels)
 };

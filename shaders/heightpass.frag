@@ -22,21 +22,6 @@ float samplePattern(vec2 s) {
     return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
 }
 
-// gain(t) of the scale model and offset(t) of the bias model (SPEC §2 table).
-float gainOrOffset(int model, int response, float t) {
-    float smooth_t = t * t * (3.0 - 2.0 * t);
-    if (model == 0) {
-        if (response == 0) return log2(1.0 + t);
-        if (response == 1) return log(1.0 + t);
-        if (response == 2) return t;
-        return smooth_t;
-    }
-    if (response == 0) return log2(2.0 - t);
-    if (response == 1) return log(2.0 - t);
-    if (response == 2) return 1.0 - t;
-    return 1.0 - smooth_t;
-}
-
 void main() {
     vec2 uv = gl_FragCoord.xy / u_mapSize.xy;
     vec2 d = uv - u_centerScale.xy;
@@ -46,16 +31,18 @@ void main() {
     if (any(lessThan(s, vec2(0.0))) || any(greaterThan(s, vec2(1.0)))) discard;
 
     float L = samplePattern(s);
-    float h = u_drive.x, t = u_drive.y;
+    // u_drive.z: gain(t) (scale) or offset(t) (bias) of SPEC §2's table, computed once per
+    // placement on the CPU (dermis::deformConstant) instead of a log per fragment.
+    float h = u_drive.x, t = u_drive.y, k = u_drive.z;
     float value;
     if (t <= 0.0) {
         value = 0.0;
     } else if (t >= 1.0) {
         value = L * h;                                        // both models at t = 1
     } else if (u_mode.x == 0) {
-        value = L * h * gainOrOffset(0, u_mode.z, t);         // scale model, paper eq. 1
+        value = L * h * k;                                    // scale model, paper eq. 1
     } else {
-        value = max(h * (L - gainOrOffset(1, u_mode.z, t)), 0.0); // bias model, paper eq. 2
+        value = max(h * (L - k), 0.0);                        // bias model, paper eq. 2
     }
     o_heights = u_mode.y == 0 ? vec2(value, 0.0) : vec2(0.0, value);
 }

@@ -2,6 +2,7 @@
 // Writes temporary files; reads them back with decodeFrame and, independently, OpenImageIO.
 #include "TestFiles.hpp"
 #include "io/frame_io.hpp"
+#include "io/webp_encode.hpp"
 
 #include <gtest/gtest.h>
 
@@ -86,6 +87,8 @@ TEST(FrameIoTest, FormatFromExtension) {
     EXPECT_EQ(frameFormatFromPath("x.JpEg"), FrameFormat::Jpeg);
     EXPECT_EQ(frameFormatFromPath("/a.b/c.exr"), FrameFormat::Exr);
     EXPECT_EQ(frameFormatFromPath("c.EXR"), FrameFormat::Exr);
+    EXPECT_EQ(frameFormatFromPath("f.webp"), FrameFormat::Webp);
+    EXPECT_EQ(frameFormatFromPath("F.WebP"), FrameFormat::Webp);
     EXPECT_FALSE(frameFormatFromPath("x.tif"));
     EXPECT_FALSE(frameFormatFromPath("png"));
     EXPECT_FALSE(frameFormatFromPath("x.png.bak"));
@@ -232,6 +235,72 @@ TEST(FrameIoTest, EncodeFrameDispatches) {
     ASSERT_GE(exr->size(), 4u);
     const std::vector<std::uint8_t> exrMagic = {0x76, 0x2F, 0x31, 0x01};
     EXPECT_TRUE(std::equal(exrMagic.begin(), exrMagic.end(), exr->begin()));
+}
+
+TEST(FrameIoTest, WebpLosslessRoundTripIsExactIncludingAlpha) {
+    // Random bytes everywhere, alpha 0 included: lossless WebP with `exact` keeps the colour of
+    // fully transparent pixels too, so libwebp's decoder gives back every byte.
+    for (auto [w, h] : {std::pair{37, 23}, {1, 1}, {300, 7}}) {
+        Image8 img = noiseImage(w, h, 5);
+        for (std::size_t k = 3; k < img.rgba.size(); k += 40) img.rgba[k] = 0;
+        auto webp = encodeWebpLossless(img);
+        ASSERT_TRUE(webp.ok()) << webp.error().message;
+        EXPECT_TRUE(looksLikeWebp(*webp));
+        auto back = decodeWebp(*webp);
+        ASSERT_TRUE(back.ok()) << back.error().message;
+        EXPECT_EQ(back->width, w);
+        EXPECT_EQ(back->height, h);
+        EXPECT_EQ(back->rgba, img.rgba) << w << "x" << h;
+    }
+    // Without alpha: every pixel opaque, RGB exact.
+    const Image8 img = gradientImage(64, 48);
+    auto opaque = encodeWebpLossless(img, false);
+    ASSERT_TRUE(opaque.ok());
+    auto back = decodeWebp(*opaque);
+    ASSERT_TRUE(back.ok());
+    for (std::size_t k = 0; k < img.rgba.size(); k += 4) {
+        ASSERT_EQ(back->rgba[k + 0], img.rgba[k + 0]) << k;
+        ASSERT_EQ(back->rgba[k + 1], img.rgba[k + 1]) << k;
+        ASSERT_EQ(back->rgba[k + 2], img.rgba[k + 2]) << k;
+        ASSERT_EQ(back->rgba[k + 3], 255) << k;
+    }
+    // Smooth frames compress well below raw RGBA.
+    EXPECT_LT(opaque->size(), img.rgba.size() / 3);
+    // Dispatch and file writing by extension.
+    auto viaFrame = encodeFrame(img, FrameFormat::Webp);
+    ASSERT_TRUE(viaFrame.ok());
+    EXPECT_EQ(*viaFrame, *encodeWebpLossless(img, true));
+    TempDir dir;
+    ASSERT_TRUE(writeFrame(dir / "f.webp", img).ok());
+    auto file = decodeWebp(readBytes(dir / "f.webp"));
+    ASSERT_TRUE(file.ok());
+    EXPECT_EQ(file->rgba, img.rgba);
+}
+
+TEST(FrameIoTest, WebpRejectsBadInput) {
+    Image8 empty;
+    auto e = encodeWebpLossless(empty);
+    ASSERT_FALSE(e.ok());
+    expectError(e.error(), ErrorCode::InvalidArgument, "dermis::encodeWebpLossless", "image");
+    Image8 wrong = gradientImage(8, 8);
+    wrong.rgba.pop_back();
+    auto w = encodeWebpLossless(wrong);
+    ASSERT_FALSE(w.ok());
+    expectError(w.error(), ErrorCode::InvalidArgument, "dermis::encodeWebpLossless", "image.rgba");
+    Image8 huge;
+    huge.width = kMaxWebpSide + 1;
+    huge.height = 1;
+    huge.rgba.resize(static_cast<std::size_t>(huge.width) * 4);
+    EXPECT_FALSE(encodeWebpLossless(huge).ok());
+    auto good = encodeWebpLossless(gradientImage(16, 16));
+    ASSERT_TRUE(good.ok());
+    for (std::vector<std::uint8_t> bad :
+         {std::vector<std::uint8_t>{}, *encodePng(gradientImage(4, 4)),
+          std::vector<std::uint8_t>(good->begin(), good->begin() + 20)}) {
+        auto d = decodeWebp(bad);
+        ASSERT_FALSE(d.ok()) << bad.size();
+        EXPECT_EQ(d.error().code, ErrorCode::Parse);
+    }
 }
 
 TEST(FrameIoTest, WritesPngAndJpegByExtension) {

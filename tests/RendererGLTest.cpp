@@ -26,6 +26,7 @@
 #include <cstddef>
 #include <cstdlib>
 #include <map>
+#include <random>
 
 using namespace dermis;
 using namespace dermis::test;
@@ -718,3 +719,60 @@ TEST_F(DefaultCharacterGLTest, ReadsBackTheMapsItUsed) {
 }
 
 } // namespace
+
+// Issue #13 "no cliff": on a software rasterizer a height pass covering many map areas is baked by
+// the CPU and uploaded (RendererOptions::softwareCpuBakeCoverage, default 2 map areas); on a
+// hardware GL, with the option at 0, or for a small pass, the GL pass runs. The maps equal the
+// CPU reference either way.
+TEST_F(RendererGLTest, LargeHeightPassesOnASoftwareRasterizerAreBakedByTheCpu) {
+    const auto pattern = makePatternImage(testPattern(64, 64, 2.0, 1.5));
+    HeightPassInput in;
+    in.width = 160;
+    in.height = 120;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.1, 0.9), rot(-180, 180);
+    for (int k = 0; k < 60; ++k) { // 60 × 0.25 × 0.2 = 3 map areas
+        BakePlacement p;
+        p.pattern = &pattern->pixels;
+        p.patternId = pattern->contentId;
+        p.footprint.center = {u(rng), u(rng)};
+        p.footprint.scale = {0.25, 0.2};
+        p.footprint.rotationDeg = rot(rng);
+        p.t = 0.3 + 0.01 * k;
+        p.model = k % 2 ? DeformModel::Bias : DeformModel::Scale;
+        p.target = k % 3 ? Target::Bump : Target::Displacement;
+        in.placements.push_back(p);
+    }
+    const std::string name = gl().info().renderer;
+    const bool software = name.find("llvmpipe") != std::string::npos ||
+                          name.find("softpipe") != std::string::npos ||
+                          name.find("swrast") != std::string::npos;
+    const auto before = gl().stats();
+    auto maps = gl().bakeHeightMaps(in);
+    ASSERT_TRUE(maps) << maps.error().message;
+    EXPECT_EQ(gl().stats().heightPassesOnCpu - before.heightPassesOnCpu, software ? 1u : 0u) << name;
+    auto cpu = bakeHeightMaps(in);
+    ASSERT_TRUE(cpu);
+    if (software) { // the CPU bake itself, uploaded and read back: exact
+        EXPECT_EQ(maps->bump.data, cpu->bump.data);
+        EXPECT_EQ(maps->displacement.data, cpu->displacement.data);
+    } else {
+        expectMatchesCpu(*maps, in);
+    }
+
+    RendererOptions glOnly;
+    glOnly.softwareCpuBakeCoverage = 0.0;
+    auto other = Renderer::create(requestedBackend(), glOnly);
+    ASSERT_TRUE(other) << other.error().message;
+    auto viaGl = (*other)->bakeHeightMaps(in);
+    ASSERT_TRUE(viaGl) << viaGl.error().message;
+    EXPECT_EQ((*other)->stats().heightPasses, 1u);
+    EXPECT_EQ((*other)->stats().heightPassesOnCpu, 0u);
+    expectMatchesCpu(*viaGl, in);
+
+    in.placements.resize(5); // 0.25 map areas: the GL pass
+    const auto small = gl().stats();
+    ASSERT_TRUE(gl().bakeHeightMaps(in));
+    EXPECT_EQ(gl().stats().heightPasses, small.heightPasses + 1);
+    EXPECT_EQ(gl().stats().heightPassesOnCpu, small.heightPassesOnCpu);
+}

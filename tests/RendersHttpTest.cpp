@@ -6,6 +6,7 @@
 //   * back-pressure: with a render queue of 1 (a second server), concurrent frames answer 200 or
 //     503 + Retry-After, and renders go through again once the burst is over.
 #include "HttpTestFixture.hpp"
+#include "io/webp_encode.hpp"
 
 using namespace dermis;
 using namespace dermis::test;
@@ -63,6 +64,32 @@ TEST_F(RendersHttpTest, BatchStreamsOneImagePartPerFrame) {
     ASSERT_EQ(jparts.size(), 1u);
     EXPECT_NE(jparts[0].headers.find("image/jpeg"), std::string::npos);
     EXPECT_TRUE(decodeFrame({jparts[0].content.begin(), jparts[0].content.end()}));
+
+    // Lossless WebP batches: image/webp parts that libwebp decodes to the PNG batch's pixels.
+    body["format"] = "png";
+    Reply pr = h.post("/render", body);
+    ASSERT_EQ(pr.status, 200) << pr;
+    std::smatch pm;
+    const std::string pct = pr.header("Content-Type");
+    ASSERT_TRUE(std::regex_search(pct, pm, std::regex("boundary=\"?([^\";]+)\"?")));
+    const auto pparts = multipartParts(pr.body, pm[1]);
+    ASSERT_EQ(pparts.size(), 1u);
+    auto pimg = decodeFrame({pparts[0].content.begin(), pparts[0].content.end()});
+    ASSERT_TRUE(pimg);
+    body["format"] = "webp";
+    Reply wr = h.post("/render", body);
+    ASSERT_EQ(wr.status, 200) << wr;
+    std::smatch wm;
+    const std::string wct = wr.header("Content-Type");
+    ASSERT_TRUE(std::regex_search(wct, wm, std::regex("boundary=\"?([^\";]+)\"?")));
+    const auto wparts = multipartParts(wr.body, wm[1]);
+    ASSERT_EQ(wparts.size(), 1u);
+    EXPECT_NE(wparts[0].headers.find("Content-Type: image/webp"), std::string::npos);
+    auto wimg = decodeWebp({wparts[0].content.begin(), wparts[0].content.end()});
+    ASSERT_TRUE(wimg) << wimg.error().message;
+    EXPECT_EQ(wimg->rgba, pimg->rgba);
+    body["format"] = "gif";
+    EXPECT_EQ(h.post("/render", body).status, 422);
 
     // A view for every frame of the batch; an unknown one is refused before any render.
     body["format"] = "png";

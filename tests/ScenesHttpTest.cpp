@@ -5,6 +5,7 @@
 //     pose put/patch (merge, null removal), revisions, frames (PNG/JPEG, size, backend header,
 //     changing with the pose), height maps (png16/exr/f32, normal), delete.
 #include "HttpTestFixture.hpp"
+#include "io/webp_encode.hpp"
 
 using namespace dermis;
 using namespace dermis::test;
@@ -121,6 +122,25 @@ TEST_F(ScenesHttpTest, SceneLifecycleWithEditsAndRenders) {
     ASSERT_TRUE(j) << j.error().message;
     EXPECT_EQ(j->width, 120);
     EXPECT_EQ(j->height, 80);
+    // Lossless WebP: its own content type and magic bytes, the same pixels as the PNG frame.
+    Reply webp = h.get("/scenes/" + id + "/frame?format=webp&width=128&height=96");
+    ASSERT_EQ(webp.status, 200) << webp;
+    EXPECT_EQ(webp.header("Content-Type"), "image/webp");
+    const std::vector<std::uint8_t> webpBytes = webp.bytes();
+    ASSERT_GE(webpBytes.size(), 12u);
+    EXPECT_EQ(std::string(webpBytes.begin(), webpBytes.begin() + 4), "RIFF");
+    EXPECT_EQ(std::string(webpBytes.begin() + 8, webpBytes.begin() + 12), "WEBP");
+    auto w = decodeWebp(webpBytes);
+    ASSERT_TRUE(w) << w.error().message;
+    EXPECT_EQ(w->width, 128);
+    EXPECT_EQ(w->height, 96);
+    EXPECT_EQ(w->rgba, a->rgba); // both lossless and opaque
+    // Unknown formats are still refused, naming the parameter.
+    for (const char* f : {"gif", "WEBP", "webp-lossy", ""}) {
+        Reply bad = h.get("/scenes/" + id + "/frame?width=32&height=32&format=" + std::string(f));
+        EXPECT_EQ(bad.status, 422) << f << bad;
+        EXPECT_EQ(bad.js()["error"]["field"], "format") << f << bad;
+    }
 
     // Two pose times give different frames (the elbow curls); the same time the same frame.
     ASSERT_EQ(h.patch("/scenes/" + id + "/pose", {{"time", 0.0}}).status, 200);

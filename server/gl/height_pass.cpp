@@ -1,6 +1,7 @@
 // Stage 1 of the renderer: pattern and base textures cached by content id (in the byte budget of
 // gpu_cache.cpp), the height targets, the height pass (one quad per placement, additive), readback
-// and upload of maps (see renderer_impl.hpp).
+// and upload of maps (see renderer_impl.hpp). On a software rasterizer a pass covering many map
+// areas is baked by the CPU and uploaded (RendererOptions::softwareCpuBakeCoverage).
 #include "gl/renderer_impl.hpp"
 
 #include "gl/uniform_blocks.hpp"
@@ -77,7 +78,10 @@ HeightPassBlock placementBlock(const BakePlacement& p, int W, int H) {
     const double texel = 1.5 * std::max(1.0 / W, 1.0 / H);
     b.rotation = glm::vec4(std::cos(a), std::sin(a), texel / p.footprint.scale.x,
                            texel / p.footprint.scale.y);
-    b.drive = glm::vec4(static_cast<float>(p.h), static_cast<float>(p.t), 0.0f, 0.0f);
+    // The deform constant once per placement, not per fragment (llvmpipe evaluates a log2 per
+    // fragment otherwise): the same float as the CPU bake's.
+    b.drive = glm::vec4(static_cast<float>(p.h), static_cast<float>(p.t),
+                        deformConstant(p.model, p.response, p.t), 0.0f);
     b.mode = glm::ivec4(p.model == DeformModel::Scale ? 0 : 1, p.target == Target::Bump ? 0 : 1,
                         static_cast<int>(p.response), 0);
     b.mapSize = glm::vec4(static_cast<float>(W), static_cast<float>(H), 0.0f, 0.0f);
@@ -86,6 +90,20 @@ HeightPassBlock placementBlock(const BakePlacement& p, int W, int H) {
         b.mapSize.w = static_cast<float>(p.pattern->height);
     }
     return b;
+}
+
+/// Whether this height pass is baked by the CPU (RendererOptions::softwareCpuBakeCoverage): a
+/// software rasterizer and footprints covering more than `coverage` map areas.
+bool bakeOnCpu(const HeightPassInput& in, double coverage, const std::string& glRenderer) {
+    if (!(coverage > 0.0)) return false;
+    const bool software = glRenderer.find("llvmpipe") != std::string::npos ||
+                          glRenderer.find("softpipe") != std::string::npos ||
+                          glRenderer.find("swrast") != std::string::npos;
+    if (!software) return false;
+    double covered = 0.0;
+    for (const BakePlacement& p : in.placements)
+        if (p.t > 0.0) covered += p.footprint.scale.x * p.footprint.scale.y;
+    return covered > coverage;
 }
 
 } // namespace
@@ -190,6 +208,18 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
         return Ok{};
     }
     lastHeights.reset();
+    if (bakeOnCpu(in, softwareCpuBakeCoverage, info.renderer)) {
+        BakeSettings settings;
+        settings.width = W;
+        settings.height = H;
+        settings.base = in.base;
+        if (auto s = dermis::bakeHeightMapsInto(in.placements, settings, cpuBake); !s) return s;
+        if (auto s = uploadHeightMaps(cpuBake); !s) return s;
+        lastHeights = std::move(key);
+        ++heightPasses;
+        ++heightPassesOnCpu;
+        return Ok{};
+    }
     const std::size_t stride = uploadHeightBlocks(in);
     drawHeightPass(in, resolved->textures, stride);
     if (auto st = checkGl("height pass"); !st) return st;

@@ -195,6 +195,7 @@ Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Result<std::unique_ptr<Renderer>> Renderer::create(GlBackend backend, const RendererOptions& options) {
     auto impl = std::make_unique<Impl>();
     impl->cacheBudget = options.cacheBudgetBytes;
+    impl->softwareCpuBakeCoverage = options.softwareCpuBakeCoverage;
     impl->publishCacheStats();
     std::promise<Status> started;
     std::future<Status> startedFuture = started.get_future();
@@ -250,7 +251,9 @@ void Renderer::forgetPatterns() {
 }
 
 Renderer::Stats Renderer::stats() {
-    return impl_->run([&] { return Stats{impl_->heightPasses, impl_->heightPassesSkipped}; });
+    return impl_->run([&] {
+        return Stats{impl_->heightPasses, impl_->heightPassesSkipped, impl_->heightPassesOnCpu};
+    });
 }
 
 Result<Renderer::BlockLayout> Renderer::blockLayout(const std::string& block) {

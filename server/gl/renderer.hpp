@@ -65,6 +65,13 @@ struct RendererOptions {
     /// Bytes of pattern/base textures and model buffers/textures kept between jobs (estimated
     /// from their formats and sizes). The render targets are not counted.
     std::size_t cacheBudgetBytes = kDefaultGpuCacheBytes;
+    /// On a software rasterizer (Mesa llvmpipe / softpipe / swrast), a height pass whose
+    /// footprints cover more than this many map areas (Σ scale.u·scale.v over active placements)
+    /// is baked by the CPU (dermis::bakeHeightMapsInto, all cores) and uploaded instead: llvmpipe
+    /// shades the pass ≈ 5–10× slower per texel than the CPU bake, so hundreds of placements
+    /// would make the frame time jump. Same maps up to float rounding; Stats::heightPassesOnCpu
+    /// counts them. 0 = always the GL pass. Hardware GLs always run the GL pass.
+    double softwareCpuBakeCoverage = 2.0;
 };
 
 /// What the renderer's GPU cache holds, as of the last job that ended.
@@ -162,6 +169,7 @@ public:
     /// the same inputs (same placements, t values, patterns, base and size).
     struct Stats {
         std::size_t heightPasses = 0, heightPassesSkipped = 0;
+        std::size_t heightPassesOnCpu = 0; ///< of heightPasses: baked by the CPU (RendererOptions)
     };
     Stats stats();
 

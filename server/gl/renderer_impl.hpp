@@ -201,7 +201,9 @@ struct Renderer::Impl {
     std::size_t patternBytes = 0, modelBytes = 0; ///< sums of the entries' bytes
     std::size_t evictions = 0, forgotten = 0;
     std::optional<gl::HeightKey> lastHeights; ///< what `heights` holds now, if from a height pass
-    std::size_t heightPasses = 0, heightPassesSkipped = 0;
+    std::size_t heightPasses = 0, heightPassesSkipped = 0, heightPassesOnCpu = 0;
+    double softwareCpuBakeCoverage = 2.0; ///< RendererOptions::softwareCpuBakeCoverage
+    HeightMaps cpuBake;                   ///< storage of height passes baked on the CPU
 
     /// Bytes between consecutive blocks of `size` in one uniform buffer bound by range.
     std::size_t uboStride(std::size_t size) const {

@@ -16,7 +16,7 @@ namespace dermis::gl {
 struct HeightPassBlock {
     glm::vec4 centerScale; ///< centre u, v; size u, v
     glm::vec4 rotation;    ///< cos, sin, quad margin in pattern units (x, y)
-    glm::vec4 drive;       ///< h, t, 0, 0
+    glm::vec4 drive;       ///< h, t, deformConstant(model, response, t), 0
     glm::ivec4 mode;       ///< model (0 scale, 1 bias), target (0 bump, 1 displacement), response, 0
     glm::vec4 mapSize;     ///< map width, height; pattern width, height
 };

@@ -14,6 +14,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/oiio_loader.hpp"
+#include "io/webp_encode.hpp"
 
 #include <png.h>
 #include <turbojpeg.h>
@@ -178,6 +179,7 @@ std::optional<FrameFormat> frameFormatFromPath(const std::string& path) {
     if (ext == ".png") return FrameFormat::Png;
     if (ext == ".jpg" || ext == ".jpeg") return FrameFormat::Jpeg;
     if (ext == ".exr") return FrameFormat::Exr;
+    if (ext == ".webp") return FrameFormat::Webp;
     return std::nullopt;
 }
 
@@ -258,6 +260,8 @@ Result<std::vector<std::uint8_t>> encodeFrame(const Image8& img, FrameFormat f) 
         return encodeJpeg(img, 90);
     case FrameFormat::Exr:
         return encodeExr(img);
+    case FrameFormat::Webp:
+        return encodeWebpLossless(img, true);
     }
     return makeError(ErrorCode::InvalidArgument, "dermis::encodeFrame", "format",
                      "unknown frame format");
@@ -268,7 +272,7 @@ Status writeFrame(const std::string& path, const Image8& img) {
     const auto format = frameFormatFromPath(path);
     if (!format)
         return makeError(ErrorCode::InvalidArgument, where, path,
-                         "unknown frame format: the extension must be .png, .jpg, .jpeg or .exr");
+                         "unknown frame format: the extension must be .png, .jpg, .jpeg, .exr or .webp");
     if (auto s = checkFrame(where, img); !s) return s.error();
     auto bytes = encodeFrame(img, *format);
     if (!bytes) return bytes.error();

@@ -30,10 +30,10 @@ namespace dermis {
 /// Largest frame side accepted by the encoders and decodeFrame, in pixels.
 constexpr int kMaxFrameSide = 16384;
 
-enum class FrameFormat { Png, Jpeg, Exr };
+enum class FrameFormat { Png, Jpeg, Exr, Webp };
 
 /// The format named by a path's extension: ".png" → Png, ".jpg"/".jpeg" → Jpeg, ".exr" → Exr,
-/// case-insensitive; std::nullopt for anything else (including no extension).
+/// ".webp" → Webp (lossless), case-insensitive; std::nullopt for anything else (including no extension).
 std::optional<FrameFormat> frameFormatFromPath(const std::string& path);
 
 /// Encodes a frame as PNG in memory: 8-bit RGBA (keepAlpha) or RGB (alpha dropped), not
@@ -49,7 +49,8 @@ Result<std::vector<std::uint8_t>> encodePng(const Image8& img, bool keepAlpha = 
 /// dropped (not composited: RGB are encoded as stored).
 Result<std::vector<std::uint8_t>> encodeJpeg(const Image8& img, int quality = 90);
 
-/// Encodes a frame in format `f`: Png = encodePng(img, true), Jpeg = encodeJpeg(img, 90), Exr =
+/// Encodes a frame in format `f`: Png = encodePng(img, true), Jpeg = encodeJpeg(img, 90), Webp =
+/// encodeWebpLossless(img, true) (io/webp_encode.hpp), Exr =
 /// 4-channel (R, G, B, A) half-float OpenEXR in LINEAR light, encoded by OpenImageIO in memory
 /// with its default compression: each colour byte c is decoded with the exact sRGB EOTF
 /// (c/255 ≤ 0.04045 ? (c/255)/12.92 : ((c/255 + 0.055)/1.055)^2.4), alpha is a/255.

@@ -75,9 +75,13 @@ struct UploadFile {
     std::vector<std::uint8_t> bytes;
 };
 
+/// The frame formats of the frame route and batches: "png", "jpeg" (quality 90, for previews)
+/// and "webp" (lossless, Content-Type image/webp).
+inline bool isFrameFormat(const std::string& f) { return f == "png" || f == "jpeg" || f == "webp"; }
+
 /// Query parameters of a frame.
 struct FrameParams {
-    std::string format = "png"; ///< png | jpeg
+    std::string format = "png"; ///< png | jpeg | webp (lossless); see isFrameFormat
     std::optional<int> width, height, msaa;
     std::optional<double> yaw, pitch, distance, time;
     // Compare (SPEC §6): which version of the scene the frame shows.

@@ -5,6 +5,7 @@
 #include "core/normalmap.hpp"
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
+#include "io/webp_encode.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -105,10 +106,14 @@ Result<EncodedImage> Service::State::render(const Snapshot& snap, const FramePar
     if (!image) return image.error();
     EncodedImage out;
     out.backend = renderer->info().backend;
-    auto bytes = p.format == "jpeg" ? encodeJpeg(*image, 90) : encodePng(*image, false);
+    auto bytes = p.format == "jpeg"   ? encodeJpeg(*image, 90)
+                 : p.format == "webp" ? encodeWebpLossless(*image, false)
+                                      : encodePng(*image, false);
     if (!bytes) return bytes.error();
     out.bytes = std::move(*bytes);
-    out.contentType = p.format == "jpeg" ? "image/jpeg" : "image/png";
+    out.contentType = p.format == "jpeg"   ? "image/jpeg"
+                      : p.format == "webp" ? "image/webp"
+                                           : "image/png";
     return out;
 }
 
@@ -139,7 +144,7 @@ Error asParamError(Error e, const FrameParams& p) {
 } // namespace detail
 
 Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p) {
-    if (p.format != "png" && p.format != "jpeg") return bad("format", "must be png or jpeg");
+    if (!isFrameFormat(p.format)) return bad("format", "must be png, jpeg or webp");
     QueueSlot slot(state_->inFlight, limits_.queueLength);
     if (!slot.ok()) return queueFull();
     auto snap = state_->frameSnapshot(id, p);
@@ -248,7 +253,8 @@ Result<Service::BatchJob> Service::batch(const json& body) {
                          "more than " + std::to_string(limits_.maxBatchFrames) + " frames");
     FrameParams params;
     if (auto f = body.find("format"); f != body.end()) {
-        if (!f->is_string() || (*f != "png" && *f != "jpeg")) return bad("/format", "must be png or jpeg");
+        if (!f->is_string() || !isFrameFormat(f->get<std::string>()))
+            return bad("/format", "must be png, jpeg or webp");
         params.format = f->get<std::string>();
     }
     if (auto v = body.find("view"); v != body.end()) {

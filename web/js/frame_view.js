@@ -16,6 +16,7 @@ import { notify } from "./notice.js";
 import { addPlacement } from "./edits.js";
 import { placementFromPattern } from "./placing.js";
 import { trace } from "./trace.js";
+import { frameFormat } from "./frame_format.js";
 
 let api, stage, img, cmpImg, spinner, splitHandle, sizeSelect;
 let flickerTimer = null;
@@ -160,6 +161,7 @@ export function frameParams() {
   return {
     width: frameSize, height: frameSize,
     msaa: store.gestures > 0 ? 1 : undefined, // while dragging: quicker frames; the scene's MSAA after
+    format: frameFormat(store.gestures > 0), // JPEG previews while dragging, lossless after (frame_format.js)
     yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined,
     time: shownTime(),
     view: store.view === "shaded" ? undefined : store.view,
