@@ -14,6 +14,7 @@ PKGS=(
   chromium
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-dev python3
+  slurmctld slurmd slurm-client munge
 )
 missing=()
 for p in "${PKGS[@]}"; do

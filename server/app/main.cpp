@@ -2,10 +2,14 @@
 //   dermis-server bake   --scene S.json --out DIR [--time T] [--threads N] [--png] [--gpu] [--normals] [--gl B]
 //   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH] [--msaa N]
 //                        [--view V] [--heightmaps] [--gl B]
+//   dermis-server render … --frames A:B:STEP --shard I/N|auto/N [--resume]   (a farm shard)
+//   dermis-server farm-verify OUT --frames A:B:STEP [--json]
 //   dermis-server info   [--gl B]
 //   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B]
 //                         [--gpu-cache-mb MB] [limits]
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
+#include "app/cli_common.hpp"
+#include "app/render_cmd.hpp"
 #include "core/normalmap.hpp"
 #include "gl/gl_backend.hpp"
 #include "gl/renderer.hpp"
@@ -32,31 +36,7 @@
 
 namespace {
 
-int fail(const dermis::Error& e) {
-    std::cerr << "dermis-server: error: " << e.message << "\n";
-    return 1;
-}
-
-double msSince(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-dermis::GlBackend backendOf(const std::string& name) {
-    return dermis::glBackendFromString(name).value_or(dermis::GlBackend::Auto);
-}
-
-const std::vector<std::string> kBackendNames = {"auto", "egl-device", "egl-surfaceless", "osmesa"};
-
-dermis::Status createFolderOf(const std::string& file) {
-    const std::filesystem::path parent = std::filesystem::path(file).parent_path();
-    if (parent.empty()) return dermis::Ok{};
-    std::error_code ec;
-    std::filesystem::create_directories(parent, ec);
-    if (ec)
-        return dermis::makeError(dermis::ErrorCode::Io, "dermis-server", parent.string(),
-                                 "cannot create the output folder: " + ec.message());
-    return dermis::Ok{};
-}
+using namespace dermis::app;
 
 // --- bake ------------------------------------------------------------------------------------
 
@@ -114,147 +94,6 @@ int runBake(const BakeArgs& a) {
     std::cout << "baked " << maps.bump.width << "x" << maps.bump.height << " maps of "
               << loaded->scene.placements.size() << " placements on the " << how << " into "
               << a.out << " (" << static_cast<int>(msSince(t0)) << " ms)\n";
-    return 0;
-}
-
-// --- render ----------------------------------------------------------------------------------
-
-struct RenderArgs {
-    std::string scene, out, gl = "auto", frames, size, content, view = "shaded";
-    double time = 0.0;
-    int msaa = 0; ///< 0: the scene's render.msaa
-    bool hasTime = false, heightmaps = false;
-};
-
-/// "A:B:STEP" in seconds → the times A, A+STEP, … ≤ B (inclusive within rounding).
-dermis::Result<std::vector<double>> parseFrames(const std::string& spec) {
-    const char* where = "dermis-server render";
-    std::smatch m;
-    static const std::regex re(R"(^\s*([0-9.eE+-]+):([0-9.eE+-]+):([0-9.eE+-]+)\s*$)");
-    double a = 0, b = 0, step = 0;
-    try {
-        if (!std::regex_match(spec, m, re)) throw std::invalid_argument("format");
-        a = std::stod(m[1]);
-        b = std::stod(m[2]);
-        step = std::stod(m[3]);
-    } catch (const std::exception&) {
-        return dermis::makeError(dermis::ErrorCode::InvalidArgument, where, "--frames",
-                                 "expected A:B:STEP in seconds, got \"" + spec + "\"");
-    }
-    if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(step) || a < 0 || b < a || step <= 0)
-        return dermis::makeError(dermis::ErrorCode::InvalidArgument, where, "--frames",
-                                 "need 0 <= A <= B and STEP > 0");
-    const double n = std::floor((b - a) / step + 1e-9) + 1;
-    if (n > 100000)
-        return dermis::makeError(dermis::ErrorCode::InvalidArgument, where, "--frames",
-                                 "more than 100000 frames");
-    std::vector<double> times;
-    for (int k = 0; k < static_cast<int>(n); ++k)
-        times.push_back(a + k * step);
-    return times;
-}
-
-/// Replaces the first printf-style integer field (%d, %04d) of `pattern` with `index`.
-std::string framePath(const std::string& pattern, int index) {
-    static const std::regex field(R"(%0?[0-9]*d)");
-    std::smatch m;
-    if (!std::regex_search(pattern, m, field)) return pattern;
-    char buf[32];
-    std::snprintf(buf, sizeof buf, m.str().c_str(), index);
-    return m.prefix().str() + buf + m.suffix().str();
-}
-
-std::string withoutExtension(const std::string& path) {
-    const std::filesystem::path p(path);
-    return (p.parent_path() / p.stem()).string();
-}
-
-int runRender(const RenderArgs& a) {
-    using namespace dermis;
-    const char* where = "dermis-server render";
-    auto t0 = std::chrono::steady_clock::now();
-    if (!frameFormatFromPath(a.out))
-        return fail(makeError(ErrorCode::InvalidArgument, where, "--out",
-                              "the file name must end in .png, .jpg, .jpeg or .exr"));
-    std::vector<double> times;
-    bool animation = !a.frames.empty();
-    if (animation) {
-        auto t = parseFrames(a.frames);
-        if (!t) return fail(t.error());
-        times = *t;
-        if (times.size() > 1 && framePath(a.out, 0) == a.out)
-            return fail(makeError(ErrorCode::InvalidArgument, where, "--out",
-                                  "a frame range needs a %04d-style field in the file name"));
-    }
-    FrameOverrides overrides;
-    overrides.view = frameViewFromString(a.view).value_or(FrameView::Shaded); // checked by CLI11
-    if (a.msaa) overrides.msaa = a.msaa;
-    if (!a.size.empty()) {
-        int w = 0, h = 0;
-        char tail = 0;
-        if (std::sscanf(a.size.c_str(), "%dx%d%c", &w, &h, &tail) != 2)
-            return fail(makeError(ErrorCode::InvalidArgument, where, "--size",
-                                  "expected WxH, got \"" + a.size + "\""));
-        overrides.width = w;
-        overrides.height = h;
-    }
-    // The GL context starts (EGL, shader compilation) on the renderer's thread while this thread
-    // loads and parses the scene, its model and patterns: the two take similar time cold.
-    auto rendererStart = std::async(std::launch::async, [&] { return Renderer::create(backendOf(a.gl)); });
-    auto loaded = loadSceneFile(a.scene, a.content.empty() ? dermisContentDir() : a.content);
-    auto renderer = rendererStart.get();
-    if (!loaded) return fail(loaded.error());
-    if (!renderer) return fail(renderer.error());
-    if (!animation) times = {a.hasTime ? a.time : loaded->scene.pose.time};
-    // The one range check of render settings (size included) runs in planFrame; "--size" is named
-    // when the size it set is out of range.
-    auto checkSize = [&](Error e) {
-        if (!a.size.empty() && e.field.rfind("/render/size", 0) == 0) {
-            e.field = "--size";
-            e.message = std::string(where) + ": --size: " + e.message;
-        }
-        return e;
-    };
-
-    auto model = std::make_shared<const Model>(std::move(loaded->model));
-    const RenderSettings* used = nullptr;
-    RenderSettings last;
-    // Frames are encoded and written on a worker while the next one renders (at most two waiting:
-    // bounded memory). Each file's bytes are those of the sequential path (deterministic encoders).
-    FrameWriteQueue writer(1, 2);
-    for (std::size_t k = 0; k < times.size(); ++k) {
-        overrides.time = times[k];
-        auto plan = planFrame(loaded->scene, *model, loaded->images, loaded->base, overrides);
-        if (!plan) return fail(checkSize(plan.error()));
-        FrameRequest request = frameRequest(*plan, model);
-        request.readHeightMaps = a.heightmaps;
-        last = plan->render;
-        used = &last;
-        auto result = (*renderer)->renderFrame(request);
-        if (!result) return fail(result.error());
-        const std::string path = animation ? framePath(a.out, static_cast<int>(k)) : a.out;
-        auto frame = std::make_shared<FrameResult>(std::move(*result));
-        const bool heightmaps = a.heightmaps;
-        auto job = [path, frame, heightmaps]() -> Status {
-            if (auto s = createFolderOf(path); !s) return s;
-            if (auto s = writeFrame(path, frame->image); !s) return s;
-            if (heightmaps && frame->maps) {
-                const std::string stem = withoutExtension(path);
-                if (auto s = writeFloatImage(stem + ".bump.exr", frame->maps->bump); !s) return s;
-                if (auto s = writeFloatImage(stem + ".displacement.exr", frame->maps->displacement); !s)
-                    return s;
-            }
-            return Ok{};
-        };
-        if (auto s = times.size() == 1 ? job() : writer.push(std::move(job)); !s)
-            return fail(s.error());
-    }
-    if (auto s = writer.finish(); !s) return fail(s.error());
-    std::cout << "rendered " << times.size() << (times.size() == 1 ? " frame" : " frames") << " of "
-              << used->size[0] << "x" << used->size[1] << " with "
-              << (*renderer)->info().backend << " (" << (*renderer)->info().renderer << ") to "
-              << (animation ? framePath(a.out, 0) + " …" : a.out) << " ("
-              << static_cast<int>(msSince(t0)) << " ms)\n";
     return 0;
 }
 
@@ -428,7 +267,7 @@ int main(int argc, char** argv) {
         ->required()
         ->check(CLI::ExistingFile);
     renderCmd->add_option("--out", render.out,
-                          "Output image (.png, .jpg, .exr); with --frames a pattern like "
+                          "Output image (.png, .jpg, .webp, .exr); with --frames a pattern like "
                           "dir/frame_%04d.png")
         ->required();
     auto* timeOpt = renderCmd->add_option("--time", render.time, "Animation time in seconds")
@@ -446,6 +285,20 @@ int main(int argc, char** argv) {
                         "Also write <frame>.bump.exr and <frame>.displacement.exr");
     renderCmd->add_option("--content", render.content, "Built-in content directory (builtin: names)");
     renderCmd->add_option("--gl", render.gl, "GL backend")->check(CLI::IsMember(kBackendNames));
+    renderCmd->add_option("--shard", render.shard,
+                          "Render only slice I of N of the range, interleaved (frames k with "
+                          "k mod N = I); auto/N takes I from SLURM_ARRAY_TASK_ID or "
+                          "JOB_COMPLETION_INDEX. Skips complete frames, writes "
+                          "manifest.shard-I-of-N.json beside them");
+    renderCmd->add_flag("--resume", render.resume, "Skip frames whose file already exists");
+
+    FarmVerifyArgs verify;
+    CLI::App* verifyCmd = app.add_subcommand(
+        "farm-verify", "Check that every frame of a range exists and matches the shards' manifests");
+    verifyCmd->add_option("out", verify.out, "Frame pattern (dir/frame_%04d.png) or the frames' folder")
+        ->required();
+    verifyCmd->add_option("--frames", verify.frames, "Animation range A:B:STEP in seconds")->required();
+    verifyCmd->add_flag("--json", verify.json, "Print the report as JSON");
 
     std::string infoGl = "auto";
     CLI::App* infoCmd = app.add_subcommand("info", "Print the GL backend and driver as JSON");
@@ -464,6 +317,7 @@ int main(int argc, char** argv) {
         render.hasTime = renderCmd->count("--time") > 0;
         return runRender(render);
     }
+    if (verifyCmd->parsed()) return runFarmVerify(verify);
     if (infoCmd->parsed()) return runInfo(infoGl);
     return runServe(serve);
 }
