@@ -307,6 +307,22 @@ TEST_F(ServiceTest, DeletingAPatternInUseIsAConflictAndUnusedOnesGo) {
     EXPECT_EQ(svc_->addPattern({1, 2, 3}, "junk").error().code, ErrorCode::Parse);
 }
 
+// A pattern whose header declares sides over the limit is refused from the header: nothing is
+// decoded (a small flat PNG declaring 8192² cost the whole decode before the side limit).
+TEST_F(ServiceTest, OversizedPatternIsRefusedFromItsHeader) {
+    std::vector<std::uint8_t> png = patternPng(8, 8);
+    ASSERT_GE(png.size(), 24u);
+    for (int k = 0; k < 2; ++k) { // IHDR width and height (big-endian) at bytes 16 and 20: 8192
+        png[16 + 4 * k] = 0, png[17 + 4 * k] = 0, png[18 + 4 * k] = 0x20, png[19 + 4 * k] = 0;
+    }
+    auto refused = svc_->addPattern(png, "huge");
+    ASSERT_FALSE(refused);
+    // Decoding these bytes would fail as corrupt (the IHDR CRC and the data no longer match): the
+    // TooLarge answer naming the declared size shows the header was checked first.
+    EXPECT_EQ(refused.error().code, ErrorCode::TooLarge) << refused.error().message;
+    EXPECT_NE(refused.error().message.find("8192x8192"), std::string::npos) << refused.error().message;
+}
+
 TEST_F(ServiceTest, ReopeningRestoresScenesAndUploads) {
     const std::string id = defaultScene();
     ASSERT_TRUE(svc_->patchPose(id, {{"time", 0.5}}));

@@ -3,6 +3,7 @@
 
 #include "core/preview.hpp"
 #include "io/frame_io.hpp"
+#include "io/image_header.hpp"
 #include "io/image_io.hpp"
 #include "io/sha256.hpp"
 
@@ -78,6 +79,17 @@ Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const s
             return patternSummary(known->second, img == state_->images.end() ? nullptr : &img->second->pixels);
         }
     }
+    // PNG and JPEG sides from their headers before anything is decoded: a small file declaring
+    // 8192² would otherwise cost the decode (hundreds of MB) before the limit refuses it.
+    const auto tooLarge = [&](std::uint64_t w, std::uint64_t h) {
+        return makeError(ErrorCode::TooLarge, where, "body",
+                         "image is " + std::to_string(w) + "x" + std::to_string(h) +
+                             ", the limit is " + std::to_string(limits_.maxImageSide) + " per side");
+    };
+    if (auto declared = encodedImageSize(bytes.data(), bytes.size());
+        declared && (declared->width > static_cast<std::uint32_t>(limits_.maxImageSide) ||
+                     declared->height > static_cast<std::uint32_t>(limits_.maxImageSide)))
+        return tooLarge(declared->width, declared->height);
     auto img = readHeightImageFromMemory(bytes);
     if (!img) return img.error();
     if (img->width > limits_.maxImageSide || img->height > limits_.maxImageSide)
