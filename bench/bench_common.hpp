@@ -6,6 +6,7 @@
 #include "core/frame_plan.hpp"
 #include "core/model.hpp"
 #include "core/scene.hpp"
+#include "gl/renderer.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -27,6 +28,17 @@ inline double round2(double v) { return std::round(v * 100) / 100; }
 
 inline double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The paper's "CPU" configuration for one frame: bakes `heights` into `maps` (storage reused)
+/// and makes `request` upload them instead of running the GPU height pass. The bake's time in ms,
+/// or its error.
+inline Result<double> useCpuMaps(FrameRequest& request, const HeightMapInput& heights, HeightMaps& maps) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (auto s = bakeHeightMapsInto(heights, maps); !s) return s.error();
+    request.heights.reset();
+    request.cpuMaps = &maps;
+    return msSince(t0);
 }
 
 /// models/default.scene.json with its first 15 placements, 1024² maps, the squat clip.

@@ -313,6 +313,16 @@ inline std::vector<Part> multipartParts(const std::string& body, const std::stri
     return parts;
 }
 
+/// The parts of a multipart/mixed answer (the boundary from its Content-Type); none when the
+/// answer is not multipart/mixed.
+inline std::vector<Part> multipartAnswerParts(const Reply& r) {
+    const std::string ct = r.header("Content-Type");
+    std::smatch m;
+    if (!std::regex_search(ct, m, std::regex("^multipart/mixed; *boundary=\"?([^\";]+)\"?")))
+        return {};
+    return multipartParts(r.body, m[1]);
+}
+
 /// (METHOD, path) pairs under "paths:" of an OpenAPI YAML, by indentation.
 inline std::set<std::pair<std::string, std::string>> openapiRoutes(const std::string& yaml) {
     std::set<std::pair<std::string, std::string>> out;

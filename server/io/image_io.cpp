@@ -53,6 +53,17 @@ bool looksLikePngOrJpeg(const std::string& path) {
     return in.gcount() >= 3 && m[0] == 0xFF && m[1] == 0xD8 && m[2] == 0xFF;
 }
 
+/// A pattern read by the OpenImageIO module (loaded on first use) from a file or from bytes.
+Result<HeightImage> readHeightThroughModule(const char* where, const std::string* path,
+                                            const std::vector<std::uint8_t>* bytes) {
+    auto api = oiio::oiioApi();
+    if (!api) return api.error();
+    HeightImage img;
+    oiio::OiioFailure f;
+    if (!(*api)->readHeight(path, bytes, kMaxPatternSize, img, f)) return moduleError(where, f);
+    return img;
+}
+
 } // namespace
 
 Result<HeightImage> readHeightImage(const std::string& path) {
@@ -71,12 +82,7 @@ Result<HeightImage> readHeightImage(const std::string& path) {
             return heightOf(**direct);
         }
     }
-    auto api = oiio::oiioApi();
-    if (!api) return api.error();
-    HeightImage img;
-    oiio::OiioFailure f;
-    if (!(*api)->readHeight(&path, nullptr, kMaxPatternSize, img, f)) return moduleError(where, f);
-    return img;
+    return readHeightThroughModule(where, &path, nullptr);
 }
 
 Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes) {
@@ -86,12 +92,7 @@ Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& b
         if (!*direct) return direct->error();
         return heightOf(**direct);
     }
-    auto api = oiio::oiioApi();
-    if (!api) return api.error();
-    HeightImage img;
-    oiio::OiioFailure f;
-    if (!(*api)->readHeight(nullptr, &bytes, kMaxPatternSize, img, f)) return moduleError(where, f);
-    return img;
+    return readHeightThroughModule(where, nullptr, &bytes);
 }
 
 Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes) {
