@@ -408,8 +408,14 @@ TEST_F(ClientHttpTest, RenderResumeAfterKillWritesExactlyTheRest) {
         ::execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
         ::_exit(127);
     }
-    for (int i = 0; i < 2000; ++i) {
-        if (fs::exists(part) && filesIn(part).size() >= 5) break;
+    // Complete frames only: a frame being written is a ".dermis-part" temporary beside them.
+    auto completeIn = [&](const std::string& dir) {
+        std::size_t n = 0;
+        for (const auto& name : filesIn(dir)) n += name.find(".dermis-part") == std::string::npos;
+        return n;
+    };
+    for (int i = 0; i < 10000; ++i) { // up to 20 s on a loaded machine
+        if (fs::exists(part) && completeIn(part) >= 5) break;
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     ::kill(pid, SIGKILL);
@@ -448,8 +454,8 @@ TEST_F(ClientHttpTest, RenderResumeAfterKillWritesExactlyTheRest) {
         ::execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
         ::_exit(127);
     }
-    for (int i = 0; i < 2000; ++i) {
-        if (fs::exists(intr) && filesIn(intr).size() >= 3) break;
+    for (int i = 0; i < 10000; ++i) {
+        if (fs::exists(intr) && completeIn(intr) >= 3) break;
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     ::kill(child, SIGINT);
