@@ -105,6 +105,7 @@ void addCheckCommand(CLI::App& app, Context& ctx) {
             Progress progress("frames", total, stdoutIsTerminal() && !ctx.global.json);
             std::vector<FrameResult> results;
             std::map<std::string, nlohmann::json> documents; // file or id → document
+            std::map<std::string, ContentFiles> contents;     // scene file → its files by address
             bool interrupted = false;
             for (const CheckCase& c : cases) {
                 if (interrupted) break;
@@ -114,7 +115,11 @@ void addCheckCommand(CLI::App& app, Context& ctx) {
                     if (!documents.count(c.sceneId)) documents[c.sceneId] = ctx.http().getJson(scenePath(c.sceneId))["scene"];
                     scene = documents[c.sceneId];
                 } else {
-                    if (!documents.count(c.sceneFile)) documents[c.sceneFile] = readJsonFile(c.sceneFile, "/cases/" + c.name + "/scene");
+                    if (!documents.count(c.sceneFile)) {
+                        // Its model and pattern files go by content address (any server can render it).
+                        documents[c.sceneFile] = readJsonFile(c.sceneFile, "/cases/" + c.name + "/scene");
+                        contents[c.sceneFile] = addressContent(documents[c.sceneFile], c.sceneFile);
+                    }
                     scene = documents[c.sceneFile];
                 }
                 if (!c.size.is_null()) scene["render"]["size"] = c.size;
@@ -175,8 +180,9 @@ void addCheckCommand(CLI::App& app, Context& ctx) {
                     seen[k] = true;
                     judge(k, bytes);
                     return true;
-                });
+                }, c.sceneFile.empty() ? nullptr : &contents[c.sceneFile]);
                 interrupted = outcome.interrupted;
+                if (outcome.broken) outcome.failure = outcome.brokenWhy;
                 if (!interrupted)
                     for (std::size_t k = 0; k < c.frames.size(); ++k)
                         if (!seen[k]) {

@@ -7,7 +7,9 @@
 #include "http_client.hpp"
 #include "output.hpp"
 
+#include <chrono>
 #include <filesystem>
+#include <thread>
 #include <iostream>
 
 namespace dermis::cli {
@@ -116,6 +118,9 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             nlohmann::json scene = o->sceneFile.empty() ? ctx.http().getJson(scenePath(o->id))["scene"]
                                                         : readJsonFile(o->sceneFile, "--scene-file");
             if (!o->size.empty()) scene["render"]["size"] = parseSize(o->size);
+            // A scene file's model and pattern files go by content address: any server (any
+            // replica behind a load balancer) can render them, asking for the bytes it lacks.
+            const ContentFiles content = o->sceneFile.empty() ? ContentFiles{} : addressContent(scene, o->sceneFile);
 
             std::vector<std::size_t> pending;
             for (std::size_t k = 0; k < times.size(); ++k)
@@ -125,7 +130,8 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             std::vector<std::size_t> failed;
             std::vector<std::string> failures;
             bool interrupted = false;
-            std::size_t next = 0;
+            std::size_t next = 0, contentSent = 0, retries = 0;
+            int stalls = 0; // broken answers in a row without a frame
             while (next < pending.size() && !interrupted) {
                 const std::size_t count = std::min(pending.size() - next, static_cast<std::size_t>(o->batch));
                 nlohmann::json frames = nlohmann::json::array();
@@ -136,8 +142,25 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
                     writeFileAtomically(path, bytes);
                     if (!ctx.global.json) progress.step("frame " + std::to_string(k) + " " + path);
                     return true;
-                });
+                }, &content);
                 interrupted = r.interrupted;
+                contentSent += r.contentSent;
+                if (r.broken && !interrupted) {
+                    // A replica went away (or the connection broke): ask again for the frames not
+                    // received, after a pause that grows while no frame arrives.
+                    next += r.received;
+                    stalls = r.received > 0 ? 1 : stalls + 1;
+                    if (stalls > std::max(0, ctx.global.retries) + 1) {
+                        progress.finish();
+                        throw CliError(kExitCannotConnect, r.brokenWhy + " (after " + std::to_string(retries) +
+                                                               " retries; run again with --resume for the rest)");
+                    }
+                    ++retries;
+                    progress.note("retrying " + std::to_string(pending.size() - next) + " frames after: " + r.brokenWhy);
+                    std::this_thread::sleep_for(std::chrono::duration<double>(0.25 * double(1 << std::min(stalls, 5))));
+                    continue;
+                }
+                stalls = 0;
                 if (r.failedFrame >= 0) {
                     // The stream ended at that frame: note it and go on after it.
                     failed.push_back(pending[next + static_cast<std::size_t>(r.failedFrame)]);
@@ -153,7 +176,7 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             const double seconds = progress.seconds();
             if (ctx.global.json) {
                 printJson({{"frames", times.size()}, {"written", written}, {"skipped", skipped}, {"failed", failed},
-                           {"interrupted", interrupted}, {"seconds", seconds},
+                           {"interrupted", interrupted}, {"retries", retries}, {"content_sent", contentSent}, {"seconds", seconds},
                            {"frames_per_second", seconds > 0 ? double(written) / seconds : 0.0}});
             } else {
                 char line[200];

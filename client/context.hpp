@@ -32,6 +32,8 @@ struct CliError : std::runtime_error {
         : std::runtime_error(message), code(exitCode), field(std::move(fieldName)) {}
     int code;
     std::string field;
+    int httpStatus = 0;  ///< the server's status when it answered with an error (serverError)
+    std::string answer;  ///< and its body
 };
 
 /// A usage error (exit 2).

@@ -24,12 +24,14 @@ std::string queryString(const std::vector<std::pair<std::string, std::string>>& 
 
 CliError serverError(int status, const std::string& body) {
     const auto j = nlohmann::json::parse(body, nullptr, false);
+    CliError out(kExitServerSaidNo, "HTTP " + std::to_string(status) + " from the server");
     if (j.is_object() && j.contains("error") && j["error"].is_object()) {
         const auto& e = j["error"];
-        return CliError(kExitServerSaidNo, e.value("message", "HTTP " + std::to_string(status)),
-                        e.value("field", ""));
+        out = CliError(kExitServerSaidNo, e.value("message", "HTTP " + std::to_string(status)), e.value("field", ""));
     }
-    return CliError(kExitServerSaidNo, "HTTP " + std::to_string(status) + " from the server");
+    out.httpStatus = status;
+    out.answer = body;
+    return out;
 }
 
 Http::Http(const GlobalOptions& options) : options_(options) {

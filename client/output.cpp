@@ -67,6 +67,13 @@ void Progress::step(const std::string& line, bool failed) {
     }
 }
 
+void Progress::note(const std::string& line) {
+    // On stderr, above the redrawn line (which is drawn again with the next step).
+    if (terminal_ && drawn_) std::cout << "\r\033[K" << std::flush;
+    std::cerr << "dermis: " << line << "\n" << std::flush;
+    drawn_ = false;
+}
+
 void Progress::draw() {
     const double r = rate();
     char buf[200];

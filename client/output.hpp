@@ -30,6 +30,8 @@ public:
     Progress(std::string what, std::size_t total, bool terminal);
     /// One more step done; `line` is the log line printed when not on a terminal.
     void step(const std::string& line, bool failed = false);
+    /// A line that is not a step (a retry): on stderr as "dermis: <line>".
+    void note(const std::string& line);
     /// Ends the redrawn line (a newline) — call once at the end, also after an interruption.
     void finish();
     std::size_t done() const { return done_; }

@@ -20,6 +20,9 @@ public:
         info_.renderer = "CPU fake (tests)";
     }
     const RendererInfo& info() const override { return info_; }
+    void forgetPattern(std::uint64_t) override { ++forgottenPatterns; }
+    void forgetModel(const std::shared_ptr<const Model>&) override { ++forgottenModels; }
+    int forgottenPatterns = 0, forgottenModels = 0; ///< forget* calls (the service's cache evictions, deletes)
 
     Result<HeightMaps> bakeHeightMaps(const HeightPassInput& in) override {
         enterGate();

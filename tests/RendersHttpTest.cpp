@@ -3,9 +3,13 @@
 // clients over loopback). It checks:
 //   * the stateless batch (POST /render): multipart/mixed with one decodable image part per frame,
 //     PNG and JPEG, and a view other than shaded;
+//   * content addresses (SPEC §7): a batch naming a pattern as sha256:<hex> that the server lacks
+//     answers 409 missing_content with the list; sent again as multipart/form-data with the bytes
+//     it renders, and at the upload body limit rather than the JSON one;
 //   * back-pressure: with a render queue of 1 (a second server), concurrent frames answer 200 or
 //     503 + Retry-After, and renders go through again once the burst is over.
 #include "HttpTestFixture.hpp"
+#include "io/sha256.hpp"
 #include "io/webp_encode.hpp"
 
 using namespace dermis;
@@ -94,6 +98,58 @@ TEST_F(RendersHttpTest, BatchStreamsOneImagePartPerFrame) {
     EXPECT_GT(pixelsDiffering(*bump, frames[0]), 20u);
     body["view"] = "nope";
     expectError(h.post("/render", body), 422, "/view");
+}
+
+TEST_F(RendersHttpTest, ContentNamedByAddressIsAskedForThenSentAsMultipart) {
+    Http h = http();
+    // A pattern image this server has never seen, named by the SHA-256 of its bytes.
+    Image8 img;
+    img.width = img.height = 24;
+    img.rgba.assign(24 * 24 * 4, 255);
+    for (std::size_t k = 0; k < img.rgba.size(); k += 4) img.rgba[k] = img.rgba[k + 1] = img.rgba[k + 2] = static_cast<std::uint8_t>(k * 7);
+    const std::vector<std::uint8_t> png = *encodePng(img, false);
+    const std::string address = "sha256:" + toHex(sha256(png));
+    json scene = smallScene();
+    scene["patterns"] = {{"mine", address}};
+    scene["placements"][0]["pattern"] = "mine";
+    const json batch = {{"scene", scene}, {"frames", json::array({{{"time", 0.5}}})}, {"format", "png"}};
+
+    Reply first = h.post("/render", batch);
+    expectError(first, 409, "/scene/patterns/mine");
+    EXPECT_EQ(first.js()["error"]["code"], "missing_content");
+    EXPECT_EQ(first.js()["missing"], json::array({address}));
+
+    // Sent again as multipart/form-data: part "request", then the bytes under their address.
+    const auto multipart = [&](const std::string& pngBytes) {
+        const std::string b = "dermis-test-boundary";
+        std::string body = "--" + b + "\r\nContent-Disposition: form-data; name=\"request\"\r\n"
+                           "Content-Type: application/json\r\n\r\n" + batch.dump() + "\r\n";
+        body += "--" + b + "\r\nContent-Disposition: form-data; name=\"" + address +
+                "\"; filename=\"mine.png\"\r\nContent-Type: image/png\r\n\r\n" + pngBytes + "\r\n--" + b + "--\r\n";
+        return h.call("POST", "/render", body, "multipart/form-data; boundary=" + b);
+    };
+    Reply wrong = multipart(std::string(png.begin(), png.end() - 1) + "x");
+    expectError(wrong, 422, address);
+    Reply sent = multipart(std::string(png.begin(), png.end()));
+    ASSERT_EQ(sent.status, 200) << sent;
+    ASSERT_EQ(multipartAnswerParts(sent).size(), 1u);
+    // Now without the bytes: the server kept them by address.
+    Reply again = h.post("/render", batch);
+    ASSERT_EQ(again.status, 200) << again;
+    EXPECT_EQ(multipartAnswerParts(again)[0].content, multipartAnswerParts(sent)[0].content);
+    const json info = h.get("/info").js();
+    EXPECT_GE(info["content_cache"]["entries"].get<int>(), 1) << info.dump();
+    EXPECT_GE(info["content_cache"]["hits"].get<int>(), 1) << info.dump();
+
+    // A multipart batch may be as large as an upload (the JSON limit is smaller), no larger.
+    const std::string big(kMaxUpload / 2, 'x');
+    Reply large = h.call("POST", "/render",
+                         "--b\r\nContent-Disposition: form-data; name=\"request\"\r\n\r\n" + batch.dump() +
+                             "\r\n--b\r\nContent-Disposition: form-data; name=\"unused\"\r\n\r\n" + big + "\r\n--b--\r\n",
+                         "multipart/form-data; boundary=b");
+    expectError(large, 422, "unused"); // read whole, then refused for its name (not 413)
+    Reply huge = h.call("POST", "/render", std::string(kMaxUpload + 1024, 'x'), "multipart/form-data; boundary=b");
+    EXPECT_EQ(huge.status, 413) << huge;
 }
 
 // ================================================================================================

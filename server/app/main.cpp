@@ -6,7 +6,7 @@
 //   dermis-server farm-verify OUT --frames A:B:STEP [--json]
 //   dermis-server info   [--gl B]
 //   dermis-server [serve] [--bind 127.0.0.1] [--port 8080] [--data DIR] [--token T] [--gl B]
-//                         [--gpu-cache-mb MB] [limits]
+//                         [--gpu-cache-mb MB] [--content-cache-mb MB] [limits]
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
 #include "app/cli_common.hpp"
 #include "app/render_cmd.hpp"
@@ -126,6 +126,7 @@ struct ServeArgs {
     dermis::ServerLimits limits;
     double maxUploadMb = 64;
     double gpuCacheMb = static_cast<double>(dermis::kDefaultGpuCacheBytes >> 20);
+    double contentCacheMb = static_cast<double>(dermis::ServerLimits{}.contentCacheBytes >> 20);
     dermis::ApiOptions api; ///< connection limits (head deadline, per-address and total caps)
 };
 
@@ -134,6 +135,7 @@ int runServe(ServeArgs a) {
     if (a.token.empty())
         if (const char* env = std::getenv("DERMIS_TOKEN")) a.token = env;
     a.limits.maxUploadBytes = static_cast<std::size_t>(a.maxUploadMb * 1024.0 * 1024.0);
+    a.limits.contentCacheBytes = static_cast<std::size_t>(a.contentCacheMb * 1024.0 * 1024.0);
     // SIGINT/SIGTERM are taken by a waiting thread (blocked here, before any thread starts).
     sigset_t signals;
     sigemptyset(&signals);
@@ -203,6 +205,11 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
     app.add_option("--gpu-cache-mb", s.gpuCacheMb,
                    "GPU memory kept for pattern textures and model uploads between renders "
                    "(least recently used freed first; deleted content freed at once)")
+        ->check(CLI::Range(0.0, 1048576.0));
+    app.add_option("--content-cache-mb", s.contentCacheMb,
+                   "Memory kept for models and patterns that batches (POST /render) sent by content "
+                   "address, decoded (least recently used freed first; a replica that lacks one "
+                   "answers 409 missing_content)")
         ->check(CLI::Range(0.0, 1048576.0));
     app.add_option("--max-upload-mb", s.maxUploadMb, "Largest request body / upload")->check(CLI::Range(0.001, 4096.0));
     app.add_option("--max-render-side", s.limits.maxRenderSide, "Largest frame side")->check(CLI::Range(16, 8192));

@@ -14,6 +14,7 @@ const char* errorCodeName(ErrorCode code) {
     case ErrorCode::TooLarge: return "too_large";
     case ErrorCode::Unavailable: return "unavailable";
     case ErrorCode::Internal: return "internal";
+    case ErrorCode::MissingContent: return "missing_content";
     }
     return "unknown";
 }

@@ -13,6 +13,7 @@
 #include <string>
 #include <utility>
 #include <variant>
+#include <vector>
 
 namespace dermis {
 
@@ -28,6 +29,7 @@ enum class ErrorCode {
     TooLarge,        ///< a body, image or size exceeds a configured limit
     Unavailable,     ///< a needed resource cannot be had now (no GL backend starts, queue full)
     Internal,        ///< a failure of a lower layer that is not the caller's fault (GL errors)
+    MissingContent,  ///< content named by hash ("sha256:<hex>") that this process does not hold
 };
 
 const char* errorCodeName(ErrorCode code);
@@ -38,6 +40,8 @@ struct Error {
     std::string field;   ///< JSON pointer or field name; empty when no single field is to blame
     /// ErrorCode::StaleRevision only: the revision that is current now.
     std::optional<std::uint64_t> currentRevision;
+    /// ErrorCode::MissingContent only: the content addresses ("sha256:<hex>") that are lacking.
+    std::vector<std::string> missing;
 };
 
 /// Builds an Error whose message is "<where>: <field>: <what>" (field part omitted when empty).

@@ -38,6 +38,8 @@ int statusOf(ErrorCode code) {
         return 503;
     case ErrorCode::Internal:
         return 500;
+    case ErrorCode::MissingContent:
+        return 409;
     }
     return 500;
 }
@@ -58,6 +60,12 @@ void sendError(Res& res, const Error& e) {
         sendJson(res, statusOf(e.code),
                  {{"error", {{"code", errorCodeName(e.code)}, {"message", e.message}, {"field", e.field}}},
                   {"revision", *e.currentRevision}});
+        return;
+    }
+    if (e.code == ErrorCode::MissingContent) { // 409: the body lists what to send
+        sendJson(res, 409,
+                 {{"error", {{"code", errorCodeName(e.code)}, {"message", e.message}, {"field", e.field}}},
+                  {"missing", e.missing}});
         return;
     }
     sendError(res, statusOf(e.code), errorCodeName(e.code), e.message, e.field);
@@ -169,25 +177,29 @@ bool nestedDeeperThan(const std::string& text, int limit) {
 
 } // namespace
 
+bool jsonText(const std::string& text, const std::string& field, Res& res, json& out) {
+    if (nestedDeeperThan(text, kMaxJsonDepth)) {
+        sendError(res, 400, "parse_error",
+                  "dermis-server: " + field + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                      " levels",
+                  field);
+        return false;
+    }
+    out = json::parse(text, nullptr, false);
+    if (out.is_discarded()) {
+        sendError(res, 400, "parse_error", "dermis-server: " + field + ": malformed JSON", field);
+        return false;
+    }
+    return true;
+}
+
 bool jsonBody(const Req& req, Res& res, json& out) {
     if (!hasContentType(req, {"application/json"})) {
         sendError(res, 415, "unsupported",
                   "dermis-server: body: expected Content-Type application/json", "body");
         return false;
     }
-    if (nestedDeeperThan(req.body, kMaxJsonDepth)) {
-        sendError(res, 400, "parse_error",
-                  "dermis-server: body: JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
-                      " levels",
-                  "body");
-        return false;
-    }
-    out = json::parse(req.body, nullptr, false);
-    if (out.is_discarded()) {
-        sendError(res, 400, "parse_error", "dermis-server: body: malformed JSON", "body");
-        return false;
-    }
-    return true;
+    return jsonText(req.body, "body", res, out);
 }
 
 std::vector<std::uint8_t> bytesOf(const std::string& s) {
@@ -319,8 +331,10 @@ bool Api::Impl::isOpen(const std::string& method, const std::string& path) const
 
 std::size_t Api::Impl::bodyLimitOf(const Req& req) const {
     const std::size_t upload = svc.limits().maxUploadBytes;
+    // Uploads, and batches that carry their content (multipart, SPEC §7), at the upload limit.
     const bool isUpload = req.method == "POST" &&
-                          (req.path == kPrefix + "/patterns" || req.path == kPrefix + "/models");
+                          (req.path == kPrefix + "/patterns" || req.path == kPrefix + "/models" ||
+                           (req.path == kPrefix + "/render" && hasContentType(req, {"multipart/form-data"})));
     return isUpload ? upload : std::min(upload, opt.maxJsonBytes);
 }
 

@@ -68,6 +68,8 @@ bool hasContentType(const Req& req, std::initializer_list<const char*> types);
 /// Parses a JSON body; false (and the answer sent: 415 wrong type, 400 malformed or nested deeper
 /// than 64 levels) when it cannot.
 bool jsonBody(const Req& req, Res& res, json& out);
+/// Same for JSON text that is not the body (a multipart part): errors name `field`.
+bool jsonText(const std::string& text, const std::string& field, Res& res, json& out);
 std::vector<std::uint8_t> bytesOf(const std::string& s);
 /// Query parameters: true when absent (out untouched) or well-formed; false (and a 422 sent) when
 /// present but malformed.

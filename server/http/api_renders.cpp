@@ -5,6 +5,8 @@
 #include "http/api_internal.hpp"
 
 #include <cmath>
+#include <map>
+#include <vector>
 
 #include <memory>
 
@@ -145,8 +147,25 @@ void installRenderRoutes(RouteTable& t) {
     // --- stateless batch: frames streamed as multipart/mixed parts as they finish
     t.add("POST", "/render", [](Api::Impl& a, const Req& req, Res& res) {
         json body;
-        if (!jsonBody(req, res, body)) return;
-        auto job = a.svc.batch(body);
+        std::map<std::string, std::vector<std::uint8_t>> content;
+        if (req.is_multipart_form_data()) {
+            // A batch with its content (SPEC §7): part "request" is the JSON batch, every other
+            // part is named by the content address of its bytes.
+            if (!req.has_file("request"))
+                return sendError(res, 422, "invalid_argument",
+                                 "dermis::Api: request: a multipart batch needs a part \"request\" with the JSON batch",
+                                 "request");
+            for (const auto& [name, part] : req.files) {
+                if (name == "request") continue;
+                if (!content.emplace(name, bytesOf(part.content)).second)
+                    return sendError(res, 422, "invalid_argument", "dermis::Api: " + name + ": given twice",
+                                     name.substr(0, 80));
+            }
+            if (!jsonText(req.get_file_value("request").content, "request", res, body)) return;
+        } else if (!jsonBody(req, res, body)) {
+            return;
+        }
+        auto job = a.svc.batch(body, content);
         if (!job) return sendDocError(res, job.error());
         auto shared = std::make_shared<Service::BatchJob>(std::move(*job));
         const std::string boundary = "dermis-frame-boundary";

@@ -5,6 +5,7 @@
 #include "io/atomic_file.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/image_io.hpp"
+#include "io/sha256.hpp"
 #include "io/scene_files.hpp"
 
 #include <chrono>
@@ -24,6 +25,7 @@ json ServerLimits::toJson() const {
             {"max_placements", maxPlacements},    {"queue_length", queueLength},
             {"request_timeout_seconds", requestTimeoutSeconds},
             {"max_batch_frames", maxBatchFrames},
+            {"content_cache_bytes", contentCacheBytes},
             {"presence_seconds", presenceSeconds}};
 }
 
@@ -84,19 +86,30 @@ using namespace detail;
 
 // --- document checks ------------------------------------------------------------------------
 
-Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool withLimits) const {
+Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool withLimits,
+                                                        const ContentOverlay* overlay) const {
     if (!docIn.is_object()) return bad("", "a scene document must be a JSON object");
     json doc = docIn;
-    // Uploaded pattern ids may be used directly as placement patterns: alias them to themselves.
+    const auto overlayImage = [&](const std::string& v) {
+        return overlay && overlay->images.count(v) ? overlay->images.at(v) : nullptr;
+    };
+    // Uploaded pattern ids (and, in a batch, content addresses) may be used directly as placement
+    // patterns: alias them to themselves (an address to "sha256_<hex>", a valid pattern id).
     if (auto pl = doc.find("placements"); pl != doc.end() && pl->is_array()) {
-        for (const json& p : *pl) {
+        for (json& p : *pl) {
             if (!p.is_object()) continue;
             auto pat = p.find("pattern");
             if (pat == p.end() || !pat->is_string()) continue;
-            const std::string id = pat->get<std::string>();
+            std::string id = pat->get<std::string>();
             auto it = patterns.find(id);
-            if (it == patterns.end() || it->second.builtin) continue;
+            if ((it == patterns.end() || it->second.builtin) && !overlayImage(id)) continue;
             if (!doc.contains("patterns")) doc["patterns"] = json::object();
+            if (isContentAddress(id)) { // "sha256:…" is no pattern id: alias "sha256_…" to it
+                std::string alias = "sha256_" + id.substr(7);
+                *pat = alias;
+                if (doc["patterns"].is_object() && !doc["patterns"].contains(alias)) doc["patterns"][alias] = id;
+                continue;
+            }
             if (doc["patterns"].is_object() && !doc["patterns"].contains(id)) doc["patterns"][id] = id;
         }
     }
@@ -106,15 +119,17 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool
             const std::string field = "/patterns/" + jsonPointerEscape(it.key());
             if (!it->is_string()) continue; // parseScene reports the type
             const std::string v = it->get<std::string>();
+            if (overlayImage(v)) continue;
             auto found = patterns.find(v);
             if (found == patterns.end() || found->second.builtin)
-                return notFound(field, "must name an uploaded pattern id (p_…), got \"" + v + "\"");
+                return notFound(field, "must name an uploaded pattern id (p_…), got \"" + v + "\"" +
+                                           (isContentAddress(v) ? " (content addresses are for POST /render)" : ""));
         }
     if (auto hm = doc.find("heightmap"); hm != doc.end() && hm->is_object())
         if (auto base = hm->find("base"); base != hm->end() && base->is_string()) {
             const std::string v = base->get<std::string>();
             auto found = patterns.find(v);
-            if (found == patterns.end() || found->second.builtin)
+            if ((found == patterns.end() || found->second.builtin) && !overlayImage(v))
                 return notFound("/heightmap/base", "must name an uploaded pattern id (p_…), got \"" + v + "\"");
         }
     auto scene = parseScene(doc, manifest);
@@ -125,9 +140,15 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool
     for (const Placement& p : scene->placements) named.insert(p.pattern);
     for (auto it = scene->patterns.begin(); it != scene->patterns.end();)
         it = named.count(it->first) ? std::next(it) : scene->patterns.erase(it);
-    auto model = models.find(scene->model);
-    if (model == models.end())
-        return notFound("/model", "no model \"" + scene->model + "\" (use builtin:default or an uploaded id)");
+    std::shared_ptr<const Model> modelPtr;
+    if (overlay)
+        if (auto it = overlay->models.find(scene->model); it != overlay->models.end()) modelPtr = it->second;
+    if (!modelPtr) {
+        auto model = models.find(scene->model);
+        if (model == models.end())
+            return notFound("/model", "no model \"" + scene->model + "\" (use builtin:default or an uploaded id)");
+        modelPtr = model->second.model;
+    }
     if (withLimits && scene->placements.size() > limits.maxPlacements)
         return makeError(ErrorCode::TooLarge, "dermis::Service", "/placements",
                          "more than " + std::to_string(limits.maxPlacements) + " placements");
@@ -137,15 +158,20 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool
                              "exceeds the server's limit " + std::to_string(limits.maxMapSide));
     // The document must work on its model: render settings within this server's limits, clip and
     // joints exist, patterns resolve, UVs present — the same plan a frame makes.
-    const Model& m = *model->second.model;
+    const Model& m = *modelPtr;
     RenderLimits rl;
     if (withLimits) rl.maxSide = limits.maxRenderSide;
-    auto plan = planFrame(resolved(*scene), m, images, nullptr, {}, rl);
+    PatternImages merged;
+    if (overlay && !overlay->images.empty()) {
+        merged = images;
+        for (const auto& [address, img] : overlay->images) merged[address] = img;
+    }
+    auto plan = planFrame(resolved(*scene), m, merged.empty() ? images : merged, nullptr, {}, rl);
     if (!plan) return plan.error();
     Prepared out;
     out.canonical = toJson(*scene);
     out.scene = std::move(*scene);
-    out.model = model->second.model;
+    out.model = std::move(modelPtr);
     return out;
 }
 
@@ -156,15 +182,20 @@ Scene Service::State::resolved(const Scene& scene) const {
     return s;
 }
 
-Service::State::Snapshot Service::State::snapshotOf(const Scene& scene,
-                                                    std::shared_ptr<const Model> model) const {
+Service::State::Snapshot Service::State::snapshotOf(const Scene& scene, std::shared_ptr<const Model> model,
+                                                    const ContentOverlay* overlay) const {
     Snapshot snap;
     snap.scene = resolved(scene);
     snap.model = std::move(model);
+    const auto find = [&](const std::string& id) -> std::shared_ptr<const PatternImage> {
+        if (overlay)
+            if (auto it = overlay->images.find(id); it != overlay->images.end()) return it->second;
+        auto it = images.find(id);
+        return it == images.end() ? nullptr : it->second;
+    };
     for (const Placement& p : snap.scene.placements)
-        if (auto it = images.find(p.pattern); it != images.end()) snap.images.emplace(it->first, it->second);
-    if (snap.scene.heightmapBase)
-        if (auto it = images.find(*snap.scene.heightmapBase); it != images.end()) snap.base = it->second;
+        if (auto img = find(p.pattern)) snap.images.emplace(p.pattern, std::move(img));
+    if (snap.scene.heightmapBase) snap.base = find(*snap.scene.heightmapBase);
     return snap;
 }
 
@@ -185,12 +216,12 @@ Status Service::State::loadContent() {
         auto img = readHeightImage(contentDir + "/patterns/" + info.file);
         if (!img) return img.error();
         images[info.id] = makePatternImage(std::move(*img));
-        patterns[info.id] = PatternEntry{info.id, info.id, true, 0, &info};
+        patterns[info.id] = PatternEntry{info.id, info.id, true, 0, &info, ""};
     }
     auto defaultModel = loadGltfFile(resolveModelPath(kBuiltinDefault, "", contentDir));
     if (!defaultModel) return defaultModel.error();
     models[kBuiltinDefault] = ModelEntry{kBuiltinDefault, "default",
-                                         std::make_shared<const Model>(std::move(*defaultModel)), 0, true};
+                                         std::make_shared<const Model>(std::move(*defaultModel)), 0, true, ""};
     // The default pattern set is optional content; present but unusable is an error, not a silence.
     const std::string setPath = contentDir + "/models/default.scene.json";
     std::error_code ec;
@@ -217,6 +248,7 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
     for (const Store::Blob& b : store->listBlobs("models", warnings)) {
         Result<Model> model = makeError(ErrorCode::Internal, "", "", "");
         std::size_t bytesLen = b.meta.value("bytes", std::size_t{0});
+        std::string digest; // a .glb's content address (a multi-file upload has none)
         if (b.file.size() > 5 && b.file.compare(b.file.size() - 5, 5, ".gltf") == 0) {
             model = loadGltfFile(b.file, gl); // a multi-file upload: resources beside it only
         } else {
@@ -226,6 +258,7 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
                 continue;
             }
             bytesLen = bytes->size();
+            digest = toHex(sha256(*bytes));
             auto parsed = parseGltf(*bytes, "", gl);
             if (parsed)
                 if (auto s = loadGltfResources(*parsed, gl); !s) parsed = s.error();
@@ -237,7 +270,7 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
             continue;
         }
         models[b.id] = ModelEntry{b.id, b.meta.value("name", ""),
-                                  std::make_shared<const Model>(std::move(*model)), bytesLen, false};
+                                  std::make_shared<const Model>(std::move(*model)), bytesLen, false, digest};
     }
     for (const Store::Blob& b : store->listBlobs("patterns", warnings)) {
         auto bytes = readWholeFile(b.file);
@@ -247,7 +280,8 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
             continue;
         }
         images[b.id] = makePatternImage(std::move(*img));
-        patterns[b.id] = PatternEntry{b.id, b.meta.value("name", ""), false, bytes->size(), nullptr};
+        patterns[b.id] = PatternEntry{b.id, b.meta.value("name", ""), false, bytes->size(), nullptr,
+                                      toHex(sha256(*bytes))};
     }
     for (const Store::SceneRecord& r : store->listScenes(warnings)) {
         auto prepared = prepare(r.doc);
@@ -276,6 +310,7 @@ Result<std::unique_ptr<Service>> Service::open(const ServiceConfig& config,
     st.limits = config.limits;
     st.contentDir = config.contentDir.empty() ? dermisContentDir() : config.contentDir;
     st.renderer = std::move(renderer);
+    st.content = std::make_unique<ContentCache>(config.limits.contentCacheBytes);
     keepLargeBuffersMapped();
     auto store = Store::open(config.dataDir);
     if (!store) return store.error();
@@ -316,6 +351,10 @@ json Service::info() const {
                             {"models", c->models},             {"model_bytes", c->modelBytes},
                             {"budget_bytes", c->budgetBytes},  {"evictions", c->evictions},
                             {"forgotten", c->forgotten}};
+    const ContentCache::Stats c = state_->content->stats();
+    out["content_cache"] = {{"entries", c.entries},       {"bytes", c.bytes},       {"budget_bytes", c.budget},
+                            {"hits", c.hits},             {"misses", c.misses},     {"insertions", c.insertions},
+                            {"evictions", c.evictions}};
     return out;
 }
 

@@ -57,6 +57,8 @@ struct ServerLimits {
     int queueLength = 16;          ///< renders waiting for the GL thread
     int requestTimeoutSeconds = 30;
     std::size_t maxBatchFrames = 512;
+    /// Decoded models and patterns that batches sent inline, kept by content address (LRU).
+    std::size_t contentCacheBytes = 256u << 20;
     double presenceSeconds = 30.0; ///< a presence entry lapses this long after its last refresh
     nlohmann::json toJson() const;
 };
@@ -330,11 +332,18 @@ public:
                                    const std::string& format);
     /// Validates a stateless batch ({"scene", "frames": [{"time"} | {"pose"}], "format",
     /// "view"?, "size"?}); returns a job that renders frame k on demand.
+    /// The scene may name its model, pattern values, placement patterns and base by content
+    /// address "sha256:<64 hex>" (SPEC §7): found in `content` (address → bytes sent along, each
+    /// checked against its address, decoded and kept in this server's LRU content cache), in that
+    /// cache, or among uploads with that SHA-256. Fails: MissingContent (409) with
+    /// Error::missing listing what this server lacks; InvalidArgument for malformed addresses or
+    /// bytes that do not match their address; the scene's and the parts' decode errors.
     struct BatchJob {
         std::size_t frames = 0;
         std::function<Result<EncodedImage>(std::size_t k)> render;
     };
-    Result<BatchJob> batch(const nlohmann::json& body);
+    Result<BatchJob> batch(const nlohmann::json& body,
+                           const std::map<std::string, std::vector<std::uint8_t>>& content = {});
 
     // --- events
     Result<std::shared_ptr<Subscription>> subscribe(const std::string& id);

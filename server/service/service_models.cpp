@@ -58,9 +58,6 @@ json modelSummary(const ModelEntry& e) {
             {"bytes", e.bytes}};
 }
 
-/// The content address of a .glb: "m_" + 16 hex digits of its SHA-256.
-std::string glbId(const std::vector<std::uint8_t>& glb) { return Store::contentId("m", toHex(sha256(glb))); }
-
 /// The content address of a .gltf with its files: the SHA-256 over the main file's name, then
 /// each file in name order as name, NUL, decimal size, NUL, bytes.
 std::string gltfFilesId(const GltfFiles& named, const std::string& gltfName) {
@@ -74,6 +71,20 @@ std::string gltfFilesId(const GltfFiles& named, const std::string& gltfName) {
 }
 
 } // namespace
+
+Result<Model> detail::decodeModelBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
+                                       const char* where, const std::string& field) {
+    if (bytes.size() > limits.maxUploadBytes)
+        return makeError(ErrorCode::TooLarge, where, field, "larger than " + std::to_string(limits.maxUploadBytes) + " bytes");
+    // No base folder: no file of this machine is read. The limits are checked from the declared
+    // sizes before anything big is allocated; checkModel below is the backstop.
+    const GltfLimits gl = gltfLimitsOf(limits);
+    auto parsed = parseGltf(bytes, "", gl);
+    if (!parsed) return parsed.error();
+    if (auto s = loadGltfResources(*parsed, gl); !s) return s.error();
+    if (auto st = checkModel(parsed->model, limits, where); !st) return st.error();
+    return std::move(parsed->model);
+}
 
 std::optional<json> Service::storedModel(const std::string& id) const {
     std::shared_lock<std::shared_mutex> lock(state_->mutex);
@@ -100,20 +111,17 @@ Result<json> Service::addModel(const std::vector<std::uint8_t>& glb, const std::
                          "not a binary glTF (.glb); send a .gltf with its files as multipart/form-data");
     // Content-addressed: the same bytes again answer the stored model (two identical uploads at
     // the same moment may both store it: same id, same bytes, the later name kept).
-    const std::string id = glbId(glb);
+    // The id of a .glb: "m_" + 16 hex digits of its SHA-256.
+    const std::string digest = toHex(sha256(glb));
+    const std::string id = Store::contentId("m", digest);
     if (auto known = storedModel(id)) {
         if (existing) *existing = true;
         return *known;
     }
-    // No base folder: no file of this machine is read. The limits are checked from the declared
-    // sizes before anything big is allocated; checkModel below is the backstop.
-    const GltfLimits gl = gltfLimitsOf(limits_);
-    auto parsed = parseGltf(glb, "", gl);
-    if (!parsed) return parsed.error();
-    if (auto s = loadGltfResources(*parsed, gl); !s) return s.error();
-    if (auto st = checkModel(parsed->model, limits_, where); !st) return st.error();
-    ModelEntry e{id, sanitizeName(name), std::make_shared<const Model>(std::move(parsed->model)),
-                 glb.size(), false};
+    auto model = decodeModelBytes(glb, limits_, where, "body");
+    if (!model) return model.error();
+    ModelEntry e{id, sanitizeName(name), std::make_shared<const Model>(std::move(*model)), glb.size(),
+                 false, digest};
     return state_->addModelEntry(std::move(e), [&](Store& store, const json& meta) {
         return store.putBlob("models", id, "glb", glb, meta);
     });
@@ -149,7 +157,7 @@ Result<json> Service::addModelFiles(const std::vector<UploadFile>& files, const 
     if (!model) return model.error();
     if (auto st = checkModel(*model, limits_, where); !st) return st.error();
     ModelEntry e{id, sanitizeName(name.empty() ? gltfName : name),
-                 std::make_shared<const Model>(std::move(*model)), total, false};
+                 std::make_shared<const Model>(std::move(*model)), total, false, ""};
     return state_->addModelEntry(std::move(e), [&](Store& store, const json& meta) {
         return store.putBlobFolder("models", id, named, gltfName, meta);
     });

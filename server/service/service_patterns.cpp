@@ -50,6 +50,28 @@ std::string sniffExtension(const std::vector<std::uint8_t>& b) {
 
 } // namespace
 
+Result<HeightImage> detail::decodePatternBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
+                                               const char* where, const std::string& field) {
+    if (bytes.size() > limits.maxUploadBytes)
+        return makeError(ErrorCode::TooLarge, where, field, "larger than " + std::to_string(limits.maxUploadBytes) + " bytes");
+    // PNG and JPEG sides from their headers before anything is decoded: a small file declaring
+    // 8192² would otherwise cost the decode (hundreds of MB) before the limit refuses it.
+    const auto tooLarge = [&](std::uint64_t w, std::uint64_t h) {
+        return makeError(ErrorCode::TooLarge, where, field,
+                         "image is " + std::to_string(w) + "x" + std::to_string(h) + ", the limit is " +
+                             std::to_string(limits.maxImageSide) + " per side");
+    };
+    if (auto declared = encodedImageSize(bytes.data(), bytes.size());
+        declared && (declared->width > static_cast<std::uint32_t>(limits.maxImageSide) ||
+                     declared->height > static_cast<std::uint32_t>(limits.maxImageSide)))
+        return tooLarge(declared->width, declared->height);
+    auto img = readHeightImageFromMemory(bytes);
+    if (!img) return img.error();
+    if (img->width > limits.maxImageSide || img->height > limits.maxImageSide)
+        return tooLarge(static_cast<std::uint64_t>(img->width), static_cast<std::uint64_t>(img->height));
+    return img;
+}
+
 json Service::listPatterns() const {
     std::shared_lock<std::shared_mutex> lock(state_->mutex);
     json out = json::array();
@@ -69,7 +91,8 @@ Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const s
                          "larger than " + std::to_string(limits_.maxUploadBytes) + " bytes");
     // Content-addressed: the same bytes again answer the stored pattern (two identical uploads at
     // the same moment may both store it: same id, same bytes, the later name kept).
-    const std::string id = Store::contentId("p", toHex(sha256(bytes)));
+    const std::string digest = toHex(sha256(bytes));
+    const std::string id = Store::contentId("p", digest);
     {
         std::shared_lock<std::shared_mutex> lock(state_->mutex);
         auto known = state_->patterns.find(id);
@@ -79,25 +102,11 @@ Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const s
             return patternSummary(known->second, img == state_->images.end() ? nullptr : &img->second->pixels);
         }
     }
-    // PNG and JPEG sides from their headers before anything is decoded: a small file declaring
-    // 8192² would otherwise cost the decode (hundreds of MB) before the limit refuses it.
-    const auto tooLarge = [&](std::uint64_t w, std::uint64_t h) {
-        return makeError(ErrorCode::TooLarge, where, "body",
-                         "image is " + std::to_string(w) + "x" + std::to_string(h) +
-                             ", the limit is " + std::to_string(limits_.maxImageSide) + " per side");
-    };
-    if (auto declared = encodedImageSize(bytes.data(), bytes.size());
-        declared && (declared->width > static_cast<std::uint32_t>(limits_.maxImageSide) ||
-                     declared->height > static_cast<std::uint32_t>(limits_.maxImageSide)))
-        return tooLarge(declared->width, declared->height);
-    auto img = readHeightImageFromMemory(bytes);
+    auto img = decodePatternBytes(bytes, limits_, where, "body");
     if (!img) return img.error();
-    if (img->width > limits_.maxImageSide || img->height > limits_.maxImageSide)
-        return makeError(ErrorCode::TooLarge, where, "body",
-                         "image is " + std::to_string(img->width) + "x" + std::to_string(img->height) +
-                             ", the limit is " + std::to_string(limits_.maxImageSide) + " per side");
     PatternEntry e;
     e.id = id;
+    e.sha256 = digest;
     e.name = sanitizeName(name);
     e.bytes = bytes.size();
     auto stored = makePatternImage(std::move(*img));

@@ -241,7 +241,8 @@ Result<EncodedImage> Service::heightmap(const std::string& id, const std::string
     return out;
 }
 
-Result<Service::BatchJob> Service::batch(const json& body) {
+Result<Service::BatchJob> Service::batch(const json& body,
+                                         const std::map<std::string, std::vector<std::uint8_t>>& content) {
     if (!body.is_object()) return bad("", "the batch must be a JSON object");
     auto sceneIt = body.find("scene");
     if (sceneIt == body.end()) return bad("/scene", "missing scene document");
@@ -266,17 +267,19 @@ Result<Service::BatchJob> Service::batch(const json& body) {
         State::Snapshot snap;
         std::optional<double> time;
     };
+    auto overlay = state_->resolveContent(*sceneIt, content);
+    if (!overlay) return overlay.error();
     auto items = std::make_shared<std::vector<Item>>();
     {
         std::shared_lock<std::shared_mutex> lock(state_->mutex);
-        auto base = state_->prepare(*sceneIt);
+        auto base = state_->prepare(*sceneIt, true, &*overlay);
         if (!base) {
             Error e = base.error();
             e.field = "/scene" + e.field;
             e.message = "dermis::Service::batch: " + e.field + ": " + e.message;
             return e;
         }
-        const State::Snapshot baseSnap = state_->snapshotOf(base->scene, base->model);
+        const State::Snapshot baseSnap = state_->snapshotOf(base->scene, base->model, &*overlay);
         for (std::size_t k = 0; k < framesIt->size(); ++k) {
             const json& fr = (*framesIt)[k];
             const std::string f = "/frames/" + std::to_string(k);
@@ -295,14 +298,14 @@ Result<Service::BatchJob> Service::batch(const json& body) {
             }
             json doc = *sceneIt;
             doc["pose"] = *p;
-            auto prepared = state_->prepare(doc);
+            auto prepared = state_->prepare(doc, true, &*overlay);
             if (!prepared) {
                 Error e = prepared.error();
                 e.field = (e.field.rfind("/pose", 0) == 0 ? f : "/scene") + e.field;
                 e.message = "dermis::Service::batch: " + e.field + ": " + e.message;
                 return e;
             }
-            items->push_back({state_->snapshotOf(prepared->scene, prepared->model), time});
+            items->push_back({state_->snapshotOf(prepared->scene, prepared->model, &*overlay), time});
         }
     }
     BatchJob job;

@@ -15,6 +15,7 @@
 
 #include "core/frame_plan.hpp"
 #include "io/gltf_loader.hpp"
+#include "service/content_cache.hpp"
 
 #include <atomic>
 #include <map>
@@ -37,6 +38,7 @@ struct ModelEntry {
     std::shared_ptr<const Model> model;
     std::size_t bytes = 0;
     bool builtin = false;
+    std::string sha256; ///< hex SHA-256 of an uploaded .glb ("" otherwise): content address
 };
 
 struct PatternEntry {
@@ -44,7 +46,29 @@ struct PatternEntry {
     bool builtin = false;
     std::size_t bytes = 0;
     const PatternInfo* info = nullptr; ///< manifest entry of a built-in pattern
+    std::string sha256; ///< hex SHA-256 of an uploaded pattern's bytes ("" for built-ins)
 };
+
+/// Content a batch names by address ("sha256:<hex>", SPEC §7), resolved for one request: from
+/// its inline parts, the content cache or stored uploads. Keys are the addresses; holding the
+/// pointers keeps the content alive for the request even if the cache lets it go.
+struct ContentOverlay {
+    std::map<std::string, std::shared_ptr<const Model>> models;
+    PatternImages images;
+    bool empty() const { return models.empty() && images.empty(); }
+};
+
+/// "sha256:" followed by 64 lower-case hex digits.
+bool isContentAddress(const std::string& s);
+
+/// An uploaded model's bytes decoded and checked against `limits` (.glb, or a .gltf whose
+/// buffers and images are data: URIs — no file is read); errors name `where` and `field`.
+Result<Model> decodeModelBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
+                               const char* where, const std::string& field);
+/// An uploaded pattern image decoded and checked against `limits` (sides from the header of a
+/// PNG or JPEG before anything is decoded).
+Result<HeightImage> decodePatternBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
+                                       const char* where, const std::string& field);
 
 struct SceneEntry {
     json doc; ///< canonical document (toJson of scene)
@@ -128,6 +152,7 @@ struct Service::State {
     std::multimap<std::string, std::shared_ptr<Subscription>> subs;
 
     std::atomic<int> inFlight{0};
+    std::unique_ptr<ContentCache> content; ///< by address; its own lock (no order with the others)
 
     /// The scene a document describes, validated against this server's models and patterns.
     struct Prepared {
@@ -137,7 +162,10 @@ struct Service::State {
     };
     /// Caller holds `mutex` (shared is enough). Without `withLimits` only the document and its
     /// references are checked, not this server's configured limits (the default pattern set).
-    Result<Prepared> prepare(const json& doc, bool withLimits = true) const;
+    /// `overlay` (batches only) lets the model, pattern values, placement patterns and the base
+    /// name content addresses it holds; stored scenes never do (the cache may forget).
+    Result<Prepared> prepare(const json& doc, bool withLimits = true,
+                             const detail::ContentOverlay* overlay = nullptr) const;
     /// Placement patterns with their aliases replaced by pattern ids.
     Scene resolved(const Scene& scene) const;
 
@@ -150,7 +178,18 @@ struct Service::State {
     };
     Result<Snapshot> snapshot(const std::string& id) const;
     /// Same for a document that is not stored (batch); caller holds `mutex` shared.
-    Snapshot snapshotOf(const Scene& scene, std::shared_ptr<const Model> model) const;
+    Snapshot snapshotOf(const Scene& scene, std::shared_ptr<const Model> model,
+                        const detail::ContentOverlay* overlay = nullptr) const;
+
+    /// The content addresses batch document `doc` names, resolved (service_content.cpp):
+    /// `inlineParts` (address → bytes, from a multipart batch) are checked against their
+    /// address, decoded by the role the document gives them and cached; the rest come from the
+    /// cache or from uploads with that SHA-256. Takes `mutex` shared itself (caller holds none).
+    /// Fails: MissingContent listing every address not found (field: the first one's pointer);
+    /// InvalidArgument for a malformed address, bytes whose SHA-256 differs from their part's
+    /// name, or one address used as both model and pattern; decode errors of the parts.
+    Result<detail::ContentOverlay> resolveContent(
+        const json& doc, const std::map<std::string, std::vector<std::uint8_t>>& inlineParts);
 
     /// Validates `newDoc`, writes it durably as a new revision (history included), swaps it in
     /// and announces it. Caller holds `writeMutex` (and not `mutex`).
