@@ -6,10 +6,9 @@
 #include "frames.hpp"
 #include "http_client.hpp"
 #include "output.hpp"
+#include "render_range.hpp"
 
-#include <chrono>
 #include <filesystem>
-#include <thread>
 #include <iostream>
 
 namespace dermis::cli {
@@ -19,7 +18,7 @@ namespace {
 struct FrameOptions {
     std::string id, sceneFile, out, frames, size, view = "shaded", map, format;
     double time = -1, yaw = 0, pitch = 0, distance = 0;
-    int width = 0, height = 0, msaa = 0, revision = 0, batch = 100;
+    int width = 0, height = 0, msaa = 0, revision = 0, batch = 100, parallel = 1;
     bool hasYaw = false, hasPitch = false, hasDistance = false, resume = false;
 };
 
@@ -107,6 +106,10 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
     render->add_flag("--resume", o->resume, "Skip frames whose file exists (files appear only complete)");
     render->add_option("--batch", o->batch, "Frames per request (default 100; the server allows limits.max_batch_frames)")
         ->check(CLI::Range(1, 100000));
+    render->add_option("--parallel", o->parallel,
+                       "Requests in flight at once, each its own connection (default 1): replicas behind a load "
+                       "balancer render side by side")
+        ->check(CLI::Range(1, 64));
     render->callback([&ctx, o] {
         ctx.action = [&ctx, o] {
             if (o->id.empty() == o->sceneFile.empty()) throw usageError("give a scene id or --scene-file, not both", "id");
@@ -122,75 +125,47 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             // replica behind a load balancer) can render them, asking for the bytes it lacks.
             const ContentFiles content = o->sceneFile.empty() ? ContentFiles{} : addressContent(scene, o->sceneFile);
 
-            std::vector<std::size_t> pending;
+            RangeJob job;
+            job.scene = std::move(scene);
+            job.content = &content;
+            job.format = format;
+            job.view = o->view;
+            job.out = o->out;
+            job.times = times;
             for (std::size_t k = 0; k < times.size(); ++k)
-                if (!o->resume || !std::filesystem::exists(framePath(o->out, static_cast<int>(k)))) pending.push_back(k);
-            const std::size_t skipped = times.size() - pending.size();
-            Progress progress("frames", pending.size(), stdoutIsTerminal() && !ctx.global.json);
-            std::vector<std::size_t> failed;
-            std::vector<std::string> failures;
-            bool interrupted = false;
-            std::size_t next = 0, contentSent = 0, retries = 0;
-            int stalls = 0; // broken answers in a row without a frame
-            while (next < pending.size() && !interrupted) {
-                const std::size_t count = std::min(pending.size() - next, static_cast<std::size_t>(o->batch));
-                nlohmann::json frames = nlohmann::json::array();
-                for (std::size_t j = 0; j < count; ++j) frames.push_back({{"time", times[pending[next + j]]}});
-                BatchOutcome r = renderBatch(ctx.http(), scene, frames, format, o->view, [&](std::size_t j, std::string bytes) {
-                    const std::size_t k = pending[next + j];
-                    const std::string path = framePath(o->out, static_cast<int>(k));
-                    writeFileAtomically(path, bytes);
-                    if (!ctx.global.json) progress.step("frame " + std::to_string(k) + " " + path);
-                    return true;
-                }, &content);
-                interrupted = r.interrupted;
-                contentSent += r.contentSent;
-                if (r.broken && !interrupted) {
-                    // A replica went away (or the connection broke): ask again for the frames not
-                    // received, after a pause that grows while no frame arrives.
-                    next += r.received;
-                    stalls = r.received > 0 ? 1 : stalls + 1;
-                    if (stalls > std::max(0, ctx.global.retries) + 1) {
-                        progress.finish();
-                        throw CliError(kExitCannotConnect, r.brokenWhy + " (after " + std::to_string(retries) +
-                                                               " retries; run again with --resume for the rest)");
-                    }
-                    ++retries;
-                    progress.note("retrying " + std::to_string(pending.size() - next) + " frames after: " + r.brokenWhy);
-                    std::this_thread::sleep_for(std::chrono::duration<double>(0.25 * double(1 << std::min(stalls, 5))));
-                    continue;
-                }
-                stalls = 0;
-                if (r.failedFrame >= 0) {
-                    // The stream ended at that frame: note it and go on after it.
-                    failed.push_back(pending[next + static_cast<std::size_t>(r.failedFrame)]);
-                    failures.push_back(r.failure);
-                    if (!ctx.global.json) progress.step("frame " + std::to_string(failed.back()) + " failed: " + r.failure, true);
-                    next += static_cast<std::size_t>(r.failedFrame) + 1;
-                } else {
-                    next += r.received;
-                }
+                if (!o->resume || !std::filesystem::exists(framePath(o->out, static_cast<int>(k)))) job.pending.push_back(k);
+            job.batch = static_cast<std::size_t>(o->batch);
+            job.parallel = o->parallel;
+            const std::size_t skipped = times.size() - job.pending.size();
+            Progress progress("frames", job.pending.size(), stdoutIsTerminal() && !ctx.global.json, !ctx.global.json);
+            RangeOutcome r;
+            try {
+                r = renderRange(ctx.global, job, progress);
+            } catch (...) {
+                progress.finish();
+                throw;
             }
             progress.finish();
-            const std::size_t written = next - failed.size();
             const double seconds = progress.seconds();
+            const double fps = seconds > 0 ? double(r.written) / seconds : 0.0;
             if (ctx.global.json) {
-                printJson({{"frames", times.size()}, {"written", written}, {"skipped", skipped}, {"failed", failed},
-                           {"interrupted", interrupted}, {"retries", retries}, {"content_sent", contentSent}, {"seconds", seconds},
-                           {"frames_per_second", seconds > 0 ? double(written) / seconds : 0.0}});
+                nlohmann::json failed = nlohmann::json::array();
+                for (const auto& f : r.failed) failed.push_back(f.first);
+                printJson({{"frames", times.size()}, {"written", r.written}, {"skipped", skipped}, {"failed", failed},
+                           {"interrupted", r.interrupted}, {"retries", r.retries}, {"content_sent", r.contentSent},
+                           {"parallel", job.parallel}, {"seconds", seconds}, {"frames_per_second", fps}});
             } else {
                 char line[200];
-                std::snprintf(line, sizeof line, "rendered %zu frames of %zu (%zu skipped, %zu failed) in %.2f s, %.1f frames/s", written,
-                              times.size(), skipped, failed.size(), seconds, seconds > 0 ? double(written) / seconds : 0.0);
+                std::snprintf(line, sizeof line, "rendered %zu frames of %zu (%zu skipped, %zu failed) in %.2f s, %.1f frames/s", r.written,
+                              times.size(), skipped, r.failed.size(), seconds, fps);
                 std::cout << line << "\n";
             }
-            for (std::size_t f = 0; f < failed.size(); ++f)
-                std::cerr << "dermis: error: frame " << failed[f] << ": " << failures[f] << "\n";
-            if (interrupted) {
-                std::cerr << "dermis: interrupted: " << written << " frames written, run again with --resume for the rest\n";
+            for (const auto& [index, message] : r.failed) std::cerr << "dermis: error: frame " << index << ": " << message << "\n";
+            if (r.interrupted) {
+                std::cerr << "dermis: interrupted: " << r.written << " frames written, run again with --resume for the rest\n";
                 return kExitInterrupted;
             }
-            return failed.empty() ? kExitOk : kExitFramesFailed;
+            return r.failed.empty() ? kExitOk : kExitFramesFailed;
         };
     });
 }

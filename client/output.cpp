@@ -40,8 +40,8 @@ void printTable(const std::vector<std::string>& header, const std::vector<std::v
 
 bool stdoutIsTerminal() { return ::isatty(STDOUT_FILENO) == 1; }
 
-Progress::Progress(std::string what, std::size_t total, bool terminal)
-    : what_(std::move(what)), total_(total), terminal_(terminal), start_(std::chrono::steady_clock::now()) {}
+Progress::Progress(std::string what, std::size_t total, bool terminal, bool lines)
+    : what_(std::move(what)), total_(total), terminal_(terminal), lines_(lines), start_(std::chrono::steady_clock::now()) {}
 
 double Progress::seconds() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -56,7 +56,7 @@ void Progress::step(const std::string& line, bool failed) {
     ++done_;
     if (failed) ++failed_;
     if (!terminal_) {
-        std::cout << line << "\n" << std::flush;
+        if (lines_) std::cout << line << "\n" << std::flush;
         return;
     }
     // Redraw at most 20 times a second, and always for the last step.

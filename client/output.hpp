@@ -26,8 +26,9 @@ bool stdoutIsTerminal();
 
 class Progress {
 public:
-    /// `what` names the steps ("frames", "cases"); `terminal` picks the redrawn line.
-    Progress(std::string what, std::size_t total, bool terminal);
+    /// `what` names the steps ("frames", "cases"); `terminal` picks the redrawn line; `lines`
+    /// false prints no step lines either (--json).
+    Progress(std::string what, std::size_t total, bool terminal, bool lines = true);
     /// One more step done; `line` is the log line printed when not on a terminal.
     void step(const std::string& line, bool failed = false);
     /// A line that is not a step (a retry): on stderr as "dermis: <line>".
@@ -43,7 +44,7 @@ private:
     void draw();
     std::string what_;
     std::size_t total_, done_ = 0, failed_ = 0;
-    bool terminal_, drawn_ = false;
+    bool terminal_, lines_ = true, drawn_ = false;
     std::chrono::steady_clock::time_point start_, lastDraw_;
 };
 

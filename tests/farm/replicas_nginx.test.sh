@@ -2,7 +2,7 @@
 # FarmReplicasGLTest — stateless replicas behind nginx (issue #15, SPEC §7): three dermis-server
 # replicas, each with an empty data folder, behind Debian's nginx running
 # docker/nginx-replicas.conf (its upstream replaced by the three loopback ports, its listen line
-# by a free port). `dermis render --scene-file` renders 60 frames through nginx in batches of 12:
+# by a free port). `dermis render --scene-file` renders 60 frames through nginx in batches of 12, two at a time:
 # the scene names a model and a pattern image by file, the client sends them by content address,
 # and each replica that lacks them answers 409 missing_content and gets the bytes. One replica is
 # killed (-9) in the middle of the range, while it renders if one can be caught rendering. All 60
@@ -66,7 +66,7 @@ range=0:2.95:0.05 # 60 frames
 
 # --- 60 frames through nginx; one replica killed mid-range
 "$client_exe" --server "http://127.0.0.1:$port" --json --retries 4 render --scene-file "$tmp/shot/shot.scene.json" \
-  --frames "$range" --batch 12 -o "$tmp/farm/frame_%04d.png" >"$tmp/client.json" 2>"$tmp/client.log" &
+  --frames "$range" --batch 12 --parallel 2 -o "$tmp/farm/frame_%04d.png" >"$tmp/client.json" 2>"$tmp/client.log" &
 client=$!
 pids+=($client)
 killed=""
@@ -77,21 +77,23 @@ for _ in $(seq 1200); do
   sleep 0.02
 done
 # The replica rendering a frame now (its render queue busy: its answer is mid-stream), looked
-# for during up to 3 s while the client runs; else the second one.
-killed=$(python3 - "$client" "${ports[@]}" <<'PY'
-import http.client, json, os, sys, time
-client, ports = int(sys.argv[1]), sys.argv[2:]
+# for during up to 3 s while the client runs, is frozen (SIGSTOP) the moment it is seen, so that
+# its answer cannot complete, then killed; when none is seen busy, the second one is killed.
+killed=$(python3 - "$client" "${ports[0]}:${rpids[0]}" "${ports[1]}:${rpids[1]}" "${ports[2]}:${rpids[2]}" <<'PY'
+import http.client, json, os, signal, sys, time
+client, replicas = int(sys.argv[1]), [a.split(":") for a in sys.argv[2:]]
 end = time.time() + 3
 while time.time() < end:
     try:
         os.kill(client, 0)
     except OSError:
         break
-    for r, p in enumerate(ports):
+    for r, (port, pid) in enumerate(replicas):
         try:
-            c = http.client.HTTPConnection("127.0.0.1", int(p), timeout=1)
+            c = http.client.HTTPConnection("127.0.0.1", int(port), timeout=1)
             c.request("GET", "/api/v1/info")
             if json.loads(c.getresponse().read())["render_queue"] > 0:
+                os.kill(int(pid), signal.SIGSTOP)
                 print(r)
                 sys.exit(0)
         except Exception:
@@ -99,8 +101,7 @@ while time.time() < end:
 PY
 )
 busy=yes
-[ -n "$killed" ] || busy=no
-[ -n "$killed" ] || killed=1
+[ -n "$killed" ] || { killed=1; busy=no; }
 kill -9 "${rpids[$killed]}"
 echo "killed replica $((killed + 1)) after $n frames (rendering: $busy)"
 wait $client || fail "the client failed (exit $?): $(cat "$tmp/client.log")"
