@@ -7,7 +7,8 @@
 //     service's name, which compose resolves to every replica); the healthcheck asks that port's
 //     /api/v1/health; nginx mounts the shipped config and waits for healthy replicas; the body
 //     limits agree (--max-upload-mb = client_max_body_size); replicas keep nothing on disk (tmpfs
-//     data) and have a content cache; the token comes from the environment;
+//     data) and have a content cache; the token comes from the environment; the image runs as a
+//     non-root user, exposes the port and starts dermis-server, built by the CI install script;
 //   * the validator is not vacuous: broken copies are refused.
 // Usage: node compose.test.mjs <source dir>   (exit 0 = pass)
 import { parse } from "yaml";
@@ -62,6 +63,17 @@ function problems(doc, nginx) {
   const build = server.build ?? {};
   const context = resolve(dockerDir, build.context ?? ".");
   if (!existsSync(join(context, build.dockerfile ?? "Dockerfile"))) out.push(`no Dockerfile at ${build.dockerfile} in ${context}`);
+  const dockerfile = join(context, build.dockerfile ?? "Dockerfile");
+  if (existsSync(dockerfile)) {
+    // The image the replicas run: non-root, the port exposed, the server as entry point, the
+    // same install script as CI.
+    const text = readFileSync(dockerfile, "utf8");
+    const user = /^USER\s+(\S+)/m.exec(text)?.[1];
+    if (!user || user === "root" || user === "0") out.push(`the image runs as ${user ?? "root"}`);
+    if (!new RegExp(`^EXPOSE\\s+.*\\b${port}\\b`, "m").test(text)) out.push(`the image does not EXPOSE ${port}`);
+    if (!/^ENTRYPOINT\s+\[".*\/dermis-server"\]/m.test(text)) out.push("the image's entry point is not dermis-server");
+    if (!/scripts\/install-deps\.sh/.test(text)) out.push("the image does not use scripts/install-deps.sh");
+  }
   const hc = (server.healthcheck?.test ?? []).join(" ");
   if (!hc.includes(`127.0.0.1:${port}/api/v1/health`)) out.push(`the healthcheck does not ask /api/v1/health on port ${port}: ${hc}`);
   if (!(server.deploy?.replicas >= 2)) out.push("fewer than 2 replicas");
