@@ -145,11 +145,19 @@ TEST_F(BatchContentTest, PartsMustMatchTheirAddressAndAddressesMustBeWellFormed)
     EXPECT_NE(r.error().message.find(addressOf(junk)), std::string::npos) << r.error().message;
 
     // Parts the document does not name are ignored (not decoded, not kept).
-    const auto insertions = cacheStats()["insertions"].get<int>();
     auto ok = svc_->batch(body(scene()), {{addressOf(model_), model_}, {addressOf(pattern_), pattern_},
                                           {addressOf(junk), junk}});
     ASSERT_TRUE(ok) << ok.error().message;
-    EXPECT_EQ(cacheStats()["insertions"].get<int>(), insertions + 2);
+    EXPECT_EQ(cacheStats()["entries"], 2); // the model and the pattern
+    json named = scene();
+    named["patterns"]["mine"] = addressOf(junk);
+    auto notKept = svc_->batch(body(named));
+    ASSERT_FALSE(notKept);
+    EXPECT_EQ(notKept.error().missing, std::vector<std::string>{addressOf(junk)});
+    // Parts sent again for content already cached are not decoded again.
+    const auto insertions = cacheStats()["insertions"].get<int>();
+    ASSERT_TRUE(svc_->batch(body(scene()), both()));
+    EXPECT_EQ(cacheStats()["insertions"].get<int>(), insertions);
 }
 
 TEST_F(BatchContentTest, UploadsWithTheSameBytesServeTheirAddress) {
