@@ -1,14 +1,14 @@
 // Dermis HTTP shell — render routes: a scene's frame, its height maps, its sweep (a contact sheet
 // of a joint or clip swept in steps, or the steps as JSON), and the stateless batch (POST
-// /render), whose frames stream as multipart/mixed parts as they finish. Renders go through
+// /render), whose frames stream as multipart/mixed parts as they finish (its scene may name
+// content by address, the bytes sent along as multipart/form-data: SPEC §7). Renders go through
 // the Service to the renderer's thread (a full queue answers 503 + Retry-After).
 #include "http/api_internal.hpp"
 
 #include <cmath>
 #include <map>
-#include <vector>
-
 #include <memory>
+#include <vector>
 
 namespace dermis::api_detail {
 
