@@ -85,15 +85,15 @@ export function initFrameView(section, theApi) {
   section.innerHTML = `
     <div class="viewbar">
       <span class="title">3D</span>
-      <label>View <select id="viewMode" aria-label="view mode">
+      <label><span class="lbl">View</span> <select id="viewMode" aria-label="view mode" title="View mode">
         <option value="shaded">shaded</option><option value="bump">bump</option>
         <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
-      <label>Compare <select id="compareMode" aria-label="compare mode">
+      <label><span class="lbl">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame">
         <option value="off">off</option><option value="split">split</option>
         <option value="flicker">flicker</option><option value="diff">diff heat map</option></select></label>
-      <label>against <select id="compareAgainst" aria-label="compare against"><option value="off">patterns off</option></select></label>
+      <label id="compareAgainstLabel" hidden>against <select id="compareAgainst" aria-label="compare against"><option value="off">patterns off</option></select></label>
       <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
-      <label>Size <select id="frameSize" aria-label="frame size">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
+      <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
       <button type="button" id="placeTool" aria-pressed="false" title="Place tool (P): click the model to add a placement there">Place</button>
       <button type="button" id="resetCamera" title="Reset the camera">Reset</button>
       <span id="diffText" class="badge" hidden></span>
@@ -134,6 +134,7 @@ export function initFrameView(section, theApi) {
     $("viewMode").value = store.view;
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
+    $("compareAgainstLabel").hidden = store.compare.mode === "off"; // "against" means nothing until comparing
     refresh();
   });
   on("revision", () => whenIdle("compare-list", fillAgainst, 400));

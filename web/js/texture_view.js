@@ -35,7 +35,7 @@ export function initTextureView(section) {
   section.innerHTML = `
     <div class="viewbar">
       <span class="title">Texture</span>
-      <label>Overlay <select id="overlay" aria-label="height-map overlay">
+      <label><span class="lbl">Overlay</span> <select id="overlay" aria-label="height-map overlay" title="Height-map overlay">
         <option value="none">none</option><option value="bump">bump map</option><option value="displacement">displacement map</option>
       </select></label>
       <button type="button" id="fitTexture" title="Fit the UV square (0)">Fit</button>
