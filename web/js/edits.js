@@ -42,7 +42,8 @@ let queue = Promise.resolve(); // this editor's edits, one at a time, in order
 /// `undoable` records it for undo.
 export function edit(method, path, body, opts = {}) {
   ++store.busy;
-  const run = queue.then(() => send(method, path, body, opts)).finally(() => { --store.busy; });
+  emit("busy");
+  const run = queue.then(() => send(method, path, body, opts)).finally(() => { --store.busy; emit("busy"); });
   queue = run.catch(() => {});
   return run;
 }
@@ -56,6 +57,7 @@ async function send(method, path, body, { undoable = true, quiet = false } = {})
     const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, payload, before);
     if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
     accept(answer);
+    if (store.saveError !== null) set({ saveError: null });
     if (undoable) {
       undoStack.push(before);
       redoStack.length = 0;
@@ -70,6 +72,7 @@ async function send(method, path, body, { undoable = true, quiet = false } = {})
 
 /// Shows why an edit was refused; after a 412, re-reads the scene.
 export async function refused(e, quiet = false) {
+  set({ saveError: e.message || "refused" }); // the save indicator says so until an edit succeeds
   if (e.code === "stale_revision") {
     notify(`Someone else changed this scene first (now revision ${e.revision}). Your edit was not applied; the scene is up to date again.`, "warn");
     await reloadScene();
