@@ -83,6 +83,20 @@ export async function refused(e, quiet = false) {
 
 export const patchPlacement = (id, fields, opts) => edit("PATCH", `/placements/${encodeURIComponent(id)}`, fields, opts);
 export const deletePlacement = (id) => edit("DELETE", `/placements/${encodeURIComponent(id)}`);
+
+/// Deletes placements `ids` and says so in a notice with an Undo button (a revert to the revision
+/// before the first of these deletions, which then selects them again).
+export async function removePlacements(ids) {
+  const names = new Map(ids.map((id) => { const p = store.doc.placements.find((q) => q.id === id); return [id, (p && p.label) || id]; }));
+  const answers = await Promise.all(ids.map((id) => deletePlacement(id)));
+  const gone = ids.filter((_, i) => answers[i]);
+  if (!gone.length) return;
+  const before = Math.min(...answers.filter(Boolean).map((a) => a.revision)) - 1;
+  const what = gone.length === 1 ? `"${names.get(gone[0])}"` : `${gone.length} placements`;
+  notify(`Deleted ${what}.`, "info", { label: "Undo", run: async () => {
+    if (await revert(before)) set({ selection: gone.filter((id) => store.doc.placements.some((p) => p.id === id)) });
+  } });
+}
 export const addPlacement = (placement) => edit("POST", "/placements", placement);
 export const mirrorPlacement = (id) => edit("POST", `/placements/${encodeURIComponent(id)}/mirror`, {});
 export const patchPose = (fields, opts) => edit("PATCH", "/pose", fields, opts);

@@ -3,7 +3,7 @@
 
 import { store, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
-import { patchPlacement, deletePlacement, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
+import { patchPlacement, removePlacements, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
 import { cancelDrag, dragging, viewCentreUV } from "./texture_view.js";
 import { setPlaceTool, placeToolOn } from "./frame_view.js";
 import { currentPattern, choosePattern } from "./panels/library.js";
@@ -81,7 +81,7 @@ function onKey(e, { dlg, fitTexture }) {
     const f = k === "+" || k === "=" ? 1.05 : 1 / 1.05;
     each((p) => patchPlacement(p.id, now(p.id, (q) => ({ scale: [geo.round4(q.scale[0] * f), geo.round4(q.scale[1] * f)] }))));
   } else if ((k === "Delete" || k === "Backspace") && sel.length) {
-    sel.forEach((id) => deletePlacement(id));
+    removePlacements(sel);
     set({ selection: [] });
   } else if ((k === "m" || k === "M") && sel.length) sel.forEach((id) => mirrorPlacement(id));
   else if ((k === "d" || k === "D") && sel.length) duplicate(sel);

@@ -4,8 +4,9 @@
 
 const box = () => document.getElementById("notices");
 
-/// Shows `message`; kind: info | warn | error.
-export function notify(message, kind = "info") {
+/// Shows `message`; kind: info | warn | error. `action` ({label, run}) adds a button (e.g. Undo)
+/// that runs once and closes the notice; such a notice stays a little longer.
+export function notify(message, kind = "info", action = null) {
   const list = box();
   if (!list) return;
   const item = document.createElement("div");
@@ -18,10 +19,19 @@ export function notify(message, kind = "info") {
   close.textContent = "×";
   close.setAttribute("aria-label", "dismiss");
   close.onclick = () => item.remove();
-  item.append(text, close);
+  item.append(text);
+  if (action) {
+    const b = document.createElement("button");
+    b.type = "button";
+    b.className = "action";
+    b.textContent = action.label;
+    b.onclick = () => { item.remove(); action.run(); };
+    item.append(b);
+  }
+  item.append(close);
   list.append(item);
   while (list.children.length > 4) list.firstElementChild.remove();
-  if (kind === "info") setTimeout(() => item.remove(), 4000);
+  if (kind === "info") setTimeout(() => item.remove(), action ? 10000 : 4000);
   else setTimeout(() => item.remove(), 15000);
 }
 
