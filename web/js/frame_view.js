@@ -103,6 +103,7 @@ export function initFrameView(section, theApi) {
       <img id="compareFrame" alt="" draggable="false" hidden>
       <div class="split-handle" hidden></div>
       <div class="spinner" hidden></div>
+      <div class="stagehint" id="placeHint" role="status" hidden></div>
     </div>`;
   stage = section.querySelector(".stage");
   img = section.querySelector("#frame");
@@ -138,6 +139,7 @@ export function initFrameView(section, theApi) {
     refresh();
   });
   on("revision", () => whenIdle("compare-list", fillAgainst, 400));
+  on("currentPattern patterns", showPlaceHint);
 }
 
 /// Sets the frame size (one of 384, 512, 768, 1024; a permalink's size).
@@ -154,6 +156,18 @@ export function setPlaceTool(onOff) {
   placeTool = onOff;
   document.getElementById("placeTool").setAttribute("aria-pressed", String(onOff));
   stage.style.cursor = onOff ? "copy" : "";
+  showPlaceHint();
+}
+
+/// While the place tool is on, the 3D view says what a click adds and how to leave the tool.
+function showPlaceHint() {
+  const hint = document.getElementById("placeHint");
+  if (!hint) return;
+  hint.hidden = !placeTool;
+  if (!placeTool) return;
+  const p = currentPattern();
+  hint.textContent = p ? `Place tool: click the model to add "${p.name || p.id}" there · P or Esc to stop`
+                       : "Place tool: choose a pattern in the library first · P or Esc to stop";
 }
 
 /// The frame parameters this view shows (shared by frame, compare, diff and pick).

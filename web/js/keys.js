@@ -29,7 +29,7 @@ export const SHORTCUTS = [
   ["T / V / L", "go to the texture view / the 3D view / the placements list"],
   ["Space", "play / pause the clip"],
   ["Ctrl+Z / Ctrl+Shift+Z", "undo / redo (server reverts)"],
-  ["Esc", "cancel a drag; clear the selection"],
+  ["Esc", "cancel a drag; leave the place tool; clear the selection"],
   ["0", "fit the texture view"],
   ["?", "this list"],
 ];
@@ -68,6 +68,7 @@ function onKey(e, { dlg, fitTexture }) {
   let handled = true;
   if (k === "?") dlg.showModal();
   else if (/^[1-9]$/.test(k)) placeNth(+k - 1);
+  else if (k === "Escape" && placeToolOn()) setPlaceTool(false); // Esc leaves the place tool first
   else if (k === "Escape") set({ selection: [] });
   else if (k === "n" || k === "N") selectNext(e.shiftKey ? -1 : 1);
   else if (k.startsWith("Arrow") && sel.length) {
