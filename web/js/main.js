@@ -82,6 +82,8 @@ function wireToolbar() {
   on("undo revision", () => { $("undo").disabled = !canUndo(); $("redo").disabled = !canRedo(); });
   on("revision", () => { $("revision").textContent = `r${store.revision}`; });
   on("busy saveError online revision", showSaveState);
+  // Closing or reloading the window while an edit is still on its way would lose it: ask first.
+  window.addEventListener("beforeunload", (e) => { if (store.busy > 0) { e.preventDefault(); e.returnValue = ""; } });
   for (const b of document.querySelectorAll("[data-layout]"))
     b.onclick = () => set({ layoutMode: b.dataset.layout });
   on("layoutMode", () => {
