@@ -108,18 +108,31 @@ export async function revert(revision, { undoable = true } = {}) {
 }
 
 /// Goes back (undo) or forward (redo): a revert to the revision on top of `from`, whose own
-/// revision then goes on `to`. A refused revert leaves both stacks as they were.
-async function travel(from, to, nothing) {
+/// revision then goes on `to`. A refused revert leaves both stacks as they were. A notice names
+/// what was undone (the operation of the revision left) or redone (of the revision returned to),
+/// with the way back as its button.
+async function travel(from, to, nothing, verb, back) {
   if (!from.length) return notify(nothing, "info");
   const target = from.pop();
   const here = store.revision;
-  if (await revert(target, { undoable: false })) to.push(here);
-  else from.push(target);
+  if (await revert(target, { undoable: false })) {
+    to.push(here);
+    tellTravel(verb, verb === "Undone" ? here : target, back);
+  } else from.push(target);
   emit("undo");
 }
 
-export const undo = () => travel(undoStack, redoStack, "Nothing to undo.");
-export const redo = () => travel(redoStack, undoStack, "Nothing to redo.");
+async function tellTravel(verb, revision, back) {
+  let what = `revision ${revision}`;
+  try {
+    const r = (await api.get(`/scenes/${store.sceneId}/revisions?limit=50`)).revisions.find((x) => x.revision === revision);
+    if (r && r.op) what = r.op;
+  } catch { /* the revision number will do */ }
+  notify(`${verb}: ${what}.`, "info", back, "undo");
+}
+
+export const undo = () => travel(undoStack, redoStack, "Nothing to undo.", "Undone", { label: "Redo", run: () => redo() });
+export const redo = () => travel(redoStack, undoStack, "Nothing to redo.", "Redone", { label: "Undo", run: () => undo() });
 
 /// A stream of edits from one gesture (a drag, a slider). send(value) queues the newest value
 /// (the first leaves one interval after the stream starts, so a gesture cancelled at once sends

@@ -5,12 +5,15 @@
 const box = () => document.getElementById("notices");
 
 /// Shows `message`; kind: info | warn | error. `action` ({label, run}) adds a button (e.g. Undo)
-/// that runs once and closes the notice; such a notice stays a little longer.
-export function notify(message, kind = "info", action = null) {
+/// that runs once and closes the notice; such a notice stays a little longer. A notice with a
+/// `key` replaces the one shown before with that key (undo after undo: one notice, the latest).
+export function notify(message, kind = "info", action = null, key = null) {
   const list = box();
   if (!list) return;
+  if (key) for (const old of list.querySelectorAll(`.notice[data-key="${CSS.escape(key)}"]`)) old.remove();
   const item = document.createElement("div");
   item.className = `notice ${kind}`;
+  if (key) item.dataset.key = key;
   item.setAttribute("role", kind === "error" || kind === "warn" ? "alert" : "status");
   const text = document.createElement("span");
   text.textContent = message;
