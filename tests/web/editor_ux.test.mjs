@@ -6,8 +6,9 @@
 // their room ("against" only while comparing); the save indicator says Saving… / Saved / Not
 // saved, and closing the window with an edit on its way asks first; Delete says what it deleted
 // and its Undo brings it back selected; the place tool says what a click adds, and Esc leaves it
-// without dropping the selection. Screenshots: editor-empty.png, editor-1280x720.png,
-// editor-deleted-undo.png, editor-place-tool.png.
+// without dropping the selection; Ctrl+Z and Redo say what they undid / redid, each with the
+// way back. Screenshots: editor-empty.png, editor-1280x720.png, editor-deleted-undo.png,
+// editor-place-tool.png, editor-undo-notice.png.
 import assert from "node:assert/strict";
 import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, settled, until, sleep } from "./editor_lib.mjs";
 
@@ -138,6 +139,35 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.deepEqual((await state(page)).selection, ["elbow_r"], "the first Esc keeps the selection");
       await page.keyboard.press("Escape");
       assert.deepEqual((await state(page)).selection, [], "the next Esc clears it");
+      assert.deepEqual(page.errors, []);
+    }],
+    ["Ctrl+Z says what it undid, with Redo; Redo says what it redid, with Undo", async () => {
+      await settled(page, api);
+      const id = (await state(page)).sceneId;
+      const rotation = async () => (await api("GET", `/scenes/${id}`)).body.scene.placements.find((p) => p.id === "thigh_l").rotation;
+      const r0 = await rotation();
+      await page.click('#placementList li[data-placement="thigh_l"] .name');
+      await page.focus("#uv");
+      await page.keyboard.press("]");
+      await until(async () => (await rotation()) !== r0, "rotated on the server");
+      const r1 = await rotation();
+      await settled(page, api);
+      await page.keyboard.press("Control+z");
+      const redo = await page.waitForSelector('#notices .notice:has-text("Undone: patch placement thigh_l") button.action', { timeout: 10000 });
+      assert.equal(await redo.textContent(), "Redo");
+      await until(async () => (await rotation()) === r0, "the rotation undone on the server");
+      await redo.click();
+      await until(async () => (await rotation()) === r1, "redone by the notice's button");
+      const again = await page.waitForSelector('#notices .notice:has-text("Redone: patch placement thigh_l") button.action', { timeout: 10000 });
+      assert.equal(await again.textContent(), "Undo");
+      assert.equal(await page.$$eval('#notices .notice[data-key="undo"]', (n) => n.length), 1, "one undo notice at a time");
+      // Someone else on the scene (the window closed above is still shown for a while, or a new
+      // one): their chip must not wrap the 1280-px toolbar.
+      const other = await openEditor(context, sceneUrl, { width: 1280, height: 720 });
+      await until(() => page.$eval("#people", (e) => e.children.length > 0), "another person's chip");
+      assert.ok((await box(page, ".toolbar")).height < 44, "still one toolbar row with someone else on the scene");
+      await other.close();
+      await screenshot(page, "editor-undo-notice.png");
       assert.deepEqual(page.errors, []);
     }],
   ]);
