@@ -19,6 +19,9 @@ await runSuite("WebEditorUxBrowserTest", async () => {
   const context = await browser.newContext();
   const box = (page, sel) => page.$eval(sel, (e) => { const r = e.getBoundingClientRect(); return { top: r.top, bottom: r.bottom, left: r.left, width: r.width, height: r.height }; });
   const visible = (page, sel) => page.$eval(sel, (e) => !e.hidden && e.getBoundingClientRect().height > 0 && getComputedStyle(e).display !== "none");
+  // The texture view's key hint is shown whole or not at all (never "1–9 pla…").
+  const hintWhole = (page) => page.$eval("#textureView .viewbar .hint", (e) => getComputedStyle(e).display === "none" || e.scrollWidth <= e.clientWidth + 1);
+  const hintShown = (page) => page.$eval("#textureView .viewbar .hint", (e) => getComputedStyle(e).display !== "none");
   let page, sceneUrl; // the 1280×720 window on a scene with the default placements (checks 2–6)
 
   const failures = await runChecks("WebEditorUxBrowserTest", [
@@ -31,6 +34,10 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.ok(ws.height >= 1080 - bar.height - foot.height - 2, `the workspace takes the rest (${ws.height} px)`);
       assert.ok(await visible(p, "#placementsEmpty"), "the empty placements list shows its hint");
       assert.match(await p.$eval("#placementsEmpty", (e) => e.textContent.replace(/\s+/g, " ")), /No placements yet.*1.*9.*place tool/);
+      assert.ok(await hintWhole(p), "the key hint is whole or hidden, never cut");
+      await p.click('[data-layout="texture"]');
+      await until(async () => await hintShown(p) && await hintWhole(p), "the texture view alone shows its key hint whole");
+      await p.click('[data-layout="both"]');
       await screenshot(p, "editor-empty.png");
       // The hint's own advice works: 1 over the texture view adds one, and the hint goes.
       const uv = await box(p, "#uv");
@@ -56,6 +63,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.ok(uv.height >= 340 && stage.height >= 340, `the views keep their room (${uv.height}, ${stage.height} px)`);
       const foot = await box(page, ".timeline");
       assert.ok(Math.abs(foot.bottom - 720) <= 1 && foot.height <= 240, `the timeline (${foot.height} px) ends at the bottom`);
+      assert.ok(await hintWhole(page), "the key hint is whole or hidden, never cut");
       // "against" only means something while comparing.
       assert.equal(await visible(page, "#compareAgainstLabel"), false, "no 'against' while compare is off");
       await page.selectOption("#compareMode", "split");

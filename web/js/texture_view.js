@@ -40,7 +40,6 @@ export function initTextureView(section) {
       </select></label>
       <button type="button" id="fitTexture" title="Fit the UV square (0)">Fit</button>
       <span id="zoomText" class="badge">100%</span>
-      <span class="grow"></span>
       <span class="hint">1–9 place · drag move · corners scale · ◯ rotate · ? keys</span>
     </div>
     <div class="stage"><canvas id="uv" tabindex="0" aria-label="texture space: placements on the UV layout; arrow keys nudge the selection"></canvas></div>`;
