@@ -260,6 +260,9 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       await screenshot(page, "editor-texture-mirror.png");
       // Texture view alone (Tab from the texture view switches to 3D when one view is shown).
       await page.click('[data-layout="texture"]');
+      // The notices of earlier checks (Deleted…, Undone…) are dismissed, as a person would, for a
+      // clean picture (docs/editor-texture.png is a copy of it).
+      for (const close of await page.$$('#notices .notice button[aria-label="dismiss"]')) await close.click();
       await sleep(300);
       await screenshot(page, "editor-texture.png");
       await page.focus("#uv");

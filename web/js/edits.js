@@ -42,7 +42,8 @@ let queue = Promise.resolve(); // this editor's edits, one at a time, in order
 /// `undoable` records it for undo.
 export function edit(method, path, body, opts = {}) {
   ++store.busy;
-  const run = queue.then(() => send(method, path, body, opts)).finally(() => { --store.busy; });
+  emit("busy");
+  const run = queue.then(() => send(method, path, body, opts)).finally(() => { --store.busy; emit("busy"); });
   queue = run.catch(() => {});
   return run;
 }
@@ -56,6 +57,7 @@ async function send(method, path, body, { undoable = true, quiet = false } = {})
     const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, payload, before);
     if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
     accept(answer);
+    if (store.saveError !== null) set({ saveError: null });
     if (undoable) {
       undoStack.push(before);
       redoStack.length = 0;
@@ -70,6 +72,7 @@ async function send(method, path, body, { undoable = true, quiet = false } = {})
 
 /// Shows why an edit was refused; after a 412, re-reads the scene.
 export async function refused(e, quiet = false) {
+  set({ saveError: e.message || "refused" }); // the save indicator says so until an edit succeeds
   if (e.code === "stale_revision") {
     notify(`Someone else changed this scene first (now revision ${e.revision}). Your edit was not applied; the scene is up to date again.`, "warn");
     await reloadScene();
@@ -80,6 +83,20 @@ export async function refused(e, quiet = false) {
 
 export const patchPlacement = (id, fields, opts) => edit("PATCH", `/placements/${encodeURIComponent(id)}`, fields, opts);
 export const deletePlacement = (id) => edit("DELETE", `/placements/${encodeURIComponent(id)}`);
+
+/// Deletes placements `ids` and says so in a notice with an Undo button (a revert to the revision
+/// before the first of these deletions, which then selects them again).
+export async function removePlacements(ids) {
+  const names = new Map(ids.map((id) => { const p = store.doc.placements.find((q) => q.id === id); return [id, (p && p.label) || id]; }));
+  const answers = await Promise.all(ids.map((id) => deletePlacement(id)));
+  const gone = ids.filter((_, i) => answers[i]);
+  if (!gone.length) return;
+  const before = Math.min(...answers.filter(Boolean).map((a) => a.revision)) - 1;
+  const what = gone.length === 1 ? `"${names.get(gone[0])}"` : `${gone.length} placements`;
+  notify(`Deleted ${what}.`, "info", { label: "Undo", run: async () => {
+    if (await revert(before)) set({ selection: gone.filter((id) => store.doc.placements.some((p) => p.id === id)) });
+  } });
+}
 export const addPlacement = (placement) => edit("POST", "/placements", placement);
 export const mirrorPlacement = (id) => edit("POST", `/placements/${encodeURIComponent(id)}/mirror`, {});
 export const patchPose = (fields, opts) => edit("PATCH", "/pose", fields, opts);
@@ -91,18 +108,31 @@ export async function revert(revision, { undoable = true } = {}) {
 }
 
 /// Goes back (undo) or forward (redo): a revert to the revision on top of `from`, whose own
-/// revision then goes on `to`. A refused revert leaves both stacks as they were.
-async function travel(from, to, nothing) {
+/// revision then goes on `to`. A refused revert leaves both stacks as they were. A notice names
+/// what was undone (the operation of the revision left) or redone (of the revision returned to),
+/// with the way back as its button.
+async function travel(from, to, nothing, verb, back) {
   if (!from.length) return notify(nothing, "info");
   const target = from.pop();
   const here = store.revision;
-  if (await revert(target, { undoable: false })) to.push(here);
-  else from.push(target);
+  if (await revert(target, { undoable: false })) {
+    to.push(here);
+    tellTravel(verb, verb === "Undone" ? here : target, back);
+  } else from.push(target);
   emit("undo");
 }
 
-export const undo = () => travel(undoStack, redoStack, "Nothing to undo.");
-export const redo = () => travel(redoStack, undoStack, "Nothing to redo.");
+async function tellTravel(verb, revision, back) {
+  let what = `revision ${revision}`;
+  try {
+    const r = (await api.get(`/scenes/${store.sceneId}/revisions?limit=50`)).revisions.find((x) => x.revision === revision);
+    if (r && r.op) what = r.op;
+  } catch { /* the revision number will do */ }
+  notify(`${verb}: ${what}.`, "info", back, "undo");
+}
+
+export const undo = () => travel(undoStack, redoStack, "Nothing to undo.", "Undone", { label: "Redo", run: () => redo() });
+export const redo = () => travel(redoStack, undoStack, "Nothing to redo.", "Redone", { label: "Undo", run: () => undo() });
 
 /// A stream of edits from one gesture (a drag, a slider). send(value) queues the newest value
 /// (the first leaves one interval after the stream starts, so a gesture cancelled at once sends

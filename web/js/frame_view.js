@@ -85,15 +85,15 @@ export function initFrameView(section, theApi) {
   section.innerHTML = `
     <div class="viewbar">
       <span class="title">3D</span>
-      <label>View <select id="viewMode" aria-label="view mode">
+      <label><span class="lbl">View</span> <select id="viewMode" aria-label="view mode" title="View mode">
         <option value="shaded">shaded</option><option value="bump">bump</option>
         <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
-      <label>Compare <select id="compareMode" aria-label="compare mode">
+      <label><span class="lbl">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame">
         <option value="off">off</option><option value="split">split</option>
         <option value="flicker">flicker</option><option value="diff">diff heat map</option></select></label>
-      <label>against <select id="compareAgainst" aria-label="compare against"><option value="off">patterns off</option></select></label>
+      <label id="compareAgainstLabel" hidden>against <select id="compareAgainst" aria-label="compare against"><option value="off">patterns off</option></select></label>
       <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
-      <label>Size <select id="frameSize" aria-label="frame size">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
+      <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
       <button type="button" id="placeTool" aria-pressed="false" title="Place tool (P): click the model to add a placement there">Place</button>
       <button type="button" id="resetCamera" title="Reset the camera">Reset</button>
       <span id="diffText" class="badge" hidden></span>
@@ -103,6 +103,7 @@ export function initFrameView(section, theApi) {
       <img id="compareFrame" alt="" draggable="false" hidden>
       <div class="split-handle" hidden></div>
       <div class="spinner" hidden></div>
+      <div class="stagehint" id="placeHint" role="status" hidden></div>
     </div>`;
   stage = section.querySelector(".stage");
   img = section.querySelector("#frame");
@@ -134,9 +135,11 @@ export function initFrameView(section, theApi) {
     $("viewMode").value = store.view;
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
+    $("compareAgainstLabel").hidden = store.compare.mode === "off"; // "against" means nothing until comparing
     refresh();
   });
   on("revision", () => whenIdle("compare-list", fillAgainst, 400));
+  on("currentPattern patterns", showPlaceHint);
 }
 
 /// Sets the frame size (one of 384, 512, 768, 1024; a permalink's size).
@@ -153,6 +156,18 @@ export function setPlaceTool(onOff) {
   placeTool = onOff;
   document.getElementById("placeTool").setAttribute("aria-pressed", String(onOff));
   stage.style.cursor = onOff ? "copy" : "";
+  showPlaceHint();
+}
+
+/// While the place tool is on, the 3D view says what a click adds and how to leave the tool.
+function showPlaceHint() {
+  const hint = document.getElementById("placeHint");
+  if (!hint) return;
+  hint.hidden = !placeTool;
+  if (!placeTool) return;
+  const p = currentPattern();
+  hint.textContent = p ? `Place tool: click the model to add "${p.name || p.id}" there · P or Esc to stop`
+                       : "Place tool: choose a pattern in the library first · P or Esc to stop";
 }
 
 /// The frame parameters this view shows (shared by frame, compare, diff and pick).

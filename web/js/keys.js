@@ -3,7 +3,7 @@
 
 import { store, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
-import { patchPlacement, deletePlacement, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
+import { patchPlacement, removePlacements, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
 import { cancelDrag, dragging, viewCentreUV } from "./texture_view.js";
 import { setPlaceTool, placeToolOn } from "./frame_view.js";
 import { currentPattern, choosePattern } from "./panels/library.js";
@@ -29,7 +29,7 @@ export const SHORTCUTS = [
   ["T / V / L", "go to the texture view / the 3D view / the placements list"],
   ["Space", "play / pause the clip"],
   ["Ctrl+Z / Ctrl+Shift+Z", "undo / redo (server reverts)"],
-  ["Esc", "cancel a drag; clear the selection"],
+  ["Esc", "cancel a drag; leave the place tool; clear the selection"],
   ["0", "fit the texture view"],
   ["?", "this list"],
 ];
@@ -68,6 +68,7 @@ function onKey(e, { dlg, fitTexture }) {
   let handled = true;
   if (k === "?") dlg.showModal();
   else if (/^[1-9]$/.test(k)) placeNth(+k - 1);
+  else if (k === "Escape" && placeToolOn()) setPlaceTool(false); // Esc leaves the place tool first
   else if (k === "Escape") set({ selection: [] });
   else if (k === "n" || k === "N") selectNext(e.shiftKey ? -1 : 1);
   else if (k.startsWith("Arrow") && sel.length) {
@@ -81,7 +82,7 @@ function onKey(e, { dlg, fitTexture }) {
     const f = k === "+" || k === "=" ? 1.05 : 1 / 1.05;
     each((p) => patchPlacement(p.id, now(p.id, (q) => ({ scale: [geo.round4(q.scale[0] * f), geo.round4(q.scale[1] * f)] }))));
   } else if ((k === "Delete" || k === "Backspace") && sel.length) {
-    sel.forEach((id) => deletePlacement(id));
+    removePlacements(sel);
     set({ selection: [] });
   } else if ((k === "m" || k === "M") && sel.length) sel.forEach((id) => mirrorPlacement(id));
   else if ((k === "d" || k === "D") && sel.length) duplicate(sel);

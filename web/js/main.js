@@ -81,6 +81,9 @@ function wireToolbar() {
   $("redo").onclick = () => redo();
   on("undo revision", () => { $("undo").disabled = !canUndo(); $("redo").disabled = !canRedo(); });
   on("revision", () => { $("revision").textContent = `r${store.revision}`; });
+  on("busy saveError online revision", showSaveState);
+  // Closing or reloading the window while an edit is still on its way would lose it: ask first.
+  window.addEventListener("beforeunload", (e) => { if (store.busy > 0) { e.preventDefault(); e.returnValue = ""; } });
   for (const b of document.querySelectorAll("[data-layout]"))
     b.onclick = () => set({ layoutMode: b.dataset.layout });
   on("layoutMode", () => {
@@ -119,6 +122,19 @@ function wireToolbar() {
     else if (/\.json$/i.test(f.name)) loadSceneFile(f);
     else uploadPattern(f);
   });
+}
+
+/// The save indicator next to the revision: is what I changed on the server yet?
+function showSaveState() {
+  const el = $("saveState");
+  const [state, text, title] =
+    store.busy > 0 ? ["saving", "Saving…", "Your edits are being sent to the server"]
+    : store.saveError !== null ? ["error", "Not saved", `Your last edit was refused: ${store.saveError}`]
+    : !store.online ? ["offline", "Offline", "The connection to the server dropped: edits cannot be saved until it is back"]
+    : ["saved", "✓ Saved", `Every edit is on the server (revision ${store.revision})`];
+  el.dataset.state = state;
+  el.textContent = text;
+  el.title = title;
 }
 
 async function newSceneFromModel(f) {

@@ -4,12 +4,16 @@
 
 const box = () => document.getElementById("notices");
 
-/// Shows `message`; kind: info | warn | error.
-export function notify(message, kind = "info") {
+/// Shows `message`; kind: info | warn | error. `action` ({label, run}) adds a button (e.g. Undo)
+/// that runs once and closes the notice; such a notice stays a little longer. A notice with a
+/// `key` replaces the one shown before with that key (undo after undo: one notice, the latest).
+export function notify(message, kind = "info", action = null, key = null) {
   const list = box();
   if (!list) return;
+  if (key) for (const old of list.querySelectorAll(`.notice[data-key="${CSS.escape(key)}"]`)) old.remove();
   const item = document.createElement("div");
   item.className = `notice ${kind}`;
+  if (key) item.dataset.key = key;
   item.setAttribute("role", kind === "error" || kind === "warn" ? "alert" : "status");
   const text = document.createElement("span");
   text.textContent = message;
@@ -18,10 +22,19 @@ export function notify(message, kind = "info") {
   close.textContent = "×";
   close.setAttribute("aria-label", "dismiss");
   close.onclick = () => item.remove();
-  item.append(text, close);
+  item.append(text);
+  if (action) {
+    const b = document.createElement("button");
+    b.type = "button";
+    b.className = "action";
+    b.textContent = action.label;
+    b.onclick = () => { item.remove(); action.run(); };
+    item.append(b);
+  }
+  item.append(close);
   list.append(item);
   while (list.children.length > 4) list.firstElementChild.remove();
-  if (kind === "info") setTimeout(() => item.remove(), 4000);
+  if (kind === "info") setTimeout(() => item.remove(), action ? 10000 : 4000);
   else setTimeout(() => item.remove(), 15000);
 }
 

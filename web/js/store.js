@@ -25,7 +25,8 @@ export const store = {
   cursorUV: [0.5, 0.5], // last pointer position in the texture view
   liveCamera: null,     // the camera the server used (GET drivers: "auto" distance resolved)
   online: true,
-  busy: 0,              // edits queued or in flight
+  busy: 0,              // edits queued or in flight (topic "busy")
+  saveError: null,      // why this window's last edit was refused (null: its edits are on the server)
   gestures: 0,          // drags and slider gestures running
 };
 

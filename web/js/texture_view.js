@@ -35,12 +35,11 @@ export function initTextureView(section) {
   section.innerHTML = `
     <div class="viewbar">
       <span class="title">Texture</span>
-      <label>Overlay <select id="overlay" aria-label="height-map overlay">
+      <label><span class="lbl">Overlay</span> <select id="overlay" aria-label="height-map overlay" title="Height-map overlay">
         <option value="none">none</option><option value="bump">bump map</option><option value="displacement">displacement map</option>
       </select></label>
       <button type="button" id="fitTexture" title="Fit the UV square (0)">Fit</button>
       <span id="zoomText" class="badge">100%</span>
-      <span class="grow"></span>
       <span class="hint">1–9 place · drag move · corners scale · ◯ rotate · ? keys</span>
     </div>
     <div class="stage"><canvas id="uv" tabindex="0" aria-label="texture space: placements on the UV layout; arrow keys nudge the selection"></canvas></div>`;

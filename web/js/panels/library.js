@@ -4,7 +4,7 @@
 // with a notice and nothing is sent. The list is one tab stop (roving focus): ←/→/↑/↓, Home and
 // End move to a pattern and choose it.
 
-import { store, on, set } from "../store.js";
+import { store, on, set, emit } from "../store.js";
 import { notify } from "../notice.js";
 import { patternImagePath } from "../images.js";
 
@@ -15,6 +15,7 @@ export function choosePattern(id) {
   const hadFocus = list && list.contains(document.activeElement);
   currentId = id;
   render();
+  emit("currentPattern");
   if (hadFocus) list.querySelector('button[tabindex="0"]')?.focus();
 }
 

@@ -9,12 +9,16 @@ import { patternImagePath } from "../images.js";
 import { patchPlacement, putScene } from "../edits.js";
 import { escapeHtml } from "./library.js";
 
-let list, count;
+let list, count, empty;
 
 export function initPlacements(section) {
   section.innerHTML = `<h2>Placements <span class="badge" id="placementCount">0</span></h2>
-    <ul class="list" id="placementList" aria-label="placements" data-roving></ul>`;
+    <ul class="list" id="placementList" aria-label="placements" data-roving></ul>
+    <p class="empty" id="placementsEmpty" hidden>No placements yet. Choose a pattern in the library, then
+      press <kbd>1</kbd>–<kbd>9</kbd> over the texture view, or turn on the place tool (<kbd>P</kbd>) and
+      click the model in the 3D view.</p>`;
   list = section.querySelector("#placementList");
+  empty = section.querySelector("#placementsEmpty");
   count = section.querySelector("#placementCount");
   list.addEventListener("keydown", onListKey);
   on("selection lint solo", render);
@@ -68,6 +72,7 @@ function render() {
   const lintCount = new Map();
   for (const f of store.lint) if (f.placement) lintCount.set(f.placement, (lintCount.get(f.placement) || 0) + 1);
   count.textContent = String(store.doc.placements.length);
+  empty.hidden = store.doc.placements.length > 0;
   list.innerHTML = "";
   for (const p of store.doc.placements) {
     const li = document.createElement("li");

@@ -1,0 +1,186 @@
+// WebEditorUxBrowserTest — what an artist sees and is told, in Debian's Chromium (playwright-core)
+// against a real dermis-server on 127.0.0.1.
+// Usage: node editor_ux.test.mjs <dermis-server executable>   (exit 0 = pass)
+// Checks: the workspace fills a 1920×1080 window even when the scene has no placements, and the
+// empty placements list says how to add one; at 1280×720 the toolbar is one row and the views keep
+// their room ("against" only while comparing); the save indicator says Saving… / Saved / Not
+// saved, and closing the window with an edit on its way asks first; Delete says what it deleted
+// and its Undo brings it back selected; the place tool says what a click adds, and Esc leaves it
+// without dropping the selection; Ctrl+Z and Redo say what they undid / redid, each with the
+// way back. Screenshots: editor-empty.png, editor-1280x720.png, editor-deleted-undo.png,
+// editor-place-tool.png, editor-undo-notice.png.
+import assert from "node:assert/strict";
+import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, settled, until, sleep } from "./editor_lib.mjs";
+
+const server = await startServer(process.argv[2], [], "dermis-editor-ux-");
+const api = apiClient(server.base);
+const browser = await launch();
+await runSuite("WebEditorUxBrowserTest", async () => {
+  const context = await browser.newContext();
+  const box = (page, sel) => page.$eval(sel, (e) => { const r = e.getBoundingClientRect(); return { top: r.top, bottom: r.bottom, left: r.left, width: r.width, height: r.height }; });
+  const visible = (page, sel) => page.$eval(sel, (e) => !e.hidden && e.getBoundingClientRect().height > 0 && getComputedStyle(e).display !== "none");
+  // The texture view's key hint is shown whole or not at all (never "1–9 pla…").
+  const hintWhole = (page) => page.$eval("#textureView .viewbar .hint", (e) => getComputedStyle(e).display === "none" || e.scrollWidth <= e.clientWidth + 1);
+  const hintShown = (page) => page.$eval("#textureView .viewbar .hint", (e) => getComputedStyle(e).display !== "none");
+  let page, sceneUrl; // the 1280×720 window on a scene with the default placements (checks 2–6)
+
+  const failures = await runChecks("WebEditorUxBrowserTest", [
+    ["1920×1080, no placements: the workspace fills the window and the empty list says what to do", async () => {
+      const created = await api("POST", "/scenes", { format: "dermis.scene/1", model: "builtin:default", placements: [] });
+      assert.equal(created.status, 201, JSON.stringify(created.body));
+      const p = await openEditor(context, `${server.base}/?scene=${created.body.id}`, { width: 1920, height: 1080 });
+      const bar = await box(p, ".toolbar"), ws = await box(p, ".workspace"), foot = await box(p, ".timeline");
+      assert.ok(Math.abs(foot.bottom - 1080) <= 1, `the timeline ends at the window's bottom (${foot.bottom})`);
+      assert.ok(ws.height >= 1080 - bar.height - foot.height - 2, `the workspace takes the rest (${ws.height} px)`);
+      assert.ok(await visible(p, "#placementsEmpty"), "the empty placements list shows its hint");
+      assert.match(await p.$eval("#placementsEmpty", (e) => e.textContent.replace(/\s+/g, " ")), /No placements yet.*1.*9.*place tool/);
+      assert.ok(await hintWhole(p), "the key hint is whole or hidden, never cut");
+      await p.click('[data-layout="texture"]');
+      await until(async () => await hintShown(p) && await hintWhole(p), "the texture view alone shows its key hint whole");
+      await p.click('[data-layout="both"]');
+      await screenshot(p, "editor-empty.png");
+      // The hint's own advice works: 1 over the texture view adds one, and the hint goes.
+      const uv = await box(p, "#uv");
+      await p.mouse.move(uv.left + uv.width / 2, uv.top + uv.height / 2);
+      await p.keyboard.press("1");
+      await until(async () => (await api("GET", `/scenes/${created.body.id}`)).body.scene.placements.length === 1, "a placement from key 1");
+      await until(async () => !(await visible(p, "#placementsEmpty")), "the hint hides once there is a placement");
+      assert.deepEqual(p.errors, []);
+      await p.close();
+    }],
+    ["1280×720: one toolbar row, short view bars, room for the views", async () => {
+      const scene = await api("POST", "/scenes", { default_patterns: true }); // the 18 default placements
+      assert.equal(scene.status, 201, JSON.stringify(scene.body));
+      sceneUrl = `${server.base}/?scene=${scene.body.id}`;
+      page = await openEditor(context, sceneUrl, { width: 1280, height: 720 });
+      await sleep(300);
+      const bar = await box(page, ".toolbar");
+      assert.ok(bar.height < 44, `the toolbar is one row (${bar.height} px)`);
+      const tbar = await box(page, "#textureView .viewbar"), fbar = await box(page, "#frameView .viewbar");
+      assert.ok(tbar.height < 40, `the texture view bar is one row (${tbar.height} px)`);
+      assert.ok(fbar.height < 70, `the 3D view bar is two rows at most (${fbar.height} px)`);
+      const uv = await box(page, "#uv"), stage = await box(page, "#frameStage");
+      assert.ok(uv.height >= 340 && stage.height >= 340, `the views keep their room (${uv.height}, ${stage.height} px)`);
+      const foot = await box(page, ".timeline");
+      assert.ok(Math.abs(foot.bottom - 720) <= 1 && foot.height <= 240, `the timeline (${foot.height} px) ends at the bottom`);
+      assert.ok(await hintWhole(page), "the key hint is whole or hidden, never cut");
+      // "against" only means something while comparing.
+      assert.equal(await visible(page, "#compareAgainstLabel"), false, "no 'against' while compare is off");
+      await page.selectOption("#compareMode", "split");
+      assert.equal(await visible(page, "#compareAgainstLabel"), true, "'against' while comparing");
+      await page.selectOption("#compareMode", "off");
+      await screenshot(page, "editor-1280x720.png");
+    }],
+    ["the save indicator: Saving… while an edit is on its way, Saved after, Not saved when refused", async () => {
+      await settled(page, api);
+      assert.equal(await page.$eval("#saveState", (e) => e.dataset.state), "saved");
+      assert.match(await page.$eval("#saveState", (e) => e.textContent), /Saved/);
+      assert.equal(await page.$eval("#saveState", (e) => e.getAttribute("role")), "status");
+      let release;
+      const gate = new Promise((r) => { release = r; });
+      await page.route("**/api/v1/scenes/*/placements/*", async (route) => {
+        if (route.request().method() === "PATCH") await gate;
+        await route.continue();
+      });
+      await page.click('#placementList li[data-placement="elbow_l"] .name');
+      await page.focus("#uv");
+      await page.keyboard.press("]");
+      await until(() => page.$eval("#saveState", (e) => e.dataset.state === "saving" && /Saving/.test(e.textContent)), "Saving… while the edit is held");
+      release();
+      await until(() => page.$eval("#saveState", (e) => e.dataset.state === "saved"), "Saved once the server answered");
+      await page.unroute("**/api/v1/scenes/*/placements/*");
+      // A refused edit (a document naming a joint the model lacks) leaves "Not saved".
+      await page.setInputFiles("#loadFile", { name: "broken.scene.json", mimeType: "application/json", buffer: Buffer.from(JSON.stringify({ format: "dermis.scene/1", model: "builtin:default", placements: [{ id: "x", pattern: "crease", joint: "no_such_joint" }] })) });
+      await until(() => page.$eval("#saveState", (e) => e.dataset.state === "error" && /Not saved/.test(e.textContent) && /no_such_joint/.test(e.title)), "Not saved, with the reason in its title");
+      await page.focus("#uv");
+      await page.keyboard.press("[");
+      await until(() => page.$eval("#saveState", (e) => e.dataset.state === "saved"), "Saved again after a good edit");
+    }],
+    ["closing the window while an edit is on its way asks first", async () => {
+      const p = await openEditor(context, sceneUrl, { width: 1280, height: 720 });
+      await p.route("**/api/v1/scenes/*/placements/*", () => {}); // never answered
+      await p.click('#placementList li[data-placement="elbow_l"] .name');
+      await p.focus("#uv");
+      await p.keyboard.press("]");
+      await until(() => p.$eval("#saveState", (e) => e.dataset.state === "saving"), "an edit on its way");
+      const asked = new Promise((resolve) => p.once("dialog", async (d) => { resolve(d.type()); await d.accept(); }));
+      await p.close({ runBeforeUnload: true });
+      assert.equal(await Promise.race([asked, sleep(5000).then(() => "no dialog")]), "beforeunload");
+    }],
+    ["Delete says what it deleted; its Undo brings the placement back, selected", async () => {
+      await settled(page, api);
+      const before = (await api("GET", `/scenes/${(await state(page)).sceneId}`)).body.scene;
+      await page.click('#placementList li[data-placement="knee_l"] .name');
+      await page.focus("#uv");
+      await page.keyboard.press("Delete");
+      const undoButton = await page.waitForSelector('#notices .notice:has-text("Deleted \\"knee_l\\"") button.action', { timeout: 10000 });
+      assert.equal(await undoButton.textContent(), "Undo");
+      await until(async () => !(await api("GET", `/scenes/${before.id || (await state(page)).sceneId}`)).body.scene.placements.some((p) => p.id === "knee_l"), "knee_l gone on the server");
+      await screenshot(page, "editor-deleted-undo.png");
+      await undoButton.click();
+      const id = (await state(page)).sceneId;
+      await until(async () => (await api("GET", `/scenes/${id}`)).body.scene.placements.some((p) => p.id === "knee_l"), "knee_l back on the server");
+      const after = (await api("GET", `/scenes/${id}`)).body.scene;
+      assert.deepEqual(after.placements, before.placements, "the very same placements, in the same order");
+      await until(async () => (await state(page)).selection.join() === "knee_l", "knee_l selected again");
+    }],
+    ["the place tool says what a click adds; Esc leaves it and keeps the selection", async () => {
+      await page.click('#placementList li[data-placement="elbow_r"] .name');
+      await page.focus("#frameStage");
+      assert.equal(await visible(page, "#placeHint"), false);
+      await page.keyboard.press("p");
+      assert.equal(await page.$eval("#placeTool", (b) => b.getAttribute("aria-pressed")), "true");
+      assert.ok(await visible(page, "#placeHint"), "the hint shows with the tool on");
+      const current = await page.$eval("#libraryList button.current", (b) => b.dataset.pattern);
+      const name = (await api("GET", "/patterns")).body.patterns.find((p) => p.id === current).name;
+      assert.match(await page.$eval("#placeHint", (e) => e.textContent), new RegExp(`"${name}".*Esc`));
+      // Choosing another pattern changes what the hint promises.
+      const other = await page.$eval("#libraryList button:not(.current)", (b) => b.dataset.pattern);
+      await page.click(`#libraryList button[data-pattern="${other}"]`);
+      const otherName = (await api("GET", "/patterns")).body.patterns.find((p) => p.id === other).name;
+      assert.match(await page.$eval("#placeHint", (e) => e.textContent), new RegExp(`"${otherName}"`));
+      await screenshot(page, "editor-place-tool.png");
+      await page.focus("#frameStage");
+      await page.keyboard.press("Escape");
+      assert.equal(await page.$eval("#placeTool", (b) => b.getAttribute("aria-pressed")), "false", "Esc leaves the place tool");
+      assert.equal(await visible(page, "#placeHint"), false);
+      assert.deepEqual((await state(page)).selection, ["elbow_r"], "the first Esc keeps the selection");
+      await page.keyboard.press("Escape");
+      assert.deepEqual((await state(page)).selection, [], "the next Esc clears it");
+      assert.deepEqual(page.errors, []);
+    }],
+    ["Ctrl+Z says what it undid, with Redo; Redo says what it redid, with Undo", async () => {
+      await settled(page, api);
+      const id = (await state(page)).sceneId;
+      const rotation = async () => (await api("GET", `/scenes/${id}`)).body.scene.placements.find((p) => p.id === "thigh_l").rotation;
+      const r0 = await rotation();
+      await page.click('#placementList li[data-placement="thigh_l"] .name');
+      await page.focus("#uv");
+      await page.keyboard.press("]");
+      await until(async () => (await rotation()) !== r0, "rotated on the server");
+      const r1 = await rotation();
+      await settled(page, api);
+      await page.keyboard.press("Control+z");
+      const redo = await page.waitForSelector('#notices .notice:has-text("Undone: patch placement thigh_l") button.action', { timeout: 10000 });
+      assert.equal(await redo.textContent(), "Redo");
+      await until(async () => (await rotation()) === r0, "the rotation undone on the server");
+      await redo.click();
+      await until(async () => (await rotation()) === r1, "redone by the notice's button");
+      const again = await page.waitForSelector('#notices .notice:has-text("Redone: patch placement thigh_l") button.action', { timeout: 10000 });
+      assert.equal(await again.textContent(), "Undo");
+      assert.equal(await page.$$eval('#notices .notice[data-key="undo"]', (n) => n.length), 1, "one undo notice at a time");
+      // Someone else on the scene (the window closed above is still shown for a while, or a new
+      // one): their chip must not wrap the 1280-px toolbar.
+      const other = await openEditor(context, sceneUrl, { width: 1280, height: 720 });
+      await until(() => page.$eval("#people", (e) => e.children.length > 0), "another person's chip");
+      assert.ok((await box(page, ".toolbar")).height < 44, "still one toolbar row with someone else on the scene");
+      await other.close();
+      await screenshot(page, "editor-undo-notice.png");
+      assert.deepEqual(page.errors, []);
+    }],
+  ]);
+  return failures;
+}, async () => {
+  await browser.close();
+  server.stop();
+});
