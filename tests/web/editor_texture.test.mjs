@@ -4,7 +4,8 @@
 // Checks: one outline per placement and a decoded frame; dragging a footprint moves it (server
 // within one texel) and changes the frame; a 2 s drag sends ≤ 30 edits and ends where the
 // pointer stopped; Shift-rotate snaps to 15°; Esc cancels (server unchanged); a number key
-// places a pattern; nudge / rotate / scale keys; Delete, undo, redo; a history click reverts;
+// places a pattern; nudge / rotate / scale keys; Delete, undo, redo; a history click reverts; the
+// history list is one Tab stop (arrows / Home / End move, Enter reverts);
 // H sends enabled:false and zeroes that region of the bump map; S solos; M mirrors.
 import assert from "node:assert/strict";
 import { startServer, launch, apiClient, openEditor, waitFrame, settledFrameHash, state, footprint, screenshot,
@@ -211,6 +212,42 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       await until(async () => JSON.stringify((await api("GET", `/scenes/${sceneId}`)).body.scene) === JSON.stringify(want), "the scene equals the clicked revision");
       await settle();
       assert.deepEqual((await state(page)).doc, want);
+    }],
+    ["the history list is one Tab stop: arrows, Home and End move, Enter reverts", async () => {
+      await settle();
+      const revisions = (await api("GET", `/scenes/${sceneId}/revisions?limit=10`)).body.revisions;
+      const rev0 = (await state(page)).revision;
+      const stops = () => page.$$eval('#historyList [tabindex="0"]', (b) => b.map((e) => e.closest("li").dataset.revision));
+      await until(async () => (await stops()).length === 1, "one tab stop in the history list");
+      assert.ok(await page.$$eval("#historyList button", (b) => b.length) > 3);
+      await page.focus('#historyList [tabindex="0"]');
+      const focused = () => page.evaluate(() => document.activeElement.closest("#historyList li")?.dataset.revision);
+      await page.keyboard.press("Home");
+      assert.equal(await focused(), String(revisions[0].revision), "Home: the newest");
+      await page.keyboard.press("ArrowDown");
+      await page.keyboard.press("ArrowDown");
+      assert.equal(await focused(), String(revisions[2].revision), "↓↓ moves two revisions back");
+      assert.deepEqual(await stops(), [String(revisions[2].revision)], "the tab stop follows the focus");
+      await page.keyboard.press("ArrowUp");
+      assert.equal(await focused(), String(revisions[1].revision), "↑ moves one forward");
+      await page.keyboard.press("End");
+      assert.equal(await focused(), await page.$eval("#historyList li:last-child", (li) => li.dataset.revision), "End: the oldest listed");
+      await page.keyboard.press("Home");
+      assert.equal(await focused(), String(revisions[0].revision), "Home: the newest");
+      assert.equal((await state(page)).revision, rev0, "moving reverts nothing");
+      // Tab leaves the list at once.
+      await page.keyboard.press("Tab");
+      assert.equal(await page.evaluate(() => !!document.activeElement.closest("#historyList")), false, "one Tab leaves the list");
+      await page.keyboard.press("Shift+Tab");
+      assert.equal(await focused(), String(revisions[0].revision), "Shift+Tab comes back to the same row");
+      const target = revisions[2].revision;
+      const want = (await api("GET", `/scenes/${sceneId}?revision=${target}`)).body.scene;
+      await page.keyboard.press("ArrowDown");
+      await page.keyboard.press("ArrowDown");
+      await page.keyboard.press("Enter");
+      await until(async () => JSON.stringify((await api("GET", `/scenes/${sceneId}`)).body.scene) === JSON.stringify(want), "Enter reverts to the focused revision");
+      await settle();
+      assert.ok(await page.evaluate(() => !!document.activeElement.closest("#historyList")), "the focus stays in the history list after the reload");
     }],
     ["H hides: enabled false, and that region of the bump map becomes 0", async () => {
       await settle();

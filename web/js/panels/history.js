@@ -1,5 +1,7 @@
 // History panel: the scene's revisions, newest first, with operation, client and time; click one
 // to revert to it (a new revision equal to that one; undoable). Reloads when the revision moves.
+// The list is one Tab stop (roving focus, on the current revision's row): ↑/↓, Home and End move
+// the focus between revisions without reverting; Enter (or Space) reverts to the focused one.
 
 import { store, on, whenIdle } from "../store.js";
 import { revert } from "../edits.js";
@@ -10,8 +12,9 @@ let api, list, loading = 0;
 
 export function initHistory(section, theApi) {
   api = theApi;
-  section.innerHTML = `<h2>History</h2><ul class="list history" id="historyList" aria-label="revisions"></ul>`;
+  section.innerHTML = `<h2>History</h2><ul class="list history" id="historyList" aria-label="revisions (arrows move, Enter reverts)" data-roving></ul>`;
   list = section.querySelector("#historyList");
+  list.addEventListener("keydown", onListKey);
   on("revision", () => whenIdle("history", load));
 }
 
@@ -21,6 +24,7 @@ async function load() {
   let answer;
   try { answer = await api.get(`/scenes/${store.sceneId}/revisions?limit=40`); } catch (e) { notify(`History: ${e.message}`, "error"); return; }
   if (mine !== loading) return;
+  const focused = list.contains(document.activeElement) ? document.activeElement.closest("li")?.dataset.revision : null;
   list.innerHTML = "";
   for (const r of answer.revisions) {
     const li = document.createElement("li");
@@ -35,4 +39,27 @@ async function load() {
     };
     list.append(li);
   }
+  // One tab stop: the row that had the focus (if still listed), else the current revision's, else
+  // the newest; the focus stays in the list across reloads.
+  const stop = (focused && list.querySelector(`li[data-revision="${focused}"]`)) || list.querySelector("li.current") || list.querySelector("li");
+  for (const b of list.querySelectorAll("button")) b.tabIndex = -1;
+  if (stop) {
+    stop.querySelector("button").tabIndex = 0;
+    if (focused) stop.querySelector("button").focus();
+  }
+}
+
+/// ↑/↓, Home and End: the focus (and the tab stop) moves to the revision after/before (newest/oldest).
+function onListKey(e) {
+  if (e.altKey || e.ctrlKey || e.metaKey || e.shiftKey) return;
+  const rows = [...list.querySelectorAll("li")];
+  const i = rows.findIndex((li) => li.contains(document.activeElement));
+  const j = i < 0 ? undefined : { ArrowUp: i - 1, ArrowDown: i + 1, Home: 0, End: rows.length - 1 }[e.key];
+  if (j === undefined) return;
+  e.preventDefault();
+  e.stopPropagation(); // arrows here walk the list instead of nudging the selection
+  const next = rows[Math.min(rows.length - 1, Math.max(0, j))].querySelector("button");
+  for (const b of list.querySelectorAll("button")) b.tabIndex = -1;
+  next.tabIndex = 0;
+  next.focus();
 }
