@@ -7,10 +7,13 @@
 // saved, and closing the window with an edit on its way asks first; Delete says what it deleted
 // and its Undo brings it back selected; the place tool says what a click adds, and Esc leaves it
 // without dropping the selection; Ctrl+Z and Redo say what they undid / redid, each with the
-// way back. Screenshots: editor-empty.png, editor-1280x720.png, editor-deleted-undo.png,
-// editor-place-tool.png, editor-undo-notice.png.
+// way back; footprint labels never overlap (at 1280×720 and 1920×1080), the selected one always
+// shows, a hidden one shows on hover; Ctrl+= / Ctrl+- / Ctrl+0 zoom and fit the texture view (not
+// the page, and only there) and arrows pan it when nothing is selected, all listed by ?.
+// Screenshots: editor-empty.png, editor-1280x720.png, editor-deleted-undo.png,
+// editor-place-tool.png, editor-undo-notice.png, editor-labels.png, editor-labels-1920.png.
 import assert from "node:assert/strict";
-import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, settled, until, sleep } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-ux-");
 const api = apiClient(server.base);
@@ -176,6 +179,103 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.ok((await box(page, ".toolbar")).height < 44, "still one toolbar row with someone else on the scene");
       await other.close();
       await screenshot(page, "editor-undo-notice.png");
+      assert.deepEqual(page.errors, []);
+    }],
+    ["footprint labels never overlap; the selected one always shows, a hidden one on hover", async () => {
+      const labels = (p) => p.evaluate(() => window.dermisEditor.labelLayout());
+      const overlaps = (shown) => {
+        const bad = [];
+        for (let i = 0; i < shown.length; ++i) for (let j = i + 1; j < shown.length; ++j) {
+          const a = shown[i], b = shown[j];
+          if (a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h) bad.push(`${a.id}/${b.id}`);
+        }
+        return bad;
+      };
+      const ids = (await state(page)).doc.placements.map((p) => p.id);
+      await page.focus("#uv");
+      await page.keyboard.press("Escape");
+      await page.keyboard.press("0");
+      await sleep(150);
+      let l = await labels(page);
+      assert.deepEqual(overlaps(l.shown), [], "no two labels overlap at 1280×720");
+      assert.deepEqual([...l.shown.map((b) => b.id), ...l.hidden].sort(), [...ids].sort(), "every placement's label is laid out (shown or hidden)");
+      assert.ok(l.shown.length >= ids.length / 2, `most labels show (${l.shown.length} of ${ids.length})`);
+      // The crowded middle of the default scene: each of them, selected, shows its label.
+      for (const id of ["ribs_l", "stomach", "waist_l", "waist_r"]) {
+        await page.click(`#placementList li[data-placement="${id}"] .name`);
+        l = await until(async () => { const x = await labels(page); return x.shown.some((b) => b.id === id) && x; }, `${id}'s label shows when selected`);
+        assert.deepEqual(overlaps(l.shown), [], `no overlap with ${id} selected`);
+      }
+      await screenshot(page, "editor-labels.png");
+      // A hidden label shows while its placement is hovered.
+      await page.focus("#uv");
+      await page.keyboard.press("Escape");
+      await sleep(150);
+      l = await labels(page);
+      let hovered = null;
+      for (const id of l.hidden) {
+        const g = await footprint(page, id);
+        await page.mouse.move(g.center[0], g.center[1]);
+        if (await page.$eval("#uv", (c) => c.title.split("\n")[0]) === id) { hovered = id; break; }
+      }
+      if (l.hidden.length) {
+        assert.ok(hovered, `one of the hidden labels' placements can be hovered (${l.hidden.join(", ")})`);
+        await until(async () => (await labels(page)).shown.some((b) => b.id === hovered), `${hovered}'s label shows on hover`);
+        assert.deepEqual(overlaps((await labels(page)).shown), [], "no overlap while hovering");
+      }
+      await page.mouse.move(5, 5);
+      // A big window: the same, with room for (nearly) every label.
+      const big = await openEditor(context, sceneUrl, { width: 1920, height: 1080 });
+      await sleep(300);
+      const lb = await labels(big);
+      assert.deepEqual(overlaps(lb.shown), [], "no two labels overlap at 1920×1080");
+      assert.ok(lb.shown.length >= l.shown.length, `at least as many labels at 1920×1080 (${lb.shown.length})`);
+      await screenshot(big, "editor-labels-1920.png");
+      assert.deepEqual(big.errors, []);
+      await big.close();
+    }],
+    ["keyboard zoom and pan in the texture view: Ctrl+= / Ctrl+- / Ctrl+0, arrows with nothing selected", async () => {
+      await settled(page, api);
+      const rev = (await state(page)).revision;
+      await page.evaluate(() => { window.__prevented = []; window.addEventListener("keydown", (e) => window.__prevented.push(e.defaultPrevented)); });
+      const prevented = () => page.evaluate(() => window.__prevented[window.__prevented.length - 1]);
+      await page.focus("#uv");
+      await page.keyboard.press("Escape");
+      await page.keyboard.press("0");
+      const g0 = await footprint(page, "stomach");
+      await page.keyboard.press("Control+Equal");
+      assert.equal(await prevented(), true, "Ctrl+= in the texture view is not the browser's page zoom");
+      const g1 = await footprint(page, "stomach");
+      assert.ok(Math.abs(g1.pxPerUV / g0.pxPerUV - 1.25) < 1e-6, `Ctrl+= zooms in 25% (${g0.pxPerUV} → ${g1.pxPerUV})`);
+      await until(() => page.$eval("#zoomText", (e) => e.textContent === `${Math.round(0.94 * 1.25 * 100)}%`), "the zoom badge follows");
+      await page.keyboard.press("Control+Minus");
+      await page.keyboard.press("Control+Minus");
+      const g2 = await footprint(page, "stomach");
+      assert.ok(Math.abs(g2.pxPerUV * 1.25 / g0.pxPerUV - 1) < 1e-6, "Ctrl+- zooms out");
+      // Arrows with nothing selected pan (the view moves, the footprints the other way).
+      await page.keyboard.press("ArrowRight");
+      const g3 = await footprint(page, "stomach");
+      assert.ok(Math.abs(g3.center[0] - (g2.center[0] - 40)) < 0.01 && Math.abs(g3.center[1] - g2.center[1]) < 0.01, "→ pans 40 px");
+      await page.keyboard.press("Shift+ArrowUp");
+      const g4 = await footprint(page, "stomach");
+      assert.ok(Math.abs(g4.center[1] - (g3.center[1] + 200)) < 0.01, "Shift+↑ pans 200 px");
+      await page.keyboard.press("Control+0");
+      assert.equal(await prevented(), true, "Ctrl+0 in the texture view fits it");
+      const g5 = await footprint(page, "stomach");
+      assert.ok(Math.abs(g5.pxPerUV - g0.pxPerUV) < 1e-6 && Math.abs(g5.center[0] - g0.center[0]) < 0.01, "Ctrl+0 fits again");
+      await sleep(300);
+      assert.equal((await state(page)).revision, rev, "zoom and pan edit nothing");
+      // Outside the texture view the browser keeps its page zoom keys.
+      await page.focus('#placementList button[tabindex="0"]');
+      await page.keyboard.press("Control+Equal");
+      assert.equal(await prevented(), false, "Ctrl+= outside the texture view is left to the browser");
+      // ? lists them.
+      await page.focus("#uv");
+      await page.keyboard.press("?");
+      const help = await page.$eval("#help", (d) => d.open && d.textContent);
+      assert.match(help, /Ctrl\+=.*zoom the texture view/s);
+      assert.match(help, /nothing selected, pan the texture view/);
+      await page.keyboard.press("Escape");
       assert.deepEqual(page.errors, []);
     }],
   ]);

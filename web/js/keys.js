@@ -4,7 +4,7 @@
 import { store, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
 import { patchPlacement, removePlacements, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
-import { cancelDrag, dragging, viewCentreUV } from "./texture_view.js";
+import { cancelDrag, dragging, viewCentreUV, zoomBy, panBy } from "./texture_view.js";
 import { setPlaceTool, placeToolOn } from "./frame_view.js";
 import { currentPattern, choosePattern } from "./panels/library.js";
 import { toggleEnabled, toggleSolo } from "./panels/placements.js";
@@ -16,7 +16,7 @@ export const SHORTCUTS = [
   ["1 – 9", "place the library's n-th pattern at the pointer (texture view)"],
   ["click / Shift+click", "select / add to the selection (either view, or the list)"],
   ["N / Shift+N", "select the next / previous placement"],
-  ["← ↑ → ↓", "nudge the selection one texel (Shift: 10)"],
+  ["← ↑ → ↓", "nudge the selection one texel (Shift: 10); with nothing selected, pan the texture view (Shift: further)"],
   ["[  ]", "rotate −5° / +5° (Shift: 15°)"],
   ["+  −", "scale up / down 5%"],
   ["Delete", "remove the selection"],
@@ -30,6 +30,7 @@ export const SHORTCUTS = [
   ["Space", "play / pause the clip"],
   ["Ctrl+Z / Ctrl+Shift+Z", "undo / redo (server reverts)"],
   ["Esc", "cancel a drag; leave the place tool; clear the selection"],
+  ["Ctrl+=  Ctrl+−", "zoom the texture view in / out (Cmd on a Mac; focus in the texture view)"],
   ["0", "fit the texture view"],
   ["?", "this list"],
 ];
@@ -55,6 +56,14 @@ function onKey(e, { dlg, fitTexture }) {
     return;
   }
   if (mod && (e.key === "y" || e.key === "Y")) { e.preventDefault(); redo(); return; }
+  // Ctrl/Cmd+= / + / − / 0 zoom and fit the texture view while it has the focus (instead of the
+  // browser's page zoom, which they keep everywhere else).
+  if (mod && !e.altKey && ["=", "+", "-", "_", "0"].includes(e.key) && inTextureView()) {
+    e.preventDefault();
+    if (e.key === "0") fitTexture();
+    else zoomBy(e.key === "=" || e.key === "+" ? 1.25 : 1 / 1.25);
+    return;
+  }
   if (mod || e.altKey || typing(document.activeElement)) return;
   const inView = document.activeElement && document.activeElement.closest && document.activeElement.closest(".view");
   if (e.key === "Tab" && inView && !e.shiftKey) {
@@ -75,6 +84,10 @@ function onKey(e, { dlg, fitTexture }) {
     const step = (e.shiftKey ? 10 : 1) / heightmapSize()[0];
     const d = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, -step], ArrowDown: [0, step] }[k];
     each((p) => patchPlacement(p.id, now(p.id, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }))));
+  } else if (k.startsWith("Arrow") && inTextureView()) {
+    const step = e.shiftKey ? 200 : 40; // css px; nothing is selected: the arrows pan
+    const d = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, -step], ArrowDown: [0, step] }[k];
+    if (d) panBy(...d);
   } else if ((k === "[" || k === "]" || k === "{" || k === "}") && sel.length) {
     const step = (e.shiftKey ? 15 : 5) * (k === "[" || k === "{" ? -1 : 1);
     each((p) => patchPlacement(p.id, now(p.id, (q) => ({ rotation: geo.round4(geo.wrapDegrees(q.rotation + step)) }))));
@@ -97,6 +110,8 @@ function onKey(e, { dlg, fitTexture }) {
   else handled = false;
   if (handled) e.preventDefault();
 }
+
+const inTextureView = () => !!(document.activeElement && document.activeElement.closest && document.activeElement.closest("#textureView"));
 
 /// An edit body computed from placement `id` as it is when the edit's turn comes (null: gone).
 const now = (id, fn) => (doc) => {

@@ -9,7 +9,7 @@ import { signIn } from "./signin.js";
 import { notify } from "./notice.js";
 import { initImages, forget } from "./images.js";
 import { initEdits, accept, clearUndo, canUndo, canRedo, putScene, undo, redo, revert } from "./edits.js";
-import { initTextureView, fit, screenGeometry, dragPreview } from "./texture_view.js";
+import { initTextureView, fit, screenGeometry, dragPreview, labelLayout } from "./texture_view.js";
 import { initFrameView, setPatternSource, setPreviewSource, setFrameSize, frameStats, frameUrl, pickAt } from "./frame_view.js";
 import { initLibrary, currentPattern, uploadPattern } from "./panels/library.js";
 import { initPlacements } from "./panels/placements.js";
@@ -200,6 +200,6 @@ async function start() {
 }
 
 // For tests and benchmarks: a read-only look at the editor's state and its frame statistics.
-window.dermisEditor = { store, frameStats, frameUrl, pickAt, disconnect, connect, api, screenGeometry, trace, clearTrace };
+window.dermisEditor = { store, frameStats, frameUrl, pickAt, disconnect, connect, api, screenGeometry, labelLayout, trace, clearTrace };
 
 start();

@@ -3,7 +3,11 @@
 // rotated footprint, with handles on the selection (drag inside: move; corners: scale, Shift keeps
 // aspect; the round handle: rotate, Shift snaps to 15°; Esc during a drag cancels it). Wheel zooms
 // about the pointer; dragging empty space (or with the middle button) pans. Lint findings are
-// drawn on the footprints they concern, other people's selections in their colour.
+// drawn on the footprints they concern, other people's selections in their colour. Labels are
+// placed so that they never overlap (the selection's first, then the hovered one, then document
+// order; each tries a few spots around its footprint); a label with no free spot is hidden until
+// its placement is hovered or selected. Keys (keys.js) zoom (Ctrl/Cmd+= / −) and pan (arrows
+// with nothing selected) through zoomBy and panBy.
 //
 // Draws from the store; edits go through edits.js (a Stream per drag).
 
@@ -13,13 +17,15 @@ import { image, heightOverlay, onImageLoaded, patternImagePath } from "./images.
 import { Stream, patchPlacement } from "./edits.js";
 import { trace } from "./trace.js";
 
-const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26;
+const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26, ZOOM_MIN = 0.2, ZOOM_MAX = 40;
 
 let canvas, ctx, stage, overlaySelect, zoomText;
 let zoom = 1, ox = 0, oy = 0, fitted = false; // uv → css px: x = ox + u·zoom·S
 let drag = null;  // {kind: move|scale|rotate|pan, id, start, orig, value, stream, corner}
 let hover = null; // id under the pointer
 let dirty = false;
+let labels = { shown: [], hidden: [] }; // the last draw's label layout (css px in the canvas)
+const LABEL_FONT = "11px system-ui, sans-serif", LABEL_H = 14;
 
 const S = () => Math.min(stage.clientWidth, stage.clientHeight) || 512;
 const toScreen = (uv) => [ox + uv[0] * zoom * S(), oy + uv[1] * zoom * S()];
@@ -139,12 +145,15 @@ function draw() {
   const lintBy = new Map();
   for (const f of store.lint) if (f.placement) lintBy.set(f.placement, [...(lintBy.get(f.placement) || []), f]);
   const soloed = new Set(store.solo);
+  const dims = new Map();
   for (const raw of store.doc.placements) {
     const p = shown(raw);
     const selected = store.selection.includes(p.id);
     const dim = !p.enabled || (soloed.size && !soloed.has(p.id));
+    dims.set(p.id, dim);
     drawFootprint(p, { selected, dim, lint: lintBy.get(p.id) || [], hover: hover === p.id });
   }
+  drawLabels(dims, w, h);
   // Other people's selections, in their colour.
   for (const [client, who] of store.presence) {
     for (const id of who.selection || []) {
@@ -189,10 +198,6 @@ function drawFootprint(p, { selected, dim, lint, hover: hovered }) {
   ctx.restore();
   const color = p.target === "displacement" ? "#ff9a7a" : "#7fd0ff";
   outline(p, selected ? "#ffffff" : color, selected ? 2 : hovered ? 2 : 1.2, p.enabled ? [] : [4, 3]);
-  const [lx, ly] = toScreen(geo.toUV(p, [0, 0]));
-  ctx.font = "11px system-ui, sans-serif";
-  ctx.fillStyle = dim ? "#8d99a8" : color;
-  ctx.fillText(p.label || p.id, lx + 2, ly - 3);
   if (lint.length) {
     const [tx, ty] = toScreen(geo.toUV(p, [1, 0]));
     ctx.fillStyle = "#ffb454";
@@ -206,6 +211,58 @@ function drawFootprint(p, { selected, dim, lint, hover: hovered }) {
     ctx.font = "bold 10px system-ui, sans-serif";
     ctx.fillText(lint.length > 1 ? String(lint.length) : "!", tx - 3, ty - 3);
   }
+}
+
+/// Places every footprint's label where it overlaps no other label: the selection's first (always
+/// shown), then the hovered one (always shown), then document order; each tries above / below its
+/// footprint's box (left, then right aligned), inside it, and beside it, preferring spots inside
+/// the stage. A label with no free spot is hidden (hover or select its placement to see it).
+function layoutLabels(w, h) {
+  const ps = store.doc.placements.map(shown);
+  const rank = (p) => { const i = store.selection.indexOf(p.id); return i >= 0 ? i : p.id === hover ? store.selection.length : Infinity; };
+  const order = ps.map((p, i) => ({ p, i, r: rank(p) })).sort((a, b) => a.r - b.r || a.i - b.i);
+  ctx.font = LABEL_FONT;
+  const placed = [], hidden = [];
+  const free = (b) => placed.every((o) => b.x + b.w + 2 <= o.x || o.x + o.w + 2 <= b.x || b.y + b.h + 1 <= o.y || o.y + o.h + 1 <= b.y);
+  const inside = (b) => b.x >= 0 && b.y >= 0 && b.x + b.w <= w && b.y + b.h <= h;
+  for (const { p, r } of order) {
+    const text = p.label || p.id;
+    const lw = Math.ceil(ctx.measureText(text).width) + 6, lh = LABEL_H;
+    const c = geo.corners(p).map(toScreen);
+    const x0 = Math.min(...c.map((q) => q[0])), x1 = Math.max(...c.map((q) => q[0]));
+    const y0 = Math.min(...c.map((q) => q[1])), y1 = Math.max(...c.map((q) => q[1]));
+    const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
+    const spots = [[x0, y0 - lh - 1], [x0, y1 + 1], [x1 - lw, y0 - lh - 1], [x1 - lw, y1 + 1],
+                   [cx - lw / 2, cy - lh / 2], [x1 + 2, cy - lh / 2], [x0 - lw - 2, cy - lh / 2]]
+      .map(([x, y]) => ({ id: p.id, text, x: Math.round(x), y: Math.round(y), w: lw, h: lh }));
+    const must = r !== Infinity; // selected or hovered
+    const box = spots.find((b) => free(b) && inside(b)) || spots.find(free) || (must ? spots[0] : null);
+    if (box) placed.push(box);
+    else hidden.push(p.id);
+  }
+  return { shown: placed, hidden };
+}
+
+function drawLabels(dims, w, h) {
+  labels = layoutLabels(w, h);
+  ctx.font = LABEL_FONT;
+  ctx.textBaseline = "middle";
+  for (const b of labels.shown) {
+    const p = placementById(b.id);
+    const color = p && p.target === "displacement" ? "#ff9a7a" : "#7fd0ff";
+    const selected = store.selection.includes(b.id);
+    ctx.fillStyle = selected ? "rgba(36, 56, 77, 0.92)" : "rgba(13, 16, 20, 0.72)";
+    ctx.fillRect(b.x, b.y, b.w, b.h);
+    ctx.fillStyle = selected ? "#ffffff" : dims.get(b.id) ? "#8d99a8" : color;
+    ctx.fillText(b.text, b.x + 3, b.y + b.h / 2 + 0.5);
+  }
+  ctx.textBaseline = "alphabetic";
+}
+
+/// The last drawn label layout, for tests: {shown: [{id, x, y, w, h}] in client px, hidden: [id]}.
+export function labelLayout() {
+  const r = canvas.getBoundingClientRect();
+  return { shown: labels.shown.map(({ id, x, y, w, h }) => ({ id, x: r.left + x, y: r.top + y, w, h })), hidden: [...labels.hidden] };
 }
 
 function handlePoints(p) {
@@ -347,9 +404,29 @@ function wheel(e) {
   e.preventDefault();
   const [x, y] = local(e);
   const before = toUV(x, y);
-  zoom = Math.min(Math.max(zoom * Math.exp(-e.deltaY * 0.0015), 0.2), 40);
+  zoom = Math.min(Math.max(zoom * Math.exp(-e.deltaY * 0.0015), ZOOM_MIN), ZOOM_MAX);
   ox = x - before[0] * zoom * S();
   oy = y - before[1] * zoom * S();
+  fitted = true;
+  redraw();
+}
+
+/// Zooms by factor `f` about the stage's centre (keys: Ctrl/Cmd+= and Ctrl/Cmd+−).
+export function zoomBy(f) {
+  const x = stage.clientWidth / 2, y = stage.clientHeight / 2;
+  const before = toUV(x, y);
+  zoom = Math.min(Math.max(zoom * f, ZOOM_MIN), ZOOM_MAX);
+  ox = x - before[0] * zoom * S();
+  oy = y - before[1] * zoom * S();
+  fitted = true;
+  redraw();
+}
+
+/// Pans by (dx, dy) css px: the view moves that way over the UV square (keys: arrows with
+/// nothing selected).
+export function panBy(dx, dy) {
+  ox -= dx;
+  oy -= dy;
   fitted = true;
   redraw();
 }
