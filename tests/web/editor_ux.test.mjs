@@ -9,9 +9,12 @@
 // without dropping the selection; Ctrl+Z and Redo say what they undid / redid, each with the
 // way back; footprint labels never overlap (at 1280×720 and 1920×1080), the selected one always
 // shows, a hidden one shows on hover; Ctrl+= / Ctrl+- / Ctrl+0 zoom and fit the texture view (not
-// the page, and only there) and arrows pan it when nothing is selected, all listed by ?.
+// the page, and only there) and arrows pan it when nothing is selected, all listed by ?; at
+// 1280×720 the 3D view bar is one row with Size and Reset in a ⋯ menu that Enter / ↓ opens and
+// Esc closes (focus back on ⋯), at 1920×1080 they sit in the bar.
 // Screenshots: editor-empty.png, editor-1280x720.png, editor-deleted-undo.png,
-// editor-place-tool.png, editor-undo-notice.png, editor-labels.png, editor-labels-1920.png.
+// editor-place-tool.png, editor-undo-notice.png, editor-labels.png, editor-labels-1920.png,
+// editor-3d-more.png.
 import assert from "node:assert/strict";
 import { startServer, launch, apiClient, openEditor, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep } from "./editor_lib.mjs";
 
@@ -61,7 +64,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.ok(bar.height < 44, `the toolbar is one row (${bar.height} px)`);
       const tbar = await box(page, "#textureView .viewbar"), fbar = await box(page, "#frameView .viewbar");
       assert.ok(tbar.height < 40, `the texture view bar is one row (${tbar.height} px)`);
-      assert.ok(fbar.height < 70, `the 3D view bar is two rows at most (${fbar.height} px)`);
+      assert.ok(fbar.height < 40, `the 3D view bar is one row too (${fbar.height} px): Size and Reset fold into ⋯`);
       const uv = await box(page, "#uv"), stage = await box(page, "#frameStage");
       assert.ok(uv.height >= 340 && stage.height >= 340, `the views keep their room (${uv.height}, ${stage.height} px)`);
       const foot = await box(page, ".timeline");
@@ -73,6 +76,42 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.equal(await visible(page, "#compareAgainstLabel"), true, "'against' while comparing");
       await page.selectOption("#compareMode", "off");
       await screenshot(page, "editor-1280x720.png");
+    }],
+    ["1280×720: the 3D view bar's ⋯ menu works by keyboard (Enter opens, Esc closes), 1920×1080 needs none", async () => {
+      assert.ok(await visible(page, "#viewMore"), "⋯ shows on the narrow 3D view bar");
+      assert.equal(await visible(page, "#resetCamera"), false, "Reset is folded into it");
+      assert.equal(await page.$eval("#viewMore", (b) => b.getAttribute("aria-expanded")), "false");
+      await page.focus("#viewMore");
+      await page.keyboard.press("Enter");
+      assert.equal(await page.$eval("#viewMore", (b) => b.getAttribute("aria-expanded")), "true", "Enter opens it");
+      assert.equal(await page.evaluate(() => document.activeElement.id), "frameSize", "the focus on its first control");
+      assert.ok(await visible(page, "#resetCamera"));
+      const menu = await box(page, "#viewMoreMenu"), stage = await box(page, "#frameStage");
+      assert.ok(menu.left + menu.width <= 1280 && menu.top >= stage.top - 40, "the menu opens under the bar, inside the window");
+      await screenshot(page, "editor-3d-more.png");
+      await page.keyboard.press("Tab");
+      assert.equal(await page.evaluate(() => document.activeElement.id), "resetCamera", "Tab reaches Reset");
+      await page.evaluate(() => window.dermisEditor.store.camera.yaw = 77);
+      await page.keyboard.press("Enter");
+      await until(async () => (await state(page)).camera.yaw === 0, "Enter on Reset resets the camera");
+      const selection = (await state(page)).selection;
+      await page.keyboard.press("Escape");
+      assert.equal(await page.$eval("#viewMore", (b) => b.getAttribute("aria-expanded")), "false", "Esc closes it");
+      assert.equal(await page.evaluate(() => document.activeElement.id), "viewMore", "and gives the focus back to ⋯");
+      assert.deepEqual((await state(page)).selection, selection, "that Esc only closes the menu");
+      assert.equal(await visible(page, "#resetCamera"), false);
+      // ↓ opens it too; Tab past its last control closes it.
+      await page.keyboard.press("ArrowDown");
+      assert.equal(await page.evaluate(() => document.activeElement.id), "frameSize");
+      await page.keyboard.press("Tab");
+      await page.keyboard.press("Tab");
+      assert.equal(await page.$eval("#viewMore", (b) => b.getAttribute("aria-expanded")), "false", "leaving the menu closes it");
+      const wide = await openEditor(context, sceneUrl, { width: 1920, height: 1080 });
+      assert.equal(await visible(wide, "#viewMore"), false, "no ⋯ where the bar has room");
+      assert.ok(await visible(wide, "#resetCamera") && await visible(wide, "#frameSize"), "Size and Reset sit in the bar");
+      assert.ok((await box(wide, "#frameView .viewbar")).height < 40, "one row");
+      await wide.close();
+      assert.deepEqual(page.errors, []);
     }],
     ["the save indicator: Saving… while an edit is on its way, Saved after, Not saved when refused", async () => {
       await settled(page, api);

@@ -93,9 +93,14 @@ export function initFrameView(section, theApi) {
         <option value="flicker">flicker</option><option value="diff">diff heat map</option></select></label>
       <label id="compareAgainstLabel" hidden>against <select id="compareAgainst" aria-label="compare against"><option value="off">patterns off</option></select></label>
       <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
-      <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
       <button type="button" id="placeTool" aria-pressed="false" title="Place tool (P): click the model to add a placement there">Place</button>
-      <button type="button" id="resetCamera" title="Reset the camera">Reset</button>
+      <div class="more" id="viewMoreWrap">
+        <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: frame size, reset camera">⋯</button>
+        <div class="moremenu" id="viewMoreMenu" role="group" aria-label="more 3D view settings">
+          <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
+          <button type="button" id="resetCamera" title="Reset the camera">Reset</button>
+        </div>
+      </div>
       <span id="diffText" class="badge" hidden></span>
     </div>
     <div class="stage" id="frameStage" tabindex="0" aria-label="3D view: drag to orbit, wheel to zoom, click to select">
@@ -130,6 +135,7 @@ export function initFrameView(section, theApi) {
   sizeSelect.onchange = () => { frameSize = +sizeSelect.value; refresh(); };
   $("placeTool").onclick = () => setPlaceTool(!placeTool);
   $("resetCamera").onclick = () => set({ camera: { yaw: 0, pitch: 10, distance: null } });
+  initMoreMenu($("viewMoreWrap"));
   orbit(stage);
   on("doc revision camera view compare solo time pinnedRevision gestures drag", () => {
     $("viewMode").value = store.view;
@@ -140,6 +146,29 @@ export function initFrameView(section, theApi) {
   });
   on("revision", () => whenIdle("compare-list", fillAgainst, 400));
   on("currentPattern patterns", showPlaceHint);
+}
+
+/// The view bar's ⋯ menu (Size, Reset): where the bar is narrow (a container query in
+/// editor.css) those controls fold into it, elsewhere they sit in the bar and ⋯ is hidden. Enter,
+/// Space or ↓ on ⋯ opens it with the focus on its first control; Esc closes it (the focus back on
+/// ⋯), as do a click or the focus elsewhere.
+function initMoreMenu(wrap) {
+  const button = wrap.querySelector(".morebutton");
+  const open = (yes, focusBack = false) => {
+    wrap.classList.toggle("open", yes);
+    button.setAttribute("aria-expanded", String(yes));
+    if (yes) wrap.querySelector(".moremenu select, .moremenu button")?.focus();
+    else if (focusBack) button.focus();
+  };
+  button.onclick = () => open(!wrap.classList.contains("open"));
+  button.addEventListener("keydown", (e) => {
+    if (e.key === "ArrowDown" && !wrap.classList.contains("open")) { e.preventDefault(); open(true); }
+  });
+  wrap.addEventListener("keydown", (e) => {
+    if (e.key === "Escape" && wrap.classList.contains("open")) { e.preventDefault(); e.stopPropagation(); open(false, true); }
+  });
+  wrap.addEventListener("focusout", (e) => { if (!wrap.contains(e.relatedTarget)) open(false); });
+  document.addEventListener("pointerdown", (e) => { if (!wrap.contains(e.target)) open(false); });
 }
 
 /// Sets the frame size (one of 384, 512, 768, 1024; a permalink's size).
