@@ -8,7 +8,7 @@
 // and its Undo brings it back selected; the place tool says what a click adds, and Esc leaves it
 // without dropping the selection; Ctrl+Z and Redo say what they undid / redid, each with the
 // way back; footprint labels never overlap (at 1280×720 and 1920×1080), the selected one always
-// shows, a hidden one shows on hover; Ctrl+= / Ctrl+- / Ctrl+0 zoom and fit the texture view (not
+// shows (clear of its handles), a hidden one shows on hover; Ctrl+= / Ctrl+- / Ctrl+0 zoom and fit the texture view (not
 // the page, and only there) and arrows pan it when nothing is selected, all listed by ?; at
 // 1280×720 the 3D view bar is one row with Size and Reset in a ⋯ menu that Enter / ↓ opens and
 // Esc closes (focus back on ⋯), at 1920×1080 they sit in the bar.
@@ -244,6 +244,10 @@ await runSuite("WebEditorUxBrowserTest", async () => {
         await page.click(`#placementList li[data-placement="${id}"] .name`);
         l = await until(async () => { const x = await labels(page); return x.shown.some((b) => b.id === id) && x; }, `${id}'s label shows when selected`);
         assert.deepEqual(overlaps(l.shown), [], `no overlap with ${id} selected`);
+        // No label covers the selection's handles (corners, the rotation handle).
+        const g = await footprint(page, id);
+        const covered = l.shown.filter((b) => [...g.corners, g.rotate].some(([x, y]) => x > b.x - 4 && x < b.x + b.w + 4 && y > b.y - 4 && y < b.y + b.h + 4));
+        assert.deepEqual(covered.map((b) => b.id), [], `labels clear of ${id}'s handles`);
       }
       await screenshot(page, "editor-labels.png");
       // A hidden label shows while its placement is hovered.

@@ -222,7 +222,7 @@ function layoutLabels(w, h) {
   const rank = (p) => { const i = store.selection.indexOf(p.id); return i >= 0 ? i : p.id === hover ? store.selection.length : Infinity; };
   const order = ps.map((p, i) => ({ p, i, r: rank(p) })).sort((a, b) => a.r - b.r || a.i - b.i);
   ctx.font = LABEL_FONT;
-  const placed = [], hidden = [];
+  const placed = obstacles(), hidden = [];
   const free = (b) => placed.every((o) => b.x + b.w + 2 <= o.x || o.x + o.w + 2 <= b.x || b.y + b.h + 1 <= o.y || o.y + o.h + 1 <= b.y);
   const inside = (b) => b.x >= 0 && b.y >= 0 && b.x + b.w <= w && b.y + b.h <= h;
   for (const { p, r } of order) {
@@ -232,7 +232,8 @@ function layoutLabels(w, h) {
     const x0 = Math.min(...c.map((q) => q[0])), x1 = Math.max(...c.map((q) => q[0]));
     const y0 = Math.min(...c.map((q) => q[1])), y1 = Math.max(...c.map((q) => q[1]));
     const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
-    const spots = [[x0, y0 - lh - 1], [x0, y1 + 1], [x1 - lw, y0 - lh - 1], [x1 - lw, y1 + 1],
+    const m = p.id === store.selection[0] ? HANDLE_PX / 2 + 2 : 1; // clear of the selection's corner handles
+    const spots = [[x0, y0 - lh - m], [x0, y1 + m], [x1 - lw, y0 - lh - m], [x1 - lw, y1 + m],
                    [cx - lw / 2, cy - lh / 2], [x1 + 2, cy - lh / 2], [x0 - lw - 2, cy - lh / 2]]
       .map(([x, y]) => ({ id: p.id, text, x: Math.round(x), y: Math.round(y), w: lw, h: lh }));
     const must = r !== Infinity; // selected or hovered
@@ -240,7 +241,38 @@ function layoutLabels(w, h) {
     if (box) placed.push(box);
     else hidden.push(p.id);
   }
-  return { shown: placed, hidden };
+  return { shown: placed.filter((b) => !b.obstacle), hidden };
+}
+
+/// What labels keep clear of: the selection's handles (and the rotation handle's stem), the lint
+/// marks and other people's names (boxes in css px).
+function obstacles() {
+  const boxes = [];
+  const box = (x0, y0, x1, y1) => boxes.push({ obstacle: true, x: Math.min(x0, x1), y: Math.min(y0, y1), w: Math.abs(x1 - x0), h: Math.abs(y1 - y0) });
+  const r = HANDLE_PX / 2 + 1;
+  const prim = store.selection.length ? placementById(store.selection[0]) : null;
+  if (prim) {
+    const hp = handlePoints(shown(prim));
+    for (const [x, y] of hp.corners) box(x - r, y - r, x + r, y + r);
+    box(hp.rotate[0] - r - 1, hp.rotate[1] - r - 1, hp.rotate[0] + r + 1, hp.rotate[1] + r + 1);
+    box(hp.top[0] - 1, hp.top[1] - 1, hp.rotate[0] + 1, hp.rotate[1] + 1);
+  }
+  const linted = new Set(store.lint.map((f) => f.placement).filter(Boolean));
+  for (const id of linted) {
+    const p = placementById(id);
+    if (!p) continue;
+    const [tx, ty] = toScreen(geo.toUV(shown(p), [1, 0]));
+    box(tx - 9, ty - 16, tx + 9, ty - 1);
+  }
+  for (const [client, who] of store.presence) {
+    for (const id of who.selection || []) {
+      const p = placementById(id);
+      if (!p) continue;
+      const [x, y] = toScreen(geo.toUV(p, [0, 1]));
+      box(x, y + 1, x + ctx.measureText(client).width, y + 15);
+    }
+  }
+  return boxes;
 }
 
 function drawLabels(dims, w, h) {
