@@ -31,7 +31,7 @@ export const SHORTCUTS = [
   ["Ctrl+Z / Ctrl+Shift+Z", "undo / redo (server reverts)"],
   ["Esc", "cancel a drag; leave the place tool; clear the selection"],
   ["Ctrl+=  Ctrl+−", "zoom the texture view in / out (Cmd on a Mac; focus in the texture view)"],
-  ["0", "fit the texture view"],
+  ["0  Ctrl+0", "fit the texture view"],
   ["?", "this list"],
 ];
 
