@@ -1,0 +1,72 @@
+// Dermis core — data derived from one immutable model, built once and shared by every request that
+// reads it: the UV index (UvLookup: lint, pick by UV, mirror) and the rest pose's symmetry plane
+// (mirror). Each piece is built lazily, on its first use, at most once (std::call_once): a route
+// pays only for what it reads, and concurrent first uses wait for one build instead of each
+// making its own.
+//
+//   ModelDerived      the derived data of one model; holds that model (shared), so the UvLookup's
+//                     pointer into it stays valid for as long as anyone holds the ModelDerived.
+//   ModelDerivedSlot  where a model's ModelDerived lives next to the model (the service's model
+//                     entry): made on the first get(), then the same object for that model; freed
+//                     with the slot (a deleted model's entry), once no request holds it.
+//
+// Pure (no GL, no I/O); thread-safe. Not done here: the rest-pose skinning mirrorPlacement and
+// lintScene do inside themselves (core mirror.cpp, lint.cpp) is not cached; nor is anything that
+// depends on a scene or a pose.
+#pragma once
+
+#include "mirror.hpp"
+#include "model.hpp"
+#include "uv_lookup.hpp"
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+
+namespace dermis {
+
+class ModelDerived {
+public:
+    /// Nothing is computed yet. Precondition: `model` is not null (checked: std::invalid_argument).
+    explicit ModelDerived(std::shared_ptr<const Model> model);
+    ModelDerived(const ModelDerived&) = delete;
+    ModelDerived& operator=(const ModelDerived&) = delete;
+
+    const Model& model() const { return *model_; }
+    const std::shared_ptr<const Model>& modelPtr() const { return model_; }
+
+    /// The model's UV index (UvLookup(model()), default cells), built on the first call. The
+    /// reference lives as long as this object. A build that throws (std::bad_alloc) is retried
+    /// by the next call.
+    const UvLookup& uvLookup() const;
+    /// symmetryPlane(model()), computed on the first call (O(vertices · 450)).
+    const SymmetryPlane& symmetryPlane() const;
+
+    /// How many times each piece was built: 0 before its first use, 1 after (for tests).
+    int uvLookupBuilds() const { return lookupBuilds_.load(); }
+    int symmetryPlaneBuilds() const { return planeBuilds_.load(); }
+
+private:
+    std::shared_ptr<const Model> model_;
+    mutable std::once_flag lookupOnce_, planeOnce_;
+    mutable std::unique_ptr<const UvLookup> lookup_;
+    mutable SymmetryPlane plane_;
+    mutable std::atomic<int> lookupBuilds_{0}, planeBuilds_{0};
+};
+
+class ModelDerivedSlot {
+public:
+    /// The ModelDerived of `model`: the one made before for this same model (pointer identity),
+    /// else a new one (nothing computed yet: that happens outside this slot's lock, on use). A
+    /// slot asked for a different model than before replaces its object (holders of the old one
+    /// keep it). Precondition: `model` is not null.
+    std::shared_ptr<const ModelDerived> get(const std::shared_ptr<const Model>& model);
+    /// The object made so far (null before the first get), without making one.
+    std::shared_ptr<const ModelDerived> peek() const;
+
+private:
+    mutable std::mutex mutex_;
+    std::shared_ptr<const ModelDerived> derived_;
+};
+
+} // namespace dermis
