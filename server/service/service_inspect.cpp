@@ -1,12 +1,12 @@
 // Inspection of a stored scene, CPU only (SPEC §6): pick — frame pixel to skin —, probe — why a
 // texel has its height —,
 // activation — each placement's t over a clip, with flags — and lint. All run on a snapshot,
-// unlocked.
+// unlocked. Lint and pick by UV read the model's UV index from its entry (State::derivedOf:
+// built once per model, core ModelDerived), not a new one per request.
 #include "service/service_state.hpp"
 
 #include "core/activation.hpp"
 #include "core/deform.hpp"
-#include "core/uv_lookup.hpp"
 #include "core/lint.hpp"
 #include "core/pick.hpp"
 #include "core/probe.hpp"
@@ -42,6 +42,18 @@ json pickAnswer(const Model& m, const PickHit& h) {
 }
 
 } // namespace
+
+std::shared_ptr<const ModelDerived> Service::State::derivedOf(const Snapshot& snap) const {
+    std::shared_ptr<ModelDerivedSlot> slot;
+    {
+        std::shared_lock<std::shared_mutex> lock(mutex);
+        auto it = models.find(snap.scene.model);
+        if (it != models.end() && it->second.model == snap.model && it->second.derived)
+            slot = it->second.derived;
+    }
+    if (!slot) return std::make_shared<const ModelDerived>(snap.model);
+    return slot->get(snap.model);
+}
 
 Result<json> Service::probe(const std::string& id, double u, double v, std::optional<double> time) {
     auto snap = state_->snapshot(id);
@@ -113,9 +125,9 @@ Result<json> Service::lint(const std::string& id) {
         for (const auto& [pid, e] : state_->patterns)
             if (!e.builtin && !used.count(pid)) unused.push_back(pid);
     }
-    const UvLookup lookup(*snap->model);
+    const auto derived = state_->derivedOf(*snap);
     json out = json::array();
-    for (const LintFinding& f : lintScene(snap->scene, *snap->model, lookup, snap->images))
+    for (const LintFinding& f : lintScene(snap->scene, *snap->model, derived->uvLookup(), snap->images))
         out.push_back({{"code", f.code},
                        {"severity", std::string(toString(f.severity))},
                        {"placement", f.placement >= 0
@@ -148,8 +160,8 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     auto snap = state_->snapshot(id);
     if (!snap) return snap.error();
     if (!snap->model->hasUVs()) return bad("u", "the model has no UVs: nothing lies at a texture point");
-    const UvLookup lookup(*snap->model);
-    const auto hit = dermis::pickUv(*snap->model, lookup, {u, v});
+    const auto derived = state_->derivedOf(*snap); // the model's UV index, built once
+    const auto hit = dermis::pickUv(*snap->model, derived->uvLookup(), {u, v});
     if (!hit) return json{{"hit", false}};
     return pickAnswer(*snap->model, *hit);
 }
