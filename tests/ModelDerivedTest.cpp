@@ -1,11 +1,12 @@
 // ModelDerivedTest — the per-model derived data (core ModelDerived, ModelDerivedSlot) that lint,
-// pick by UV and mirror share: the cached UV index and symmetry plane equal freshly computed
-// ones (default character, CesiumMan); each piece is built once per model, on first use, also
-// when many threads ask at once; a slot hands out the same object for the same model and a new
-// one for another; the object keeps its model alive and is freed with its last holder. Through
-// the Service (CPU, no renderer needed): pick by UV, mirror and lint answer what the core
-// computes with fresh data, repeatedly, and deleting the model frees it with its derived data.
-// No GL, no HTTP.
+// the picks and mirror share: the cached UV index and symmetry plane equal freshly computed ones
+// (default character, CesiumMan) and the cached driver suggestions core suggestDriver's (also
+// the KayKit Barbarian, many clips); each piece is built once per model, on first use, also when
+// many threads ask at once; a slot hands out the same object for the same model and a new one
+// for another; the object keeps its model alive and is freed with its last holder. Through the
+// Service (CPU, no renderer needed): pick by UV, mirror and lint answer what the core computes
+// with fresh data, repeatedly, and deleting the model frees it with its derived data. No GL, no
+// HTTP.
 #include "core/lint.hpp"
 #include "core/model_derived.hpp"
 #include "core/pick.hpp"
@@ -28,6 +29,7 @@ namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
 const std::string kCesium = std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb";
+const std::string kBarbarian = std::string(DERMIS_SHARED_DIR) + "/models/KayKitBarbarian/Barbarian.glb";
 
 std::shared_ptr<const Model> loadShared(const std::string& path) {
     auto m = loadGltfFile(path);
@@ -66,6 +68,28 @@ void expectSameAsFresh(const std::shared_ptr<const Model>& model) {
     EXPECT_EQ(derived.symmetryPlane().error, plane.error);
 }
 
+/// The cached driver suggestion equals core suggestDriver at the skin under every hit of a 41×41
+/// UV grid (and for an empty list); the clips are sampled once.
+void expectSameSuggestions(const std::shared_ptr<const Model>& model) {
+    const ModelDerived derived(model);
+    int compared = 0;
+    for (int j = 0; j < 41; ++j)
+        for (int i = 0; i < 41; ++i) {
+            const auto hit = pickUv(*model, derived.uvLookup(), {(i + 0.5) / 41.0, (j + 0.5) / 41.0});
+            if (!hit) continue;
+            const SuggestedDriver a = derived.suggestDriver(hit->joints);
+            const SuggestedDriver b = suggestDriver(*model, hit->joints);
+            ASSERT_EQ(a.joint, b.joint) << i << ", " << j;
+            EXPECT_EQ(a.axis, b.axis);
+            EXPECT_EQ(a.thetaMin, b.thetaMin);
+            EXPECT_EQ(a.thetaMax, b.thetaMax);
+            ++compared;
+        }
+    EXPECT_GT(compared, 100);
+    EXPECT_EQ(derived.clipRangeBuilds(), model->clips.empty() ? 0 : 1);
+    EXPECT_EQ(derived.suggestDriver({}).joint, "");
+}
+
 /// A renderer for a service whose tests never render; keeps the models it is told to forget.
 class ForgetfulRenderer final : public FrameRenderer {
 public:
@@ -97,12 +121,21 @@ TEST(ModelDerivedTest, CachedDataEqualsFreshOnCesiumMan) {
     expectSameAsFresh(model);
 }
 
+TEST(ModelDerivedTest, CachedDriverSuggestionsEqualCoreOnes) {
+    for (const auto& model : {defaultCharacter(), loadShared(kCesium), loadShared(kBarbarian)}) {
+        ASSERT_TRUE(model);
+        SCOPED_TRACE(std::to_string(model->clips.size()) + " clips");
+        expectSameSuggestions(model);
+    }
+}
+
 TEST(ModelDerivedTest, EachPieceIsBuiltOnFirstUseOnly) {
     auto model = defaultCharacter();
     ASSERT_TRUE(model);
     const ModelDerived d(model);
     EXPECT_EQ(d.uvLookupBuilds(), 0);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 0);
+    EXPECT_EQ(d.clipRangeBuilds(), 0);
     const UvLookup* first = &d.uvLookup();
     EXPECT_EQ(d.uvLookupBuilds(), 1);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 0); // pick and lint never pay for the plane
@@ -208,6 +241,11 @@ TEST(ModelDerivedTest, ServiceRoutesAnswerAsFreshDataAndADeletedModelIsFreed) {
         EXPECT_EQ((*pick)["triangle"], hit->triangle);
         EXPECT_FLOAT_EQ((*pick)["position"][0].get<float>(), hit->position.x);
         EXPECT_FLOAT_EQ((*pick)["position"][2].get<float>(), hit->position.z);
+        const SuggestedDriver d = suggestDriver(model, hit->joints);
+        EXPECT_EQ((*pick)["suggested"]["joint"], d.joint);
+        EXPECT_EQ((*pick)["suggested"]["axis"], d.axis);
+        EXPECT_EQ((*pick)["suggested"]["theta_min"], d.thetaMin);
+        EXPECT_EQ((*pick)["suggested"]["theta_max"], d.thetaMax);
 
         // Mirror: the twin core mirrorPlacement makes with a fresh lookup and plane.
         auto mirrored = s.mirrorPlacement(id, "knee_l", {});

@@ -1,6 +1,6 @@
 // Dermis core — data derived from one immutable model, built once and shared by every request that
-// reads it: the UV index (UvLookup: lint, pick by UV, mirror) and the rest pose's symmetry plane
-// (mirror). Each piece is built lazily, on its first use, at most once (std::call_once): a route
+// reads it: the UV index (UvLookup: lint, pick by UV, mirror), the rest pose's symmetry plane
+// (mirror) and the joints' angle ranges over the clips (the picks' driver suggestion). Each piece is built lazily, on its first use, at most once (std::call_once): a route
 // pays only for what it reads, and concurrent first uses wait for one build instead of each
 // making its own.
 //
@@ -17,11 +17,15 @@
 
 #include "mirror.hpp"
 #include "model.hpp"
+#include "pick.hpp"
 #include "uv_lookup.hpp"
 
+#include <array>
 #include <atomic>
 #include <memory>
 #include <mutex>
+#include <utility>
+#include <vector>
 
 namespace dermis {
 
@@ -42,16 +46,29 @@ public:
     /// symmetryPlane(model()), computed on the first call (O(vertices · 450)).
     const SymmetryPlane& symmetryPlane() const;
 
+    /// core suggestDriver(model(), joints), bit for bit, with the clips sampled once per model:
+    /// the angle range of every skin joint about x, y and z over all clips at 15 fps (what that
+    /// function samples per call) is computed on the first call that needs it. Joints that are
+    /// not skin joints, an empty list and a model without clips go to suggestDriver itself.
+    SuggestedDriver suggestDriver(const std::vector<std::pair<int, float>>& joints) const;
+
     /// How many times each piece was built: 0 before its first use, 1 after (for tests).
     int uvLookupBuilds() const { return lookupBuilds_.load(); }
     int symmetryPlaneBuilds() const { return planeBuilds_.load(); }
+    int clipRangeBuilds() const { return rangesBuilds_.load(); }
 
 private:
     std::shared_ptr<const Model> model_;
     mutable std::once_flag lookupOnce_, planeOnce_;
     mutable std::unique_ptr<const UvLookup> lookup_;
     mutable SymmetryPlane plane_;
-    mutable std::atomic<int> lookupBuilds_{0}, planeBuilds_{0};
+    struct AngleRange {
+        double lo = 1e9, hi = -1e9;
+    };
+    mutable std::once_flag rangesOnce_;
+    mutable std::vector<std::array<AngleRange, 3>> ranges_; ///< by node; x, y, z
+    mutable std::vector<bool> ranged_;                       ///< by node: a skin joint, in ranges_
+    mutable std::atomic<int> lookupBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0};
 };
 
 class ModelDerivedSlot {

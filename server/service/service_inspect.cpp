@@ -1,8 +1,8 @@
 // Inspection of a stored scene, CPU only (SPEC §6): pick — frame pixel to skin —, probe — why a
 // texel has its height —,
 // activation — each placement's t over a clip, with flags — and lint. All run on a snapshot,
-// unlocked. Lint and pick by UV read the model's UV index from its entry (State::derivedOf:
-// built once per model, core ModelDerived), not a new one per request.
+// unlocked. Lint and the picks read the model's UV index and clip ranges from its entry
+// (State::derivedOf: built once per model, core ModelDerived), not new ones per request.
 #include "service/service_state.hpp"
 
 #include "core/activation.hpp"
@@ -25,12 +25,14 @@ double rounded(double x) {
     return std::round(x * 1e6) / 1e6 + 0.0; // + 0.0: no "-0" in the JSON
 }
 
-/// The pick answer of a hit (shared by the frame and texture picks).
-json pickAnswer(const Model& m, const PickHit& h) {
+/// The pick answer of a hit (shared by the frame and texture picks); the suggestion from the
+/// model's cached clip ranges (ModelDerived::suggestDriver, equal to core suggestDriver).
+json pickAnswer(const ModelDerived& derived, const PickHit& h) {
+    const Model& m = derived.model();
     json joints = json::array();
     for (auto [node, weight] : h.joints)
         joints.push_back({{"name", m.nodes[static_cast<std::size_t>(node)].name}, {"weight", weight}});
-    const SuggestedDriver d = suggestDriver(m, h.joints);
+    const SuggestedDriver d = derived.suggestDriver(h.joints);
     return json{{"hit", true},
                 {"uv", {h.uv.x, h.uv.y}},
                 {"position", {h.position.x, h.position.y, h.position.z}},
@@ -150,7 +152,7 @@ Result<json> Service::pick(const std::string& id, const FrameParams& params, dou
     auto hit = pickFrame(*plan, *snap->model, x, y);
     if (!hit) return hit.error();
     if (!*hit) return json{{"hit", false}};
-    return pickAnswer(*snap->model, **hit);
+    return pickAnswer(*state_->derivedOf(*snap), **hit);
 }
 
 
@@ -163,7 +165,7 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     const auto derived = state_->derivedOf(*snap); // the model's UV index, built once
     const auto hit = dermis::pickUv(*snap->model, derived->uvLookup(), {u, v});
     if (!hit) return json{{"hit", false}};
-    return pickAnswer(*snap->model, *hit);
+    return pickAnswer(*derived, *hit);
 }
 
 Result<json> Service::drivers(const std::string& id, const FrameParams& params) {
