@@ -7,6 +7,7 @@
 // Service (CPU, no renderer needed): pick by UV, mirror and lint answer what the core computes
 // with fresh data, repeatedly, and deleting the model frees it with its derived data. No GL, no
 // HTTP.
+#include "TestFiles.hpp"
 #include "core/lint.hpp"
 #include "core/model_derived.hpp"
 #include "core/pick.hpp"
@@ -14,7 +15,6 @@
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
 #include "service/service.hpp"
-#include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
 
@@ -29,7 +29,8 @@ namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
 const std::string kCesium = std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb";
-const std::string kBarbarian = std::string(DERMIS_SHARED_DIR) + "/models/KayKitBarbarian/Barbarian.glb";
+const std::string kBarbarian =
+    std::string(DERMIS_SHARED_DIR) + "/models/KayKitBarbarian/Barbarian.glb";
 
 std::shared_ptr<const Model> loadShared(const std::string& path) {
     auto m = loadGltfFile(path);
@@ -75,7 +76,8 @@ void expectSameSuggestions(const std::shared_ptr<const Model>& model) {
     int compared = 0;
     for (int j = 0; j < 41; ++j)
         for (int i = 0; i < 41; ++i) {
-            const auto hit = pickUv(*model, derived.uvLookup(), {(i + 0.5) / 41.0, (j + 0.5) / 41.0});
+            const auto hit =
+                pickUv(*model, derived.uvLookup(), {(i + 0.5) / 41.0, (j + 0.5) / 41.0});
             if (!hit) continue;
             const SuggestedDriver a = derived.suggestDriver(hit->joints);
             const SuggestedDriver b = suggestDriver(*model, hit->joints);
@@ -97,13 +99,17 @@ public:
     const RendererInfo& info() const override { return info_; }
     Result<HeightMaps> bakeHeightMaps(const HeightPassInput&) override { return refused(); }
     Result<FrameResult> renderFrame(const FrameRequest&) override { return refused(); }
-    void forgetModel(const std::shared_ptr<const Model>& model) override { forgotten->push_back(model); }
+    void forgetModel(const std::shared_ptr<const Model>& model) override {
+        forgotten->push_back(model);
+    }
     /// Shared with the test (the service owns the renderer).
     std::shared_ptr<std::vector<std::weak_ptr<const Model>>> forgotten =
         std::make_shared<std::vector<std::weak_ptr<const Model>>>();
 
 private:
-    static Error refused() { return makeError(ErrorCode::Unsupported, "test", "", "no renders here"); }
+    static Error refused() {
+        return makeError(ErrorCode::Unsupported, "test", "", "no renders here");
+    }
     RendererInfo info_;
 };
 
@@ -164,7 +170,8 @@ TEST(ModelDerivedTest, ASlotBuildsOncePerModelUnderConcurrentUse) {
             lookups[k] = &d->uvLookup();
             planes[k] = &d->symmetryPlane();
         });
-    for (auto& t : threads) t.join();
+    for (auto& t : threads)
+        t.join();
     for (int k = 1; k < kThreads; ++k) {
         EXPECT_EQ(derived[k], derived[0]);
         EXPECT_EQ(lookups[k], lookups[0]);
@@ -190,7 +197,7 @@ TEST(ModelDerivedTest, FreedWithItsLastHolderAndKeepsItsModelUntilThen) {
     ASSERT_TRUE(model);
     const std::weak_ptr<const Model> weakModel = model;
     auto slot = std::make_shared<ModelDerivedSlot>(); // as a model entry holds it
-    auto request = slot->get(model);                   // as a request in flight holds it
+    auto request = slot->get(model);                  // as a request in flight holds it
     (void)request->uvLookup();
     const std::weak_ptr<const ModelDerived> weakDerived = request;
     model.reset();
@@ -264,8 +271,11 @@ TEST(ModelDerivedTest, ServiceRoutesAnswerAsFreshDataAndADeletedModelIsFreed) {
         const auto findings = lintScene(loaded->scene, model, fresh, loaded->images);
         std::vector<std::string> got, want;
         for (const json& f : *lint)
-            if (f["code"] != "unused_upload") got.push_back(f["code"].get<std::string>() + ": " + f["message"].get<std::string>());
-        for (const LintFinding& f : findings) want.push_back(f.code + ": " + f.message);
+            if (f["code"] != "unused_upload")
+                got.push_back(f["code"].get<std::string>() + ": " +
+                              f["message"].get<std::string>());
+        for (const LintFinding& f : findings)
+            want.push_back(f.code + ": " + f.message);
         EXPECT_EQ(got, want);
     }
 

@@ -31,25 +31,29 @@ const SymmetryPlane& ModelDerived::symmetryPlane() const {
     return plane_;
 }
 
-SuggestedDriver ModelDerived::suggestDriver(const std::vector<std::pair<int, float>>& joints) const {
+SuggestedDriver
+ModelDerived::suggestDriver(const std::vector<std::pair<int, float>>& joints) const {
     const Model& model = *model_;
     if (joints.empty() || model.clips.empty()) return dermis::suggestDriver(model, joints);
     std::call_once(rangesOnce_, [&] {
         std::vector<std::array<AngleRange, 3>> ranges(model.nodes.size());
         std::vector<bool> ranged(model.nodes.size(), false);
         for (int n : model.joints)
-            if (n >= 0 && static_cast<std::size_t>(n) < model.nodes.size()) ranged[static_cast<std::size_t>(n)] = true;
+            if (n >= 0 && static_cast<std::size_t>(n) < model.nodes.size())
+                ranged[static_cast<std::size_t>(n)] = true;
         const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
         // The same samples, in the same order, as core suggestDriver (pick.cpp).
         for (const Clip& clip : model.clips) {
             const int steps = static_cast<int>(std::floor(clip.duration * 15.0)) + 1;
             const int c = model.findClip(clip.name);
             for (int k = 0; k <= steps; ++k) {
-                const LocalPose pose = sampleClip(model, c, std::min(clip.duration, static_cast<float>(k) / 15.0f));
+                const LocalPose pose =
+                    sampleClip(model, c, std::min(clip.duration, static_cast<float>(k) / 15.0f));
                 for (std::size_t n = 0; n < ranges.size(); ++n) {
                     if (!ranged[n]) continue;
                     for (std::size_t a = 0; a < 3; ++a) {
-                        const double th = jointAngle(model.nodes[n].rotation, pose.rotation[n], axes[a]);
+                        const double th =
+                            jointAngle(model.nodes[n].rotation, pose.rotation[n], axes[a]);
                         ranges[n][a].lo = std::min(ranges[n][a].lo, th);
                         ranges[n][a].hi = std::max(ranges[n][a].hi, th);
                     }
@@ -61,7 +65,8 @@ SuggestedDriver ModelDerived::suggestDriver(const std::vector<std::pair<int, flo
         rangesBuilds_.fetch_add(1);
     });
     for (const auto& [node, weight] : joints)
-        if (node < 0 || static_cast<std::size_t>(node) >= ranged_.size() || !ranged_[static_cast<std::size_t>(node)])
+        if (node < 0 || static_cast<std::size_t>(node) >= ranged_.size() ||
+            !ranged_[static_cast<std::size_t>(node)])
             return dermis::suggestDriver(model, joints);
     // The choice, as core suggestDriver makes it: the joint and axis of the largest weighted range.
     static const char* kAxes[3] = {"x", "y", "z"};
@@ -76,7 +81,9 @@ SuggestedDriver ModelDerived::suggestDriver(const std::vector<std::pair<int, flo
             bestScore = score;
             out.joint = model.nodes[static_cast<std::size_t>(node)].name;
             out.axis = kAxes[a];
-            const double nearRest = (r.lo <= 0.0 && r.hi >= 0.0) ? 0.0 : (std::abs(r.lo) < std::abs(r.hi) ? r.lo : r.hi);
+            const double nearRest = (r.lo <= 0.0 && r.hi >= 0.0)
+                                        ? 0.0
+                                        : (std::abs(r.lo) < std::abs(r.hi) ? r.lo : r.hi);
             const double far = std::abs(r.hi - nearRest) >= std::abs(r.lo - nearRest) ? r.hi : r.lo;
             out.thetaMin = std::round(nearRest * 2.0) / 2.0;
             out.thetaMax = std::round(far * 2.0) / 2.0;
@@ -88,9 +95,11 @@ SuggestedDriver ModelDerived::suggestDriver(const std::vector<std::pair<int, flo
     return out;
 }
 
-std::shared_ptr<const ModelDerived> ModelDerivedSlot::get(const std::shared_ptr<const Model>& model) {
+std::shared_ptr<const ModelDerived>
+ModelDerivedSlot::get(const std::shared_ptr<const Model>& model) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!derived_ || derived_->modelPtr() != model) derived_ = std::make_shared<const ModelDerived>(model);
+    if (!derived_ || derived_->modelPtr() != model)
+        derived_ = std::make_shared<const ModelDerived>(model);
     return derived_;
 }
 

@@ -1,8 +1,8 @@
 // Dermis core — data derived from one immutable model, built once and shared by every request that
 // reads it: the UV index (UvLookup: lint, pick by UV, mirror), the rest pose's symmetry plane
-// (mirror) and the joints' angle ranges over the clips (the picks' driver suggestion). Each piece is built lazily, on its first use, at most once (std::call_once): a route
-// pays only for what it reads, and concurrent first uses wait for one build instead of each
-// making its own.
+// (mirror) and the joints' angle ranges over the clips (the picks' driver suggestion). Each piece
+// is built lazily, on its first use, at most once (std::call_once): a route pays only for what it
+// reads, and concurrent first uses wait for one build instead of each making its own.
 //
 //   ModelDerived      the derived data of one model; holds that model (shared), so the UvLookup's
 //                     pointer into it stays valid for as long as anyone holds the ModelDerived.
@@ -67,7 +67,7 @@ private:
     };
     mutable std::once_flag rangesOnce_;
     mutable std::vector<std::array<AngleRange, 3>> ranges_; ///< by node; x, y, z
-    mutable std::vector<bool> ranged_;                       ///< by node: a skin joint, in ranges_
+    mutable std::vector<bool> ranged_;                      ///< by node: a skin joint, in ranges_
     mutable std::atomic<int> lookupBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0};
 };
 

@@ -129,7 +129,8 @@ Result<json> Service::lint(const std::string& id) {
     }
     const auto derived = state_->derivedOf(*snap);
     json out = json::array();
-    for (const LintFinding& f : lintScene(snap->scene, *snap->model, derived->uvLookup(), snap->images))
+    const UvLookup& lookup = derived->uvLookup();
+    for (const LintFinding& f : lintScene(snap->scene, *snap->model, lookup, snap->images))
         out.push_back({{"code", f.code},
                        {"severity", std::string(toString(f.severity))},
                        {"placement", f.placement >= 0
