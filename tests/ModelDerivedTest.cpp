@@ -150,7 +150,11 @@ TEST(ModelDerivedTest, EachPieceIsBuiltOnFirstUseOnly) {
     EXPECT_EQ(&d.symmetryPlane(), plane);
     EXPECT_EQ(d.uvLookupBuilds(), 1);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 1);
-    EXPECT_THROW(ModelDerived(nullptr), std::invalid_argument);
+    const ModelDerived empty(nullptr); // an empty model: nothing to find, nothing thrown
+    EXPECT_FALSE(empty.uvLookup().find({0.5, 0.5}));
+    EXPECT_EQ(empty.uvLookup().chartCount(), 0);
+    EXPECT_EQ(empty.symmetryPlane().axis, 0);
+    EXPECT_EQ(empty.suggestDriver({}).joint, "");
 }
 
 TEST(ModelDerivedTest, ASlotBuildsOncePerModelUnderConcurrentUse) {

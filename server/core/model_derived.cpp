@@ -6,14 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <utility>
 
 namespace dermis {
 
-ModelDerived::ModelDerived(std::shared_ptr<const Model> model) : model_(std::move(model)) {
-    if (!model_) throw std::invalid_argument("dermis::ModelDerived: null model");
-}
+ModelDerived::ModelDerived(std::shared_ptr<const Model> model)
+    : model_(model ? std::move(model) : std::make_shared<const Model>()) {}
 
 const UvLookup& ModelDerived::uvLookup() const {
     std::call_once(lookupOnce_, [this] {

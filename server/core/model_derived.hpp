@@ -31,7 +31,8 @@ namespace dermis {
 
 class ModelDerived {
 public:
-    /// Nothing is computed yet. Precondition: `model` is not null (checked: std::invalid_argument).
+    /// Nothing is computed yet. A null `model` stands for an empty one (no triangles, no joints:
+    /// an empty lookup, the plane x = 0, no suggestion); nothing here throws but std::bad_alloc.
     explicit ModelDerived(std::shared_ptr<const Model> model);
     ModelDerived(const ModelDerived&) = delete;
     ModelDerived& operator=(const ModelDerived&) = delete;
@@ -76,7 +77,7 @@ public:
     /// The ModelDerived of `model`: the one made before for this same model (pointer identity),
     /// else a new one (nothing computed yet: that happens outside this slot's lock, on use). A
     /// slot asked for a different model than before replaces its object (holders of the old one
-    /// keep it). Precondition: `model` is not null.
+    /// keep it; a null model gets a new, empty one each time).
     std::shared_ptr<const ModelDerived> get(const std::shared_ptr<const Model>& model);
     /// The object made so far (null before the first get), without making one.
     std::shared_ptr<const ModelDerived> peek() const;
