@@ -1,12 +1,12 @@
 // Inspection of a stored scene, CPU only (SPEC §6): pick — frame pixel to skin —, probe — why a
 // texel has its height —,
 // activation — each placement's t over a clip, with flags — and lint. All run on a snapshot,
-// unlocked.
+// unlocked. Lint and the picks read the model's UV index and clip ranges from its entry
+// (State::derivedOf: built once per model, core ModelDerived), not new ones per request.
 #include "service/service_state.hpp"
 
 #include "core/activation.hpp"
 #include "core/deform.hpp"
-#include "core/uv_lookup.hpp"
 #include "core/lint.hpp"
 #include "core/pick.hpp"
 #include "core/probe.hpp"
@@ -25,12 +25,14 @@ double rounded(double x) {
     return std::round(x * 1e6) / 1e6 + 0.0; // + 0.0: no "-0" in the JSON
 }
 
-/// The pick answer of a hit (shared by the frame and texture picks).
-json pickAnswer(const Model& m, const PickHit& h) {
+/// The pick answer of a hit (shared by the frame and texture picks); the suggestion from the
+/// model's cached clip ranges (ModelDerived::suggestDriver, equal to core suggestDriver).
+json pickAnswer(const ModelDerived& derived, const PickHit& h) {
+    const Model& m = derived.model();
     json joints = json::array();
     for (auto [node, weight] : h.joints)
         joints.push_back({{"name", m.nodes[static_cast<std::size_t>(node)].name}, {"weight", weight}});
-    const SuggestedDriver d = suggestDriver(m, h.joints);
+    const SuggestedDriver d = derived.suggestDriver(h.joints);
     return json{{"hit", true},
                 {"uv", {h.uv.x, h.uv.y}},
                 {"position", {h.position.x, h.position.y, h.position.z}},
@@ -42,6 +44,18 @@ json pickAnswer(const Model& m, const PickHit& h) {
 }
 
 } // namespace
+
+std::shared_ptr<const ModelDerived> Service::State::derivedOf(const Snapshot& snap) const {
+    std::shared_ptr<ModelDerivedSlot> slot;
+    {
+        std::shared_lock<std::shared_mutex> lock(mutex);
+        auto it = models.find(snap.scene.model);
+        if (it != models.end() && it->second.model == snap.model && it->second.derived)
+            slot = it->second.derived;
+    }
+    if (!slot) return std::make_shared<const ModelDerived>(snap.model);
+    return slot->get(snap.model);
+}
 
 Result<json> Service::probe(const std::string& id, double u, double v, std::optional<double> time) {
     auto snap = state_->snapshot(id);
@@ -113,8 +127,9 @@ Result<json> Service::lint(const std::string& id) {
         for (const auto& [pid, e] : state_->patterns)
             if (!e.builtin && !used.count(pid)) unused.push_back(pid);
     }
-    const UvLookup lookup(*snap->model);
+    const auto derived = state_->derivedOf(*snap);
     json out = json::array();
+    const UvLookup& lookup = derived->uvLookup();
     for (const LintFinding& f : lintScene(snap->scene, *snap->model, lookup, snap->images))
         out.push_back({{"code", f.code},
                        {"severity", std::string(toString(f.severity))},
@@ -138,7 +153,7 @@ Result<json> Service::pick(const std::string& id, const FrameParams& params, dou
     auto hit = pickFrame(*plan, *snap->model, x, y);
     if (!hit) return hit.error();
     if (!*hit) return json{{"hit", false}};
-    return pickAnswer(*snap->model, **hit);
+    return pickAnswer(*state_->derivedOf(*snap), **hit);
 }
 
 
@@ -148,10 +163,10 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     auto snap = state_->snapshot(id);
     if (!snap) return snap.error();
     if (!snap->model->hasUVs()) return bad("u", "the model has no UVs: nothing lies at a texture point");
-    const UvLookup lookup(*snap->model);
-    const auto hit = dermis::pickUv(*snap->model, lookup, {u, v});
+    const auto derived = state_->derivedOf(*snap); // the model's UV index, built once
+    const auto hit = dermis::pickUv(*snap->model, derived->uvLookup(), {u, v});
     if (!hit) return json{{"hit", false}};
-    return pickAnswer(*snap->model, *hit);
+    return pickAnswer(*derived, *hit);
 }
 
 Result<json> Service::drivers(const std::string& id, const FrameParams& params) {

@@ -205,9 +205,9 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
     for (const Placement& p : snap->scene.placements)
         if (p.id == pid) source = &p;
     if (!source) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
-    const Model& model = *snap->model;
-    const UvLookup lookup(model);
-    auto twin = dermis::mirrorPlacement(*source, model, lookup, symmetryPlane(model));
+    const auto derived = state_->derivedOf(*snap); // UV index and symmetry plane, built once
+    auto twin = dermis::mirrorPlacement(*source, derived->model(), derived->uvLookup(),
+                                        derived->symmetryPlane());
     if (!twin) {
         Error e = twin.error();
         e.code = ErrorCode::InvalidArgument; // the placement cannot be mirrored: 422

@@ -14,6 +14,7 @@
 #include "service/service.hpp"
 
 #include "core/frame_plan.hpp"
+#include "core/model_derived.hpp"
 #include "io/gltf_loader.hpp"
 #include "service/content_cache.hpp"
 
@@ -39,6 +40,10 @@ struct ModelEntry {
     std::size_t bytes = 0;
     bool builtin = false;
     std::string sha256; ///< hex SHA-256 of an uploaded .glb ("" otherwise): content address
+    /// The model's derived data (UV index, symmetry plane), made on first use (State::derivedOf)
+    /// and shared by the copies of this entry; it goes with the entry when the model is deleted
+    /// (requests still holding it keep it, and the model, until they finish).
+    std::shared_ptr<ModelDerivedSlot> derived = std::make_shared<ModelDerivedSlot>();
 };
 
 struct PatternEntry {
@@ -177,6 +182,11 @@ struct Service::State {
         std::shared_ptr<const PatternImage> base;
     };
     Result<Snapshot> snapshot(const std::string& id) const;
+    /// The derived data of `snap`'s model (service_inspect.cpp): the one its model entry keeps,
+    /// made on the first call (what it computes is built on use, unlocked). A model that is not
+    /// (or no longer) the entry's — deleted since the snapshot — gets a fresh, uncached one.
+    /// Takes `mutex` shared itself (caller holds none). Never fails.
+    std::shared_ptr<const ModelDerived> derivedOf(const Snapshot& snap) const;
     /// Same for a document that is not stored (batch); caller holds `mutex` shared.
     Snapshot snapshotOf(const Scene& scene, std::shared_ptr<const Model> model,
                         const detail::ContentOverlay* overlay = nullptr) const;

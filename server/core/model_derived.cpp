@@ -1,0 +1,109 @@
+// Per-model derived data, built once. See model_derived.hpp.
+#include "model_derived.hpp"
+
+#include "angles.hpp"
+#include "rig.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace dermis {
+
+ModelDerived::ModelDerived(std::shared_ptr<const Model> model)
+    : model_(model ? std::move(model) : std::make_shared<const Model>()) {}
+
+const UvLookup& ModelDerived::uvLookup() const {
+    std::call_once(lookupOnce_, [this] {
+        lookup_ = std::make_unique<const UvLookup>(*model_);
+        lookupBuilds_.fetch_add(1);
+    });
+    return *lookup_;
+}
+
+const SymmetryPlane& ModelDerived::symmetryPlane() const {
+    std::call_once(planeOnce_, [this] {
+        plane_ = dermis::symmetryPlane(*model_);
+        planeBuilds_.fetch_add(1);
+    });
+    return plane_;
+}
+
+SuggestedDriver
+ModelDerived::suggestDriver(const std::vector<std::pair<int, float>>& joints) const {
+    const Model& model = *model_;
+    if (joints.empty() || model.clips.empty()) return dermis::suggestDriver(model, joints);
+    std::call_once(rangesOnce_, [&] {
+        std::vector<std::array<AngleRange, 3>> ranges(model.nodes.size());
+        std::vector<bool> ranged(model.nodes.size(), false);
+        for (int n : model.joints)
+            if (n >= 0 && static_cast<std::size_t>(n) < model.nodes.size())
+                ranged[static_cast<std::size_t>(n)] = true;
+        const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+        // The same samples, in the same order, as core suggestDriver (pick.cpp).
+        for (const Clip& clip : model.clips) {
+            const int steps = static_cast<int>(std::floor(clip.duration * 15.0)) + 1;
+            const int c = model.findClip(clip.name);
+            for (int k = 0; k <= steps; ++k) {
+                const LocalPose pose =
+                    sampleClip(model, c, std::min(clip.duration, static_cast<float>(k) / 15.0f));
+                for (std::size_t n = 0; n < ranges.size(); ++n) {
+                    if (!ranged[n]) continue;
+                    for (std::size_t a = 0; a < 3; ++a) {
+                        const double th =
+                            jointAngle(model.nodes[n].rotation, pose.rotation[n], axes[a]);
+                        ranges[n][a].lo = std::min(ranges[n][a].lo, th);
+                        ranges[n][a].hi = std::max(ranges[n][a].hi, th);
+                    }
+                }
+            }
+        }
+        ranges_ = std::move(ranges);
+        ranged_ = std::move(ranged);
+        rangesBuilds_.fetch_add(1);
+    });
+    for (const auto& [node, weight] : joints)
+        if (node < 0 || static_cast<std::size_t>(node) >= ranged_.size() ||
+            !ranged_[static_cast<std::size_t>(node)])
+            return dermis::suggestDriver(model, joints);
+    // The choice, as core suggestDriver makes it: the joint and axis of the largest weighted range.
+    static const char* kAxes[3] = {"x", "y", "z"};
+    SuggestedDriver out;
+    out.joint = model.nodes[static_cast<std::size_t>(joints.front().first)].name;
+    double bestScore = -1.0;
+    for (const auto& [node, weight] : joints)
+        for (std::size_t a = 0; a < 3; ++a) {
+            const AngleRange& r = ranges_[static_cast<std::size_t>(node)][a];
+            const double score = weight * (r.hi - r.lo);
+            if (r.hi < r.lo || score <= bestScore) continue;
+            bestScore = score;
+            out.joint = model.nodes[static_cast<std::size_t>(node)].name;
+            out.axis = kAxes[a];
+            const double nearRest = (r.lo <= 0.0 && r.hi >= 0.0)
+                                        ? 0.0
+                                        : (std::abs(r.lo) < std::abs(r.hi) ? r.lo : r.hi);
+            const double far = std::abs(r.hi - nearRest) >= std::abs(r.lo - nearRest) ? r.hi : r.lo;
+            out.thetaMin = std::round(nearRest * 2.0) / 2.0;
+            out.thetaMax = std::round(far * 2.0) / 2.0;
+        }
+    if (out.thetaMin == out.thetaMax) { // a joint that never moves: a default range
+        out.thetaMin = 0.0;
+        out.thetaMax = 90.0;
+    }
+    return out;
+}
+
+std::shared_ptr<const ModelDerived>
+ModelDerivedSlot::get(const std::shared_ptr<const Model>& model) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!derived_ || derived_->modelPtr() != model)
+        derived_ = std::make_shared<const ModelDerived>(model);
+    return derived_;
+}
+
+std::shared_ptr<const ModelDerived> ModelDerivedSlot::peek() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return derived_;
+}
+
+} // namespace dermis

@@ -1,0 +1,90 @@
+// Dermis core — data derived from one immutable model, built once and shared by every request that
+// reads it: the UV index (UvLookup: lint, pick by UV, mirror), the rest pose's symmetry plane
+// (mirror) and the joints' angle ranges over the clips (the picks' driver suggestion). Each piece
+// is built lazily, on its first use, at most once (std::call_once): a route pays only for what it
+// reads, and concurrent first uses wait for one build instead of each making its own.
+//
+//   ModelDerived      the derived data of one model; holds that model (shared), so the UvLookup's
+//                     pointer into it stays valid for as long as anyone holds the ModelDerived.
+//   ModelDerivedSlot  where a model's ModelDerived lives next to the model (the service's model
+//                     entry): made on the first get(), then the same object for that model; freed
+//                     with the slot (a deleted model's entry), once no request holds it.
+//
+// Pure (no GL, no I/O); thread-safe. Not done here: the rest-pose skinning mirrorPlacement and
+// lintScene do inside themselves (core mirror.cpp, lint.cpp) is not cached; nor is anything that
+// depends on a scene or a pose.
+#pragma once
+
+#include "mirror.hpp"
+#include "model.hpp"
+#include "pick.hpp"
+#include "uv_lookup.hpp"
+
+#include <array>
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <utility>
+#include <vector>
+
+namespace dermis {
+
+class ModelDerived {
+public:
+    /// Nothing is computed yet. A null `model` stands for an empty one (no triangles, no joints:
+    /// an empty lookup, the plane x = 0, no suggestion); nothing here throws but std::bad_alloc.
+    explicit ModelDerived(std::shared_ptr<const Model> model);
+    ModelDerived(const ModelDerived&) = delete;
+    ModelDerived& operator=(const ModelDerived&) = delete;
+
+    const Model& model() const { return *model_; }
+    const std::shared_ptr<const Model>& modelPtr() const { return model_; }
+
+    /// The model's UV index (UvLookup(model()), default cells), built on the first call. The
+    /// reference lives as long as this object. A build that throws (std::bad_alloc) is retried
+    /// by the next call.
+    const UvLookup& uvLookup() const;
+    /// symmetryPlane(model()), computed on the first call (O(vertices · 450)).
+    const SymmetryPlane& symmetryPlane() const;
+
+    /// core suggestDriver(model(), joints), bit for bit, with the clips sampled once per model:
+    /// the angle range of every skin joint about x, y and z over all clips at 15 fps (what that
+    /// function samples per call) is computed on the first call that needs it. Joints that are
+    /// not skin joints, an empty list and a model without clips go to suggestDriver itself.
+    SuggestedDriver suggestDriver(const std::vector<std::pair<int, float>>& joints) const;
+
+    /// How many times each piece was built: 0 before its first use, 1 after (for tests).
+    int uvLookupBuilds() const { return lookupBuilds_.load(); }
+    int symmetryPlaneBuilds() const { return planeBuilds_.load(); }
+    int clipRangeBuilds() const { return rangesBuilds_.load(); }
+
+private:
+    std::shared_ptr<const Model> model_;
+    mutable std::once_flag lookupOnce_, planeOnce_;
+    mutable std::unique_ptr<const UvLookup> lookup_;
+    mutable SymmetryPlane plane_;
+    struct AngleRange {
+        double lo = 1e9, hi = -1e9;
+    };
+    mutable std::once_flag rangesOnce_;
+    mutable std::vector<std::array<AngleRange, 3>> ranges_; ///< by node; x, y, z
+    mutable std::vector<bool> ranged_;                      ///< by node: a skin joint, in ranges_
+    mutable std::atomic<int> lookupBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0};
+};
+
+class ModelDerivedSlot {
+public:
+    /// The ModelDerived of `model`: the one made before for this same model (pointer identity),
+    /// else a new one (nothing computed yet: that happens outside this slot's lock, on use). A
+    /// slot asked for a different model than before replaces its object (holders of the old one
+    /// keep it; a null model gets a new, empty one each time).
+    std::shared_ptr<const ModelDerived> get(const std::shared_ptr<const Model>& model);
+    /// The object made so far (null before the first get), without making one.
+    std::shared_ptr<const ModelDerived> peek() const;
+
+private:
+    mutable std::mutex mutex_;
+    std::shared_ptr<const ModelDerived> derived_;
+};
+
+} // namespace dermis
