@@ -156,7 +156,19 @@ TEST(ServerProcessHttpTest, AcknowledgedEditsSurviveKillDashNine) {
                 acks.push_back({sid, body["revision"].get<std::uint64_t>(), t});
             }
         });
-        std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+        // Kill once at least 1.5 s have passed and more than 20 edits are acknowledged (on a
+        // loaded machine, under sanitizers, edits are slow: wait up to 60 s for them).
+        const auto start = std::chrono::steady_clock::now();
+        for (;;) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+            std::size_t n = 0;
+            {
+                std::lock_guard<std::mutex> lock(m);
+                n = acks.size();
+            }
+            const auto waited = std::chrono::steady_clock::now() - start;
+            if ((n > 20 && waited > std::chrono::milliseconds(1500)) || waited > std::chrono::seconds(60)) break;
+        }
         server.kill(SIGKILL);
         stop = true;
         editor.join();
