@@ -1,7 +1,9 @@
 // ModelDerivedTest — the per-model derived data (core ModelDerived, ModelDerivedSlot) that lint,
 // the picks and mirror share: the cached UV index and symmetry plane equal freshly computed ones
 // (default character, CesiumMan) and the cached driver suggestions core suggestDriver's (also
-// the KayKit Barbarian, many clips); each piece is built once per model, on first use, also when
+// the KayKit Barbarian, many clips), and core mirrorPlacement and lintScene give identical answers
+// with the cached rest skin and plane as without (all three models); each piece is built once per
+// model, on first use, also when
 // many threads ask at once; a slot hands out the same object for the same model and a new one
 // for another; the object keeps its model alive and is freed with its last holder. Through the
 // Service (CPU, no renderer needed): pick by UV, mirror and lint answer what the core computes
@@ -92,6 +94,85 @@ void expectSameSuggestions(const std::shared_ptr<const Model>& model) {
     EXPECT_EQ(derived.suggestDriver({}).joint, "");
 }
 
+/// Core mirrorPlacement and lintScene with the cached rest skin, plane and lookup answer exactly
+/// what they answer computing everything per call: twins of placements on every skin joint over
+/// a UV grid, then lint of a scene holding those placements and their twins (every second twin
+/// turned by 30°, so that mirror pairs are both symmetric and not).
+void expectSameMirrorAndLint(const std::shared_ptr<const Model>& model) {
+    const ModelDerived derived(model);
+    const UvLookup fresh(*model);
+    const SymmetryPlane plane = symmetryPlane(*model);
+    const RestSkin rest = restSkin(*model);
+    ASSERT_EQ(derived.restSkin().world.size(), rest.world.size());
+    for (std::size_t n = 0; n < rest.world.size(); ++n)
+        EXPECT_EQ(derived.restSkin().world[n], rest.world[n]);
+    ASSERT_EQ(derived.restSkin().parts.size(), rest.parts.size());
+    for (std::size_t k = 0; k < rest.parts.size(); ++k)
+        EXPECT_EQ(derived.restSkin().parts[k].positions, rest.parts[k].positions);
+    EXPECT_EQ(derived.restSkin().bounds.min, rest.bounds.min);
+    EXPECT_EQ(derived.restSkin().bounds.max, rest.bounds.max);
+    EXPECT_EQ(derived.symmetryPlane().axis, plane.axis);
+    EXPECT_EQ(derived.symmetryPlane().offset, plane.offset);
+    EXPECT_EQ(derived.symmetryPlane().error, plane.error);
+    EXPECT_EQ(symmetryPlane(rest).offset, plane.offset);
+
+    Scene scene;
+    int mirrored = 0, k = 0;
+    for (int j = 0; j < 9; ++j)
+        for (int i = 0; i < 9; ++i, ++k) {
+            Placement p;
+            p.id = "p" + std::to_string(k);
+            p.pattern = "crease";
+            p.center = {(i + 0.5) / 9.0, (j + 0.5) / 9.0};
+            p.scale = {0.04, 0.07};
+            p.rotation = 10.0 * k;
+            const int node = model->joints[static_cast<std::size_t>(k) % model->joints.size()];
+            p.joint = model->nodes[static_cast<std::size_t>(node)].name;
+            p.axisName = k % 2 ? "z" : "";
+            p.axis = k % 2 ? std::array<double, 3>{0, 0, 1} : std::array<double, 3>{0.6, 0.0, 0.8};
+            p.thetaMin = 5.0;
+            p.thetaMax = 60.0;
+            const auto a = mirrorPlacement(p, *model, fresh, plane);
+            const auto b = mirrorPlacement(p, *model, derived.uvLookup(), derived.symmetryPlane(),
+                                           derived.restSkin());
+            ASSERT_EQ(static_cast<bool>(a), static_cast<bool>(b)) << p.id;
+            scene.placements.push_back(p);
+            if (!a) {
+                EXPECT_EQ(a.error().code, b.error().code);
+                EXPECT_EQ(a.error().message, b.error().message);
+                continue;
+            }
+            ++mirrored;
+            EXPECT_EQ(a->center, b->center) << p.id;
+            EXPECT_EQ(a->scale, b->scale);
+            EXPECT_EQ(a->rotation, b->rotation);
+            EXPECT_EQ(a->joint, b->joint);
+            EXPECT_EQ(a->axis, b->axis);
+            EXPECT_EQ(a->axisName, b->axisName);
+            Placement twin = *b;
+            twin.id = p.id + "_twin";
+            if (mirrored % 2) twin.rotation += 30.0;
+            scene.placements.push_back(twin);
+        }
+    EXPECT_GT(mirrored, 10);
+    const PatternImages images;
+    const auto a = lintScene(scene, *model, fresh, images);
+    const auto b = lintScene(scene, derived, images);
+    ASSERT_EQ(a.size(), b.size());
+    int asymmetric = 0;
+    for (std::size_t f = 0; f < a.size(); ++f) {
+        EXPECT_EQ(a[f].code, b[f].code) << f;
+        EXPECT_EQ(a[f].severity, b[f].severity);
+        EXPECT_EQ(a[f].placement, b[f].placement);
+        EXPECT_EQ(a[f].message, b[f].message);
+        asymmetric += a[f].code == "mirror_asymmetric";
+    }
+    EXPECT_GT(asymmetric, 0); // the mirror-pair check ran
+    EXPECT_EQ(derived.restSkinBuilds(), 1);
+    EXPECT_EQ(derived.symmetryPlaneBuilds(), 1);
+    EXPECT_EQ(derived.uvLookupBuilds(), 1);
+}
+
 /// A renderer for a service whose tests never render; keeps the models it is told to forget.
 class ForgetfulRenderer final : public FrameRenderer {
 public:
@@ -135,6 +216,14 @@ TEST(ModelDerivedTest, CachedDriverSuggestionsEqualCoreOnes) {
     }
 }
 
+TEST(ModelDerivedTest, CachedRestSkinGivesTheSameTwinsAndLint) {
+    for (const auto& model : {defaultCharacter(), loadShared(kCesium), loadShared(kBarbarian)}) {
+        ASSERT_TRUE(model);
+        SCOPED_TRACE(std::to_string(model->joints.size()) + " joints");
+        expectSameMirrorAndLint(model);
+    }
+}
+
 TEST(ModelDerivedTest, EachPieceIsBuiltOnFirstUseOnly) {
     auto model = defaultCharacter();
     ASSERT_TRUE(model);
@@ -142,18 +231,33 @@ TEST(ModelDerivedTest, EachPieceIsBuiltOnFirstUseOnly) {
     EXPECT_EQ(d.uvLookupBuilds(), 0);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 0);
     EXPECT_EQ(d.clipRangeBuilds(), 0);
+    EXPECT_EQ(d.restSkinBuilds(), 0);
     const UvLookup* first = &d.uvLookup();
     EXPECT_EQ(d.uvLookupBuilds(), 1);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 0); // pick and lint never pay for the plane
     EXPECT_EQ(&d.uvLookup(), first);
+    // Lint without mirror pairs pays for neither the plane nor the rest skin.
+    Scene scene;
+    scene.placements.push_back(Placement{});
+    scene.placements.back().id = "a";
+    scene.placements.back().pattern = "crease";
+    scene.placements.back().joint = d.model().nodes[static_cast<std::size_t>(d.model().joints.at(0))].name;
+    (void)lintScene(scene, d, PatternImages{});
+    EXPECT_EQ(d.symmetryPlaneBuilds(), 0);
+    EXPECT_EQ(d.restSkinBuilds(), 0);
     const SymmetryPlane* plane = &d.symmetryPlane();
+    EXPECT_EQ(d.restSkinBuilds(), 1); // the plane is computed from the rest skin
     EXPECT_EQ(&d.symmetryPlane(), plane);
+    const RestSkin* rest = &d.restSkin();
+    EXPECT_EQ(&d.restSkin(), rest);
     EXPECT_EQ(d.uvLookupBuilds(), 1);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 1);
+    EXPECT_EQ(d.restSkinBuilds(), 1);
     const ModelDerived empty(nullptr); // an empty model: nothing to find, nothing thrown
     EXPECT_FALSE(empty.uvLookup().find({0.5, 0.5}));
     EXPECT_EQ(empty.uvLookup().chartCount(), 0);
     EXPECT_EQ(empty.symmetryPlane().axis, 0);
+    EXPECT_TRUE(empty.restSkin().parts.empty());
     EXPECT_EQ(empty.suggestDriver({}).joint, "");
 }
 
@@ -166,12 +270,14 @@ TEST(ModelDerivedTest, ASlotBuildsOncePerModelUnderConcurrentUse) {
     std::vector<const ModelDerived*> derived(kThreads);
     std::vector<const UvLookup*> lookups(kThreads);
     std::vector<const SymmetryPlane*> planes(kThreads);
+    std::vector<const RestSkin*> rests(kThreads);
     std::vector<std::thread> threads;
     for (int k = 0; k < kThreads; ++k)
         threads.emplace_back([&, k] {
             const auto d = slot.get(model);
             derived[k] = d.get();
             lookups[k] = &d->uvLookup();
+            rests[k] = &d->restSkin();
             planes[k] = &d->symmetryPlane();
         });
     for (auto& t : threads)
@@ -180,11 +286,13 @@ TEST(ModelDerivedTest, ASlotBuildsOncePerModelUnderConcurrentUse) {
         EXPECT_EQ(derived[k], derived[0]);
         EXPECT_EQ(lookups[k], lookups[0]);
         EXPECT_EQ(planes[k], planes[0]);
+        EXPECT_EQ(rests[k], rests[0]);
     }
     const auto d = slot.get(model);
     EXPECT_EQ(d.get(), derived[0]);
     EXPECT_EQ(d->uvLookupBuilds(), 1);
     EXPECT_EQ(d->symmetryPlaneBuilds(), 1);
+    EXPECT_EQ(d->restSkinBuilds(), 1);
     EXPECT_EQ(&d->model(), model.get());
 
     // Another model (here: a copy) gets its own object; holders of the old one keep theirs.

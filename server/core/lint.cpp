@@ -2,14 +2,18 @@
 #include "lint.hpp"
 
 #include "mirror.hpp"
+#include "model_derived.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <set>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 namespace dermis {
 
@@ -94,12 +98,15 @@ std::string num(double x, int decimals = 2) {
 
 /// mirror_asymmetric findings: pairs are enabled placements with the same pattern on joints that
 /// are mirror twins by name (mirrorJointName), each paired once with the candidate nearest to
-/// where it mirrors; the pair is compared with what mirrorPlacement makes of the first.
+/// where it mirrors; the pair is compared with what mirrorPlacement makes of the first. The
+/// symmetry plane and rest skin come from `mirrorData`, called once, on the first pair.
+using MirrorData = std::function<std::pair<const SymmetryPlane*, const RestSkin*>()>;
 void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& lookup,
-                     std::vector<LintFinding>& out) {
+                     const MirrorData& mirrorData, std::vector<LintFinding>& out) {
     const std::size_t n = scene.placements.size();
     std::vector<bool> paired(n, false);
-    std::optional<SymmetryPlane> plane;
+    const SymmetryPlane* plane = nullptr;
+    const RestSkin* rest = nullptr;
     const double texW = scene.heightmapSize[0], texH = scene.heightmapSize[1];
     for (std::size_t i = 0; i < n; ++i) {
         const Placement& p = scene.placements[i];
@@ -113,8 +120,8 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
                 candidates.push_back(j);
         }
         if (candidates.empty()) continue;
-        if (!plane) plane = symmetryPlane(model);
-        auto m = mirrorPlacement(p, model, lookup, *plane);
+        if (!plane) std::tie(plane, rest) = mirrorData();
+        auto m = mirrorPlacement(p, model, lookup, *plane, *rest);
         if (!m) continue; // a centre on no chart: off_chart says so
         std::size_t best = candidates.front();
         double bestTexels = std::numeric_limits<double>::infinity();
@@ -172,8 +179,10 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
 
 } // namespace
 
-std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,
-                                   const PatternImages& images) {
+namespace {
+
+std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, const UvLookup& lookup,
+                                       const PatternImages& images, const MirrorData& mirrorData) {
     std::vector<LintFinding> out;
     if (!scene.placements.empty() && !model.hasUVs()) {
         out.push_back({"no_uvs", LintSeverity::Warning, -1,
@@ -233,10 +242,31 @@ std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const
                                    percent(shared, n) + " of this footprint): heights add up"});
         }
     }
-    lintMirrorPairs(scene, model, lookup, out);
+    lintMirrorPairs(scene, model, lookup, mirrorData, out);
     std::stable_sort(out.begin(), out.end(),
                      [](const LintFinding& a, const LintFinding& b) { return a.placement < b.placement; });
     return out;
+}
+
+} // namespace
+
+std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,
+                                   const PatternImages& images) {
+    RestSkin rest;
+    SymmetryPlane plane;
+    return lintSceneWith(scene, model, lookup, images, [&] {
+        rest = restSkin(model);
+        plane = symmetryPlane(rest);
+        return std::pair<const SymmetryPlane*, const RestSkin*>{&plane, &rest};
+    });
+}
+
+std::vector<LintFinding> lintScene(const Scene& scene, const ModelDerived& derived,
+                                   const PatternImages& images) {
+    return lintSceneWith(scene, derived.model(), derived.uvLookup(), images, [&] {
+        return std::pair<const SymmetryPlane*, const RestSkin*>{&derived.symmetryPlane(),
+                                                               &derived.restSkin()};
+    });
 }
 
 } // namespace dermis

@@ -17,10 +17,13 @@
 // Each placement's footprint is sampled on a 12×12 grid of pattern coordinates; only samples
 // where its pattern is not flat (|L| > 0.02, when the image is given) count, so a transparent
 // border hanging off a chart is no finding. Clips are sampled at 30 fps. Disabled placements are
-// skipped. Pure; reads the model through `lookup` (which must index the same model).
+// skipped. Pure; reads the model through `lookup` (which must index the same model). The
+// overload taking a ModelDerived reads the model's UV index, rest skin and symmetry plane from it
+// (built once per model) instead of computing the plane and the rest-pose skinning per call.
 #pragma once
 
 #include "bake.hpp"
+#include "model_derived.hpp"
 #include "uv_lookup.hpp"
 
 #include <string>
@@ -51,6 +54,11 @@ struct LintFinding {
 /// pattern (then every sample counts). Never fails: unknown joints or clips are what
 /// validation reports, not lint.
 std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,
+                                   const PatternImages& images);
+/// The same findings, identical, on derived.model() with its cached UV index, rest skin and
+/// symmetry plane (the last two built on the first mirror pair only, if not built yet). Never
+/// fails either; the caller keeps `derived` alive for the call.
+std::vector<LintFinding> lintScene(const Scene& scene, const ModelDerived& derived,
                                    const PatternImages& images);
 
 } // namespace dermis

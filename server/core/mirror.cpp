@@ -19,10 +19,6 @@ namespace {
 /// The largest footprint side a scene accepts (scene_parse.cpp's limit).
 constexpr double kMaxPlacementScaleForMirror = 16.0;
 
-std::vector<SkinnedPart> restWorld(const Model& m) {
-    return skin(m, worldMatrices(m, restPose(m)));
-}
-
 glm::vec3 reflect(glm::vec3 p, const SymmetryPlane& s) {
     p[s.axis] = 2.0f * s.offset - p[s.axis];
     return p;
@@ -90,11 +86,15 @@ std::optional<glm::dvec2> nearestUv(const Model& m, const std::vector<SkinnedPar
 std::optional<glm::vec3> surfaceAt(const Model& m, const std::vector<SkinnedPart>& rest,
                                    const UvLookup& lookup, glm::dvec2 uv) {
     const auto hit = lookup.find(uv);
-    if (!hit) return std::nullopt;
+    if (!hit || static_cast<std::size_t>(hit->part) >= rest.size()) return std::nullopt;
     const MeshPart& p = m.parts[static_cast<std::size_t>(hit->part)];
     const auto& pos = rest[static_cast<std::size_t>(hit->part)].positions;
     glm::vec3 out(0.0f);
-    for (int k = 0; k < 3; ++k) out += hit->bary[k] * pos[p.indices[3 * static_cast<std::size_t>(hit->triangle) + k]];
+    for (int k = 0; k < 3; ++k) {
+        const std::uint32_t i = p.indices[3 * static_cast<std::size_t>(hit->triangle) + static_cast<std::size_t>(k)];
+        if (i >= pos.size()) return std::nullopt; // a RestSkin of another model
+        out += hit->bary[k] * pos[i];
+    }
     return out;
 }
 
@@ -105,13 +105,25 @@ std::string lower(std::string s) {
 
 } // namespace
 
+RestSkin restSkin(const Model& model) {
+    RestSkin out;
+    out.world = worldMatrices(model, restPose(model));
+    out.parts = skin(model, out.world);
+    out.bounds = framingBounds(out.parts);
+    return out;
+}
+
 SymmetryPlane symmetryPlane(const Model& model) {
-    const auto rest = restWorld(model);
+    return symmetryPlane(restSkin(model));
+}
+
+SymmetryPlane symmetryPlane(const RestSkin& restSkin) {
+    const std::vector<SkinnedPart>& rest = restSkin.parts;
     std::vector<glm::vec3> all;
     for (const auto& p : rest) all.insert(all.end(), p.positions.begin(), p.positions.end());
     SymmetryPlane best;
     if (all.empty()) return best;
-    const Bounds b = framingBounds(rest);
+    const Bounds& b = restSkin.bounds;
     const glm::vec3 centre = 0.5f * (b.min + b.max);
     const std::size_t stride = std::max<std::size_t>(1, all.size() / 150);
     best.error = std::numeric_limits<float>::max();
@@ -165,10 +177,15 @@ std::string mirrorJointName(const Model& model, const std::string& joint) {
 
 namespace {
 
+glm::dmat3 reflectionD(int axis) {
+    glm::dmat3 r(1.0);
+    r[axis][axis] = -1.0;
+    return r;
+}
+
 /// Rest world rotation in double: the world matrices' rotation parts with scale removed
 /// (Gram–Schmidt, so that a slightly skewed float matrix still gives a rotation).
-glm::dquat restWorldRotationD(const Model& model, int n) {
-    const auto world = worldMatrices(model, restPose(model));
+glm::dquat restWorldRotationD(const std::vector<glm::mat4>& world, int n) {
     glm::dmat3 m{glm::dmat4(world[static_cast<std::size_t>(n)])};
     m[0] = glm::normalize(m[0]);
     m[1] = glm::normalize(m[1] - glm::dot(m[1], m[0]) * m[0]);
@@ -176,10 +193,16 @@ glm::dquat restWorldRotationD(const Model& model, int n) {
     return glm::normalize(glm::quat_cast(m));
 }
 
-glm::dmat3 reflectionD(int axis) {
-    glm::dmat3 r(1.0);
-    r[axis][axis] = -1.0;
-    return r;
+glm::dquat restWorldRotationD(const Model& model, int n) {
+    return restWorldRotationD(worldMatrices(model, restPose(model)), n);
+}
+
+/// mirrorAxis from the rest world matrices.
+glm::vec3 mirrorAxisOf(const std::vector<glm::mat4>& world, int j, int t, const glm::vec3& axis,
+                       int planeAxis) {
+    const glm::dvec3 w = restWorldRotationD(world, j) * glm::dvec3(axis);
+    const glm::dvec3 mirrored = -(reflectionD(planeAxis) * w);
+    return glm::vec3(glm::normalize(glm::inverse(restWorldRotationD(world, t)) * mirrored));
 }
 
 } // namespace
@@ -197,16 +220,20 @@ glm::quat mirrorDelta(const glm::quat& qj, const glm::quat& qt, const glm::quat&
 }
 
 glm::vec3 mirrorAxis(const Model& model, int j, int t, const glm::vec3& axis, int planeAxis) {
-    const glm::dvec3 world = restWorldRotationD(model, j) * glm::dvec3(axis);
-    const glm::dvec3 mirrored = -(reflectionD(planeAxis) * world);
-    return glm::vec3(glm::normalize(glm::inverse(restWorldRotationD(model, t)) * mirrored));
+    return mirrorAxisOf(worldMatrices(model, restPose(model)), j, t, axis, planeAxis);
 }
 
 Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
                                   const SymmetryPlane& plane) {
+    if (!model.hasUVs()) return mirrorPlacement(p, model, lookup, plane, RestSkin{});
+    return mirrorPlacement(p, model, lookup, plane, restSkin(model));
+}
+
+Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
+                                  const SymmetryPlane& plane, const RestSkin& restSkin) {
     const char* where = "dermis::mirrorPlacement";
     if (!model.hasUVs()) return makeError(ErrorCode::Unsupported, where, "/uvs", "the model has no UVs");
-    const auto rest = restWorld(model);
+    const std::vector<SkinnedPart>& rest = restSkin.parts;
     Footprint fp;
     fp.center = {p.center[0], p.center[1]};
     fp.scale = {p.scale[0], p.scale[1]};
@@ -235,14 +262,17 @@ Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const 
         }
     }
     // Joint: by name, else by reflected rest position.
-    const int j = model.findJoint(p.joint);
+    const std::vector<glm::mat4>& world = restSkin.world;
+    const auto inWorld = [&](int n) { return n >= 0 && static_cast<std::size_t>(n) < world.size(); };
+    int j = model.findJoint(p.joint);
+    if (!inWorld(j)) j = -1; // a RestSkin of another model
     std::string twin = mirrorJointName(model, p.joint);
-    const auto world = worldMatrices(model, restPose(model));
     if (twin.empty() && j >= 0) {
         const glm::vec3 at = reflect(glm::vec3(world[static_cast<std::size_t>(j)][3]), plane);
-        const Bounds b = framingBounds(rest);
+        const Bounds& b = restSkin.bounds;
         float best = 0.05f * glm::length(b.max - b.min);
         for (int n : model.joints) {
+            if (!inWorld(n)) continue;
             const float d = glm::length(glm::vec3(world[static_cast<std::size_t>(n)][3]) - at);
             if (d < best) {
                 best = d;
@@ -255,9 +285,12 @@ Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const 
                          "joint '" + p.joint + "' has no mirror twin by name or by position");
     out.joint = twin;
     const int t = model.findJoint(twin);
+    if (!inWorld(t))
+        return makeError(ErrorCode::NotFound, where, "joint",
+                         "joint '" + twin + "' is not in the rest pose given");
     const glm::dvec3 in(p.axis[0], p.axis[1], p.axis[2]);
     if (!(glm::length(in) > 0.0)) return makeError(ErrorCode::InvalidArgument, where, "axis", "zero axis");
-    const glm::vec3 a = mirrorAxis(model, j, t, glm::vec3(glm::normalize(in)), plane.axis);
+    const glm::vec3 a = mirrorAxisOf(world, j, t, glm::vec3(glm::normalize(in)), plane.axis);
     out.axis = {a.x, a.y, a.z};
     out.axisName.clear();
     for (int k = 0; k < 3; ++k) // a named axis stays named when it maps onto one

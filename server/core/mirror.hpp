@@ -19,9 +19,13 @@
 //                   so a pose and its mirror image give both twins the same θ, hence the same t;
 //                   θ range, h, model, target and response are kept.
 //
-// Pure; O(vertices) per mirror for the nearest-point search (no index yet).
+// Pure; O(vertices) per mirror for the nearest-point search (no index yet). What depends only on
+// the model (the rest-pose skinning, RestSkin) can be computed once and passed in; the overloads
+// without it compute it per call.
 #pragma once
 
+#include "camera.hpp"
+#include "rig.hpp"
 #include "scene.hpp"
 #include "uv_lookup.hpp"
 
@@ -37,8 +41,23 @@ struct SymmetryPlane {
     float error = 0.0f;    ///< mean distance of reflected sample vertices to the mesh, world units
 };
 
+/// The model's rest pose as the mirror reads it; depends only on the model, so it can be made
+/// once per model (core ModelDerived::restSkin) and passed to the overloads below. Plain values
+/// (no pointer into the model).
+struct RestSkin {
+    std::vector<glm::mat4> world;     ///< worldMatrices(model, restPose(model)): one per node
+    std::vector<SkinnedPart> parts;   ///< skin(model, world): rest positions, one per part
+    Bounds bounds;                    ///< framingBounds(parts)
+};
+
+/// The RestSkin of `model` (O(vertices · influences)). Never fails; an empty model gives empty
+/// vectors and the cube bounds.
+RestSkin restSkin(const Model& model);
+
 /// The rest pose's symmetry plane (see above). A model without vertices gets x = 0.
 SymmetryPlane symmetryPlane(const Model& model);
+/// The same from a precomputed `rest`, which must be restSkin(model) of the model meant.
+SymmetryPlane symmetryPlane(const RestSkin& rest);
 
 /// The twin joint's name for `joint` by the naming conventions above ("" when none applies or
 /// the model has no such joint).
@@ -49,6 +68,11 @@ std::string mirrorJointName(const Model& model, const std::string& joint);
 /// the joint has no twin by name or position.
 Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
                                   const SymmetryPlane& plane);
+/// The same, bit for bit, without the per-call rest-pose skinning: `rest` must be
+/// restSkin(model) of this same model (not checked; another model's gives wrong twins, and a
+/// RestSkin with fewer nodes or parts than the model is read only within its bounds).
+Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
+                                  const SymmetryPlane& plane, const RestSkin& rest);
 
 /// The reflection of a local rotation delta for the twin joint, for tests and tools: given the
 /// rest world rotations Q_j, Q_t and a delta Δ of joint j (pose = rest·Δ), the twin's delta Δ'

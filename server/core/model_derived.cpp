@@ -21,9 +21,17 @@ const UvLookup& ModelDerived::uvLookup() const {
     return *lookup_;
 }
 
+const RestSkin& ModelDerived::restSkin() const {
+    std::call_once(restOnce_, [this] {
+        rest_ = dermis::restSkin(*model_);
+        restBuilds_.fetch_add(1);
+    });
+    return rest_;
+}
+
 const SymmetryPlane& ModelDerived::symmetryPlane() const {
     std::call_once(planeOnce_, [this] {
-        plane_ = dermis::symmetryPlane(*model_);
+        plane_ = dermis::symmetryPlane(restSkin()); // = symmetryPlane(*model_)
         planeBuilds_.fetch_add(1);
     });
     return plane_;

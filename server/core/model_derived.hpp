@@ -1,6 +1,7 @@
 // Dermis core — data derived from one immutable model, built once and shared by every request that
-// reads it: the UV index (UvLookup: lint, pick by UV, mirror), the rest pose's symmetry plane
-// (mirror) and the joints' angle ranges over the clips (the picks' driver suggestion). Each piece
+// reads it: the UV index (UvLookup: lint, pick by UV, mirror), the rest-pose skinning (RestSkin:
+// mirror, lint's mirror pairs, the symmetry plane), the rest pose's symmetry plane (mirror, lint)
+// and the joints' angle ranges over the clips (the picks' driver suggestion). Each piece
 // is built lazily, on its first use, at most once (std::call_once): a route pays only for what it
 // reads, and concurrent first uses wait for one build instead of each making its own.
 //
@@ -10,9 +11,9 @@
 //                     entry): made on the first get(), then the same object for that model; freed
 //                     with the slot (a deleted model's entry), once no request holds it.
 //
-// Pure (no GL, no I/O); thread-safe. Not done here: the rest-pose skinning mirrorPlacement and
-// lintScene do inside themselves (core mirror.cpp, lint.cpp) is not cached; nor is anything that
-// depends on a scene or a pose.
+// Pure (no GL, no I/O); thread-safe. Core mirrorPlacement and lintScene take these pieces through
+// their overloads (mirror.hpp, lint.hpp). Not cached: anything that depends on a scene or a pose
+// (lint's clip sampling against the placements' ranges, mirror's nearest-point search).
 #pragma once
 
 #include "mirror.hpp"
@@ -44,7 +45,11 @@ public:
     /// reference lives as long as this object. A build that throws (std::bad_alloc) is retried
     /// by the next call.
     const UvLookup& uvLookup() const;
-    /// symmetryPlane(model()), computed on the first call (O(vertices · 450)).
+    /// restSkin(model()) (core mirror.hpp: rest world matrices, rest-skinned parts, their
+    /// bounds), computed on the first call. Same lifetime and retry rule as uvLookup().
+    const RestSkin& restSkin() const;
+    /// symmetryPlane(model()), bit for bit, computed on the first call (O(vertices · 450)) from
+    /// restSkin() (which it builds if not yet built).
     const SymmetryPlane& symmetryPlane() const;
 
     /// core suggestDriver(model(), joints), bit for bit, with the clips sampled once per model:
@@ -55,13 +60,15 @@ public:
 
     /// How many times each piece was built: 0 before its first use, 1 after (for tests).
     int uvLookupBuilds() const { return lookupBuilds_.load(); }
+    int restSkinBuilds() const { return restBuilds_.load(); }
     int symmetryPlaneBuilds() const { return planeBuilds_.load(); }
     int clipRangeBuilds() const { return rangesBuilds_.load(); }
 
 private:
     std::shared_ptr<const Model> model_;
-    mutable std::once_flag lookupOnce_, planeOnce_;
+    mutable std::once_flag lookupOnce_, restOnce_, planeOnce_;
     mutable std::unique_ptr<const UvLookup> lookup_;
+    mutable RestSkin rest_;
     mutable SymmetryPlane plane_;
     struct AngleRange {
         double lo = 1e9, hi = -1e9;
@@ -69,7 +76,7 @@ private:
     mutable std::once_flag rangesOnce_;
     mutable std::vector<std::array<AngleRange, 3>> ranges_; ///< by node; x, y, z
     mutable std::vector<bool> ranged_;                      ///< by node: a skin joint, in ranges_
-    mutable std::atomic<int> lookupBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0};
+    mutable std::atomic<int> lookupBuilds_{0}, restBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0};
 };
 
 class ModelDerivedSlot {

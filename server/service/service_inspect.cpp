@@ -1,8 +1,9 @@
 // Inspection of a stored scene, CPU only (SPEC §6): pick — frame pixel to skin —, probe — why a
 // texel has its height —,
 // activation — each placement's t over a clip, with flags — and lint. All run on a snapshot,
-// unlocked. Lint and the picks read the model's UV index and clip ranges from its entry
-// (State::derivedOf: built once per model, core ModelDerived), not new ones per request.
+// unlocked. Lint and the picks read the model's UV index, rest skin, symmetry plane and clip
+// ranges from its entry (State::derivedOf: built once per model, core ModelDerived), not new ones
+// per request.
 #include "service/service_state.hpp"
 
 #include "core/activation.hpp"
@@ -129,8 +130,8 @@ Result<json> Service::lint(const std::string& id) {
     }
     const auto derived = state_->derivedOf(*snap);
     json out = json::array();
-    const UvLookup& lookup = derived->uvLookup();
-    for (const LintFinding& f : lintScene(snap->scene, *snap->model, lookup, snap->images))
+    // The model's UV index, rest skin and symmetry plane, built once (derived->model() is snap's).
+    for (const LintFinding& f : lintScene(snap->scene, *derived, snap->images))
         out.push_back({{"code", f.code},
                        {"severity", std::string(toString(f.severity))},
                        {"placement", f.placement >= 0

@@ -205,9 +205,9 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
     for (const Placement& p : snap->scene.placements)
         if (p.id == pid) source = &p;
     if (!source) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
-    const auto derived = state_->derivedOf(*snap); // UV index and symmetry plane, built once
+    const auto derived = state_->derivedOf(*snap); // UV index, plane and rest skin, built once
     auto twin = dermis::mirrorPlacement(*source, derived->model(), derived->uvLookup(),
-                                        derived->symmetryPlane());
+                                        derived->symmetryPlane(), derived->restSkin());
     if (!twin) {
         Error e = twin.error();
         e.code = ErrorCode::InvalidArgument; // the placement cannot be mirrored: 422
