@@ -161,16 +161,20 @@ SuggestedDriver suggestDriver(const Model& model, const std::vector<std::pair<in
             bestScore = score;
             out.joint = model.nodes[static_cast<std::size_t>(joints[j].first)].name;
             out.axis = kAxes[a];
-            const double nearRest = (r.lo <= 0.0 && r.hi >= 0.0) ? 0.0 : (std::abs(r.lo) < std::abs(r.hi) ? r.lo : r.hi);
-            const double far = std::abs(r.hi - nearRest) >= std::abs(r.lo - nearRest) ? r.hi : r.lo;
-            out.thetaMin = std::round(nearRest * 2.0) / 2.0;
-            out.thetaMax = std::round(far * 2.0) / 2.0;
+            suggestThetaRange(r.lo, r.hi, out);
         }
     if (out.thetaMin == out.thetaMax) { // a joint that never moves: a default range
         out.thetaMin = 0.0;
         out.thetaMax = 90.0;
     }
     return out;
+}
+
+void suggestThetaRange(double lo, double hi, SuggestedDriver& out) {
+    const double nearRest = (lo <= 0.0 && hi >= 0.0) ? 0.0 : (std::abs(lo) < std::abs(hi) ? lo : hi);
+    const double far = std::abs(hi - nearRest) >= std::abs(lo - nearRest) ? hi : lo;
+    out.thetaMin = std::round(nearRest * 2.0) / 2.0;
+    out.thetaMax = std::round(far * 2.0) / 2.0;
 }
 
 } // namespace dermis

@@ -55,4 +55,9 @@ struct SuggestedDriver {
 /// 0.5°. Without clips: the most weighted joint, x, 0–90. Empty joint name when `joints` is.
 SuggestedDriver suggestDriver(const Model& model, const std::vector<std::pair<int, float>>& joints);
 
+/// The θ range suggestDriver gives a joint axis whose angle moves over [lo, hi] degrees: from
+/// the angle nearest the rest pose (0 when the motion passes through it) to the far end of the
+/// motion, each rounded to 0.5°. Sets out.thetaMin / thetaMax only.
+void suggestThetaRange(double lo, double hi, SuggestedDriver& out);
+
 } // namespace dermis

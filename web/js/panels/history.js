@@ -7,6 +7,7 @@ import { store, on, whenIdle } from "../store.js";
 import { revert } from "../edits.js";
 import { escapeHtml } from "./library.js";
 import { notify } from "../notice.js";
+import { rowForListKey } from "../list_keys.js";
 
 let api, list, loading = 0;
 
@@ -51,14 +52,9 @@ async function load() {
 
 /// ↑/↓, Home and End: the focus (and the tab stop) moves to the revision after/before (newest/oldest).
 function onListKey(e) {
-  if (e.altKey || e.ctrlKey || e.metaKey || e.shiftKey) return;
-  const rows = [...list.querySelectorAll("li")];
-  const i = rows.findIndex((li) => li.contains(document.activeElement));
-  const j = i < 0 ? undefined : { ArrowUp: i - 1, ArrowDown: i + 1, Home: 0, End: rows.length - 1 }[e.key];
-  if (j === undefined) return;
-  e.preventDefault();
-  e.stopPropagation(); // arrows here walk the list instead of nudging the selection
-  const next = rows[Math.min(rows.length - 1, Math.max(0, j))].querySelector("button");
+  const row = rowForListKey(e, list);
+  if (!row) return;
+  const next = row.querySelector("button");
   for (const b of list.querySelectorAll("button")) b.tabIndex = -1;
   next.tabIndex = 0;
   next.focus();

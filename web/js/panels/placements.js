@@ -8,6 +8,7 @@ import { store, on, set, whenIdle } from "../store.js";
 import { patternImagePath } from "../images.js";
 import { patchPlacement, putScene } from "../edits.js";
 import { escapeHtml } from "./library.js";
+import { rowForListKey } from "../list_keys.js";
 
 let list, count, empty;
 
@@ -54,14 +55,9 @@ export async function reorder(id, beforeId) {
 
 /// ↑/↓, Home and End on a row: the row before/after (first/last) is selected and focused.
 function onListKey(e) {
-  if (e.altKey || e.ctrlKey || e.metaKey || e.shiftKey) return;
-  const rows = [...list.querySelectorAll("li")];
-  const i = rows.findIndex((li) => li.contains(document.activeElement));
-  const j = i < 0 ? undefined : { ArrowUp: i - 1, ArrowDown: i + 1, Home: 0, End: rows.length - 1 }[e.key];
-  if (j === undefined) return;
-  e.preventDefault();
-  e.stopPropagation(); // arrows here walk the list instead of nudging the selection
-  const id = rows[Math.min(rows.length - 1, Math.max(0, j))].dataset.placement;
+  const row = rowForListKey(e, list);
+  if (!row) return;
+  const id = row.dataset.placement;
   set({ selection: [id] });
   list.querySelector(`li[data-placement="${CSS.escape(id)}"] .name`)?.focus();
 }
