@@ -74,26 +74,11 @@ ModelDerived::suggestDriver(const std::vector<std::pair<int, float>>& joints) co
         if (node < 0 || static_cast<std::size_t>(node) >= ranged_.size() ||
             !ranged_[static_cast<std::size_t>(node)])
             return dermis::suggestDriver(model, joints);
-    // The choice, as core suggestDriver makes it: the joint and axis of the largest weighted range.
-    static const char* kAxes[3] = {"x", "y", "z"};
-    SuggestedDriver out;
-    out.joint = model.nodes[static_cast<std::size_t>(joints.front().first)].name;
-    double bestScore = -1.0;
-    for (const auto& [node, weight] : joints)
-        for (std::size_t a = 0; a < 3; ++a) {
-            const AngleRange& r = ranges_[static_cast<std::size_t>(node)][a];
-            const double score = weight * (r.hi - r.lo);
-            if (r.hi < r.lo || score <= bestScore) continue;
-            bestScore = score;
-            out.joint = model.nodes[static_cast<std::size_t>(node)].name;
-            out.axis = kAxes[a];
-            suggestThetaRange(r.lo, r.hi, out);
-        }
-    if (out.thetaMin == out.thetaMax) { // a joint that never moves: a default range
-        out.thetaMin = 0.0;
-        out.thetaMax = 90.0;
-    }
-    return out;
+    // The choice, as core suggestDriver makes it, from the ranges sampled once.
+    std::vector<std::array<AngleRange, 3>> ranges;
+    ranges.reserve(joints.size());
+    for (const auto& [node, weight] : joints) ranges.push_back(ranges_[static_cast<std::size_t>(node)]);
+    return chooseDriver(model, joints, ranges);
 }
 
 std::shared_ptr<const ModelDerived>

@@ -70,9 +70,6 @@ private:
     mutable std::unique_ptr<const UvLookup> lookup_;
     mutable RestSkin rest_;
     mutable SymmetryPlane plane_;
-    struct AngleRange {
-        double lo = 1e9, hi = -1e9;
-    };
     mutable std::once_flag rangesOnce_;
     mutable std::vector<std::array<AngleRange, 3>> ranges_; ///< by node; x, y, z
     mutable std::vector<bool> ranged_;                      ///< by node: a skin joint, in ranges_

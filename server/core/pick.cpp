@@ -129,13 +129,9 @@ SuggestedDriver suggestDriver(const Model& model, const std::vector<std::pair<in
     }
     out.joint = model.nodes[static_cast<std::size_t>(joints.front().first)].name;
     if (model.clips.empty()) return out;
-    static const char* kAxes[3] = {"x", "y", "z"};
     const glm::vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     // Angle ranges of each candidate over every clip at 15 fps.
-    struct Range {
-        double lo = 1e9, hi = -1e9;
-    };
-    std::vector<std::array<Range, 3>> ranges(joints.size());
+    std::vector<std::array<AngleRange, 3>> ranges(joints.size());
     for (const Clip& clip : model.clips) {
         const int steps = static_cast<int>(std::floor(clip.duration * 15.0)) + 1;
         const int c = model.findClip(clip.name);
@@ -152,29 +148,33 @@ SuggestedDriver suggestDriver(const Model& model, const std::vector<std::pair<in
             }
         }
     }
+    return chooseDriver(model, joints, ranges);
+}
+
+SuggestedDriver chooseDriver(const Model& model, const std::vector<std::pair<int, float>>& joints,
+                             const std::vector<std::array<AngleRange, 3>>& ranges) {
+    static const char* kAxes[3] = {"x", "y", "z"};
+    SuggestedDriver out;
+    out.joint = model.nodes[static_cast<std::size_t>(joints.front().first)].name;
     double bestScore = -1.0;
     for (std::size_t j = 0; j < joints.size(); ++j)
         for (std::size_t a = 0; a < 3; ++a) {
-            const Range& r = ranges[j][a];
+            const AngleRange& r = ranges[j][a];
             const double score = joints[j].second * (r.hi - r.lo);
             if (r.hi < r.lo || score <= bestScore) continue;
             bestScore = score;
             out.joint = model.nodes[static_cast<std::size_t>(joints[j].first)].name;
             out.axis = kAxes[a];
-            suggestThetaRange(r.lo, r.hi, out);
+            const double nearRest = (r.lo <= 0.0 && r.hi >= 0.0) ? 0.0 : (std::abs(r.lo) < std::abs(r.hi) ? r.lo : r.hi);
+            const double far = std::abs(r.hi - nearRest) >= std::abs(r.lo - nearRest) ? r.hi : r.lo;
+            out.thetaMin = std::round(nearRest * 2.0) / 2.0;
+            out.thetaMax = std::round(far * 2.0) / 2.0;
         }
     if (out.thetaMin == out.thetaMax) { // a joint that never moves: a default range
         out.thetaMin = 0.0;
         out.thetaMax = 90.0;
     }
     return out;
-}
-
-void suggestThetaRange(double lo, double hi, SuggestedDriver& out) {
-    const double nearRest = (lo <= 0.0 && hi >= 0.0) ? 0.0 : (std::abs(lo) < std::abs(hi) ? lo : hi);
-    const double far = std::abs(hi - nearRest) >= std::abs(lo - nearRest) ? hi : lo;
-    out.thetaMin = std::round(nearRest * 2.0) / 2.0;
-    out.thetaMax = std::round(far * 2.0) / 2.0;
 }
 
 } // namespace dermis

@@ -11,6 +11,7 @@
 #include "camera.hpp"
 #include "frame_plan.hpp"
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,9 +56,17 @@ struct SuggestedDriver {
 /// 0.5°. Without clips: the most weighted joint, x, 0–90. Empty joint name when `joints` is.
 SuggestedDriver suggestDriver(const Model& model, const std::vector<std::pair<int, float>>& joints);
 
-/// The θ range suggestDriver gives a joint axis whose angle moves over [lo, hi] degrees: from
-/// the angle nearest the rest pose (0 when the motion passes through it) to the far end of the
-/// motion, each rounded to 0.5°. Sets out.thetaMin / thetaMax only.
-void suggestThetaRange(double lo, double hi, SuggestedDriver& out);
+/// A joint angle's range over sampled poses, degrees (lo > hi: nothing sampled yet).
+struct AngleRange {
+    double lo = 1e9, hi = -1e9;
+};
+
+/// suggestDriver's choice from the angle ranges it sampled: `ranges[j]` (about x, y, z) belongs
+/// to `joints[j]`. The joint and axis with the largest weight × range; θ from the angle nearest
+/// the rest pose (0 when the motion passes through it) to the far end, rounded to 0.5°; 0–90
+/// about x of the first joint when nothing moves. Precondition: `joints` non-empty, node indices
+/// valid, `ranges` as long as `joints`.
+SuggestedDriver chooseDriver(const Model& model, const std::vector<std::pair<int, float>>& joints,
+                             const std::vector<std::array<AngleRange, 3>>& ranges);
 
 } // namespace dermis
