@@ -7,13 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <limits>
 #include <optional>
 #include <set>
 #include <sstream>
-#include <tuple>
-#include <utility>
 
 namespace dermis {
 
@@ -99,14 +96,11 @@ std::string num(double x, int decimals = 2) {
 /// mirror_asymmetric findings: pairs are enabled placements with the same pattern on joints that
 /// are mirror twins by name (mirrorJointName), each paired once with the candidate nearest to
 /// where it mirrors; the pair is compared with what mirrorPlacement makes of the first. The
-/// symmetry plane and rest skin come from `mirrorData`, called once, on the first pair.
-using MirrorData = std::function<std::pair<const SymmetryPlane*, const RestSkin*>()>;
+/// symmetry plane and rest skin are `derived`'s, built (lazily) only when a pair is found.
 void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& lookup,
-                     const MirrorData& mirrorData, std::vector<LintFinding>& out) {
+                     const ModelDerived& derived, std::vector<LintFinding>& out) {
     const std::size_t n = scene.placements.size();
     std::vector<bool> paired(n, false);
-    const SymmetryPlane* plane = nullptr;
-    const RestSkin* rest = nullptr;
     const double texW = scene.heightmapSize[0], texH = scene.heightmapSize[1];
     for (std::size_t i = 0; i < n; ++i) {
         const Placement& p = scene.placements[i];
@@ -120,8 +114,7 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
                 candidates.push_back(j);
         }
         if (candidates.empty()) continue;
-        if (!plane) std::tie(plane, rest) = mirrorData();
-        auto m = mirrorPlacement(p, model, lookup, *plane, *rest);
+        auto m = mirrorPlacement(p, model, lookup, derived.symmetryPlane(), derived.restSkin());
         if (!m) continue; // a centre on no chart: off_chart says so
         std::size_t best = candidates.front();
         double bestTexels = std::numeric_limits<double>::infinity();
@@ -182,7 +175,7 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
 namespace {
 
 std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, const UvLookup& lookup,
-                                       const PatternImages& images, const MirrorData& mirrorData) {
+                                       const PatternImages& images, const ModelDerived& derived) {
     std::vector<LintFinding> out;
     if (!scene.placements.empty() && !model.hasUVs()) {
         out.push_back({"no_uvs", LintSeverity::Warning, -1,
@@ -242,7 +235,7 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
                                    percent(shared, n) + " of this footprint): heights add up"});
         }
     }
-    lintMirrorPairs(scene, model, lookup, mirrorData, out);
+    lintMirrorPairs(scene, model, lookup, derived, out);
     std::stable_sort(out.begin(), out.end(),
                      [](const LintFinding& a, const LintFinding& b) { return a.placement < b.placement; });
     return out;
@@ -252,21 +245,14 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
 
 std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,
                                    const PatternImages& images) {
-    RestSkin rest;
-    SymmetryPlane plane;
-    return lintSceneWith(scene, model, lookup, images, [&] {
-        rest = restSkin(model);
-        plane = symmetryPlane(rest);
-        return std::pair<const SymmetryPlane*, const RestSkin*>{&plane, &rest};
-    });
+    // Derived data for this call only; the model is the caller's (not owned: aliasing pointer).
+    const ModelDerived derived(std::shared_ptr<const Model>(std::shared_ptr<const Model>(), &model));
+    return lintSceneWith(scene, model, lookup, images, derived);
 }
 
 std::vector<LintFinding> lintScene(const Scene& scene, const ModelDerived& derived,
                                    const PatternImages& images) {
-    return lintSceneWith(scene, derived.model(), derived.uvLookup(), images, [&] {
-        return std::pair<const SymmetryPlane*, const RestSkin*>{&derived.symmetryPlane(),
-                                                               &derived.restSkin()};
-    });
+    return lintSceneWith(scene, derived.model(), derived.uvLookup(), images, derived);
 }
 
 } // namespace dermis
