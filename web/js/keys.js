@@ -82,12 +82,11 @@ function onKey(e, { dlg, fitTexture }) {
   else if (k === "n" || k === "N") selectNext(e.shiftKey ? -1 : 1);
   else if (k.startsWith("Arrow") && sel.length) {
     const step = (e.shiftKey ? 10 : 1) / heightmapSize()[0];
-    const d = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, -step], ArrowDown: [0, step] }[k];
+    const d = ARROWS[k].map((c) => c * step);
     each((p) => patchPlacement(p.id, now(p.id, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }))));
   } else if (k.startsWith("Arrow") && inTextureView()) {
     const step = e.shiftKey ? 200 : 40; // css px; nothing is selected: the arrows pan
-    const d = { ArrowLeft: [-step, 0], ArrowRight: [step, 0], ArrowUp: [0, -step], ArrowDown: [0, step] }[k];
-    if (d) panBy(...d);
+    panBy(...ARROWS[k].map((c) => c * step));
   } else if ((k === "[" || k === "]" || k === "{" || k === "}") && sel.length) {
     const step = (e.shiftKey ? 15 : 5) * (k === "[" || k === "{" ? -1 : 1);
     each((p) => patchPlacement(p.id, now(p.id, (q) => ({ rotation: geo.round4(geo.wrapDegrees(q.rotation + step)) }))));
@@ -110,6 +109,9 @@ function onKey(e, { dlg, fitTexture }) {
   else handled = false;
   if (handled) e.preventDefault();
 }
+
+/// Unit steps of the arrow keys (x right, y down).
+const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
 
 const inTextureView = () => !!(document.activeElement && document.activeElement.closest && document.activeElement.closest("#textureView"));
 

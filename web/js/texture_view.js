@@ -28,6 +28,8 @@ let labels = { shown: [], hidden: [] }; // the last draw's label layout (css px 
 const LABEL_FONT = "11px system-ui, sans-serif", LABEL_H = 14;
 
 const S = () => Math.min(stage.clientWidth, stage.clientHeight) || 512;
+/// A footprint's colour (outline and label) by its target: displacement warm, bump cool.
+const targetColor = (p) => (p && p.target === "displacement" ? "#ff9a7a" : "#7fd0ff");
 const toScreen = (uv) => [ox + uv[0] * zoom * S(), oy + uv[1] * zoom * S()];
 const toUV = (x, y) => [(x - ox) / (zoom * S()), (y - oy) / (zoom * S())];
 const pxToUV = (px) => px / (zoom * S());
@@ -196,7 +198,7 @@ function drawFootprint(p, { selected, dim, lint, hover: hovered }) {
     ctx.globalAlpha = 1;
   }
   ctx.restore();
-  const color = p.target === "displacement" ? "#ff9a7a" : "#7fd0ff";
+  const color = targetColor(p);
   outline(p, selected ? "#ffffff" : color, selected ? 2 : hovered ? 2 : 1.2, p.enabled ? [] : [4, 3]);
   if (lint.length) {
     const [tx, ty] = toScreen(geo.toUV(p, [1, 0]));
@@ -281,7 +283,7 @@ function drawLabels(dims, w, h) {
   ctx.textBaseline = "middle";
   for (const b of labels.shown) {
     const p = placementById(b.id);
-    const color = p && p.target === "displacement" ? "#ff9a7a" : "#7fd0ff";
+    const color = targetColor(p);
     const selected = store.selection.includes(b.id);
     ctx.fillStyle = selected ? "rgba(36, 56, 77, 0.92)" : "rgba(13, 16, 20, 0.72)";
     ctx.fillRect(b.x, b.y, b.w, b.h);
@@ -434,18 +436,16 @@ export function cancelDrag() {
 
 function wheel(e) {
   e.preventDefault();
-  const [x, y] = local(e);
-  const before = toUV(x, y);
-  zoom = Math.min(Math.max(zoom * Math.exp(-e.deltaY * 0.0015), ZOOM_MIN), ZOOM_MAX);
-  ox = x - before[0] * zoom * S();
-  oy = y - before[1] * zoom * S();
-  fitted = true;
-  redraw();
+  zoomAbout(...local(e), Math.exp(-e.deltaY * 0.0015));
 }
 
 /// Zooms by factor `f` about the stage's centre (keys: Ctrl/Cmd+= and Ctrl/Cmd+−).
 export function zoomBy(f) {
-  const x = stage.clientWidth / 2, y = stage.clientHeight / 2;
+  zoomAbout(stage.clientWidth / 2, stage.clientHeight / 2, f);
+}
+
+/// Zooms by factor `f` (within ZOOM_MIN…ZOOM_MAX) keeping the UV point under css (x, y) in place.
+function zoomAbout(x, y, f) {
   const before = toUV(x, y);
   zoom = Math.min(Math.max(zoom * f, ZOOM_MIN), ZOOM_MAX);
   ox = x - before[0] * zoom * S();
