@@ -213,6 +213,15 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       let tabs = 0;
       while (tabs < 200 && await page.evaluate(() => document.activeElement.id) !== "uv") { await page.keyboard.press("Tab"); ++tabs; }
       assert.ok(tabs <= 30, `${tabs} Tabs from the scene menu to the texture view`);
+      // No trap: from the texture view, Tab goes on through the 3D view's bar and stage to the
+      // parameters and the history (both views shown: the page order).
+      const after3d = [];
+      for (let i = 0; i < 40 && !after3d.includes("historyList"); ++i) {
+        await page.keyboard.press("Tab");
+        after3d.push(await page.evaluate(() => { const e = document.activeElement; return e.closest("#historyList") ? "historyList" : e.id || e.tagName; }));
+      }
+      assert.ok(after3d.includes("viewMode") && after3d.includes("frameStage") && after3d.includes("historyList"),
+                `Tab from the texture view reaches the 3D bar, the 3D view and the history: ${after3d.join(" | ")}`);
       // Arrows walk the lists: the library's current pattern and the placement selection follow.
       await page.focus('#libraryList button[tabindex="0"]');
       const before = await page.evaluate(() => document.activeElement.dataset.pattern);

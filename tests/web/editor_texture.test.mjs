@@ -307,6 +307,11 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       await until(() => page.$eval(".workspace", (w) => w.dataset.layout === "3d"), "Tab switched to the 3D view");
       await waitFrame(page);
       await screenshot(page, "editor-3d.png");
+      // A second Tab moves on (no trap): the layout stays, the focus leaves the view.
+      await page.keyboard.press("Tab");
+      await sleep(100);
+      assert.equal(await page.$eval(".workspace", (w) => w.dataset.layout), "3d", "the second Tab does not switch back");
+      assert.equal(await page.evaluate(() => !!document.activeElement.closest(".view")), false, "the second Tab leaves the views");
       await page.click('[data-layout="both"]');
     }],
     ["no script errors", async () => assert.deepEqual(page.errors, [])],

@@ -65,12 +65,18 @@ function onKey(e, { dlg, fitTexture }) {
     return;
   }
   if (mod || e.altKey || typing(document.activeElement)) return;
-  const inView = document.activeElement && document.activeElement.closest && document.activeElement.closest(".view");
-  if (e.key === "Tab" && inView && !e.shiftKey) {
+  // Tab on a view shown alone switches to the other view, as the paper does; a second Tab in a
+  // row moves on in the page order, so Tab never traps a keyboard user in the views. With both
+  // views shown, both are in the page order and Tab simply follows it.
+  const active = document.activeElement;
+  const onStage = active && (active.id === "uv" || active.id === "frameStage");
+  if (e.key === "Tab" && !e.shiftKey && onStage && store.layoutMode !== "both" && active !== tabSwitchedTo) {
     e.preventDefault();
     switchView();
+    tabSwitchedTo = document.activeElement;
     return;
   }
+  tabSwitchedTo = null;
   const sel = store.selection.filter((id) => placementById(id));
   const each = (fn) => sel.forEach((id) => fn(placementById(id)));
   const k = e.key;
@@ -109,6 +115,9 @@ function onKey(e, { dlg, fitTexture }) {
   else handled = false;
   if (handled) e.preventDefault();
 }
+
+/// The view a Tab just switched to: the next Tab there moves on instead of switching back.
+let tabSwitchedTo = null;
 
 /// Unit steps of the arrow keys (x right, y down).
 const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1] };
