@@ -4,12 +4,16 @@
 // sign-in dialog for a session when the server answers 401 (then retries once). It keeps no token:
 // the session lives in the server's HttpOnly cookie. Does not cache and does not retry otherwise.
 
+import { inWords } from "./messages.js";
+
 export const API = "/api/v1";
 
-/// An error answer of the server (or a network failure: status 0, code "network").
+/// An error answer of the server (or a network failure: status 0, code "network"). `message` is
+/// in words for people (messages.js); `raw` is the server's own message.
 export class ApiError extends Error {
   constructor(status, code, message, field = "", revision = undefined) {
-    super(message);
+    super(inWords({ message, code, field }));
+    this.raw = message;
     this.status = status;
     this.code = code;
     this.field = field;

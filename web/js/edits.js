@@ -1,19 +1,24 @@
 // Every change this editor makes to the scene goes through here. Each edit carries If-Match with
-// the revision the person saw; the answer's document and revision become the state. A 412 means
-// someone else changed the scene first: the editor shows a notice, reads the scene again and
+// the revision the person saw; the answer's document and revision become the state. The server
+// rebases an edit of one placement over other people's edits of other placements; a 412 means
+// someone else changed the same thing first: the editor shows a notice, reads the scene again and
 // drops the edit (it never overwrites their change). Undo and redo are server reverts to the
-// revisions around this person's own edits.
+// revisions around this person's own edits; each step remembers what it did, in words, for the
+// notice that says what was undone or redone.
 //
-// Drags use a Stream: at most one edit in flight, edits at least `interval` ms apart, the newest
-// value wins, and finish() sends the last value so the scene ends where the pointer stopped.
+// Gestures (a drag in the texture view, a joint slider) use a Stream: the gesture is previewed
+// locally (pending.js, the frame route's `preview`) and its last value is sent once when it ends,
+// one revision per gesture; a `live` Stream (joint sliders, whose frames need the stored pose)
+// also sends values while the gesture runs, at most one in flight, at least `interval` ms apart.
 
 import { store, set, emit } from "./store.js";
 import { notify } from "./notice.js";
 import { trace } from "./trace.js";
+import { inWords } from "./messages.js";
 
 let api = null;
-const undoStack = []; // revisions to go back to (the document before one of my edits)
-const redoStack = []; // revisions to go forward to
+const undoStack = []; // {revision, what}: the document before one of my edits, and that edit in words
+const redoStack = []; // {revision, what}: revisions to go forward to
 let reloadScene = async () => {};
 
 export function initEdits(theApi, reload) {
@@ -24,6 +29,18 @@ export function initEdits(theApi, reload) {
 export const canUndo = () => undoStack.length > 0;
 export const canRedo = () => redoStack.length > 0;
 export function clearUndo() { undoStack.length = 0; redoStack.length = 0; emit("undo"); }
+
+/// Records an undo step: going back to `revision` undoes `what` (words, e.g. 'move "elbow L"').
+export function pushUndo(revision, what) {
+  undoStack.push({ revision, what });
+  redoStack.length = 0;
+  emit("undo");
+}
+
+let beforeEdit = () => {};
+/// `fn` runs before every edit is queued (pending.js sends a waiting key burst first, so edits
+/// stay in the order the person made them).
+export function setBeforeEdit(fn) { beforeEdit = fn; }
 
 /// Applies an edit answer ({id, revision, scene}) to the state.
 export function accept(answer, topic = "doc") {
@@ -41,6 +58,7 @@ let queue = Promise.resolve(); // this editor's edits, one at a time, in order
 /// the answer, or null when the server refused it (the notice is shown) or `body` gave null.
 /// `undoable` records it for undo.
 export function edit(method, path, body, opts = {}) {
+  beforeEdit();
   ++store.busy;
   emit("busy");
   const run = queue.then(() => send(method, path, body, opts)).finally(() => { --store.busy; emit("busy"); });
@@ -48,21 +66,18 @@ export function edit(method, path, body, opts = {}) {
   return run;
 }
 
-async function send(method, path, body, { undoable = true, quiet = false } = {}) {
+async function send(method, path, body, { undoable = true, quiet = false, what = null } = {}) {
   const before = store.revision;
   const payload = typeof body === "function" ? body(store.doc) : body;
   if (payload === null) return null;
+  const words = undoable ? what || describeEdit(method, path, payload) : null; // before the answer changes the document
   try {
     const sentAt = performance.now();
     const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, payload, before);
     if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
     accept(answer);
     if (store.saveError !== null) set({ saveError: null });
-    if (undoable) {
-      undoStack.push(before);
-      redoStack.length = 0;
-      emit("undo");
-    }
+    if (undoable) pushUndo(before, words);
     return answer;
   } catch (e) {
     await refused(e, quiet);
@@ -70,18 +85,43 @@ async function send(method, path, body, { undoable = true, quiet = false } = {})
   }
 }
 
-/// Shows why an edit was refused; after a 412, re-reads the scene.
+/// Shows why an edit was refused (in words, see messages.js); after a 412, re-reads the scene.
+/// Tells "refused" so that fields showing the refused value show the document's again.
 export async function refused(e, quiet = false) {
-  set({ saveError: e.message || "refused" }); // the save indicator says so until an edit succeeds
+  set({ saveError: inWords(e, store.doc) }); // the save indicator says so until an edit succeeds
   if (e.code === "stale_revision") {
-    notify(`Someone else changed this scene first (now revision ${e.revision}). Your edit was not applied; the scene is up to date again.`, "warn");
+    notify(`Someone else changed this placement first (the scene is now at revision ${e.revision}). Your edit was not applied; the scene is up to date again.`, "warn");
     await reloadScene();
   } else if (!quiet) {
-    notify(e.field ? `${e.message}` : e.message, "error");
+    notify(inWords(e, store.doc), "error");
   }
+  emit("refused");
+}
+
+/// An edit in words, for undo and redo notices: 'move "elbow L"', 'change h of "elbow L"',
+/// 'add "brow"', 'pose'.
+export function describeEdit(method, path, payload) {
+  const m = /^\/placements\/([^/]+)(\/mirror)?$/.exec(path);
+  const name = (id) => { const p = store.doc && store.doc.placements.find((q) => q.id === id); return `"${(p && p.label) || id}"`; };
+  if (m) {
+    const id = decodeURIComponent(m[1]);
+    if (m[2]) return `mirror ${name(id)}`;
+    if (method === "DELETE") return `delete ${name(id)}`;
+    const keys = payload && typeof payload === "object" ? Object.keys(payload) : [];
+    const verbs = { center: "move", scale: "scale", rotation: "rotate", enabled: payload && payload.enabled ? "show" : "hide" };
+    if (keys.length === 1 && verbs[keys[0]]) return `${verbs[keys[0]]} ${name(id)}`;
+    return `change ${keys.map((k) => k.replace("theta_", "θ")).join(", ") || "fields"} of ${name(id)}`;
+  }
+  if (path === "/placements") return `add "${(payload && (payload.label || payload.pattern)) || "placement"}"`;
+  if (path === "/pose") return "pose";
+  if (path === "/revert") return `revert to revision ${payload && payload.revision}`;
+  if (path === "") return "replace the scene";
+  return `${method} ${path}`;
 }
 
 export const patchPlacement = (id, fields, opts) => edit("PATCH", `/placements/${encodeURIComponent(id)}`, fields, opts);
+/// Puts placements in a new order (a structural edit: the whole document).
+export const putOrder = (doc) => edit("PUT", "", doc, { what: "reorder placements" });
 export const deletePlacement = (id) => edit("DELETE", `/placements/${encodeURIComponent(id)}`);
 
 /// Deletes placements `ids` and says so in a notice with an Undo button (a revert to the revision
@@ -94,7 +134,7 @@ export async function removePlacements(ids) {
   const before = Math.min(...answers.filter(Boolean).map((a) => a.revision)) - 1;
   const what = gone.length === 1 ? `"${names.get(gone[0])}"` : `${gone.length} placements`;
   notify(`Deleted ${what}.`, "info", { label: "Undo", run: async () => {
-    if (await revert(before)) set({ selection: gone.filter((id) => store.doc.placements.some((p) => p.id === id)) });
+    if (await revert(before, { what: `bring back ${what}` })) set({ selection: gone.filter((id) => store.doc.placements.some((p) => p.id === id)) });
   } });
 }
 export const addPlacement = (placement) => edit("POST", "/placements", placement);
@@ -103,50 +143,45 @@ export const patchPose = (fields, opts) => edit("PATCH", "/pose", fields, opts);
 export const putScene = (doc) => edit("PUT", "", doc);
 
 /// Goes back to `revision` as a new revision (history panel, undo, redo, cancelled drags).
-export async function revert(revision, { undoable = true } = {}) {
-  return edit("POST", "/revert", { revision }, { undoable });
+export async function revert(revision, { undoable = true, what = null } = {}) {
+  return edit("POST", "/revert", { revision }, { undoable, what });
 }
 
 /// Goes back (undo) or forward (redo): a revert to the revision on top of `from`, whose own
-/// revision then goes on `to`. A refused revert leaves both stacks as they were. A notice names
-/// what was undone (the operation of the revision left) or redone (of the revision returned to),
-/// with the way back as its button.
+/// revision then goes on `to` with the same words. A refused revert leaves both stacks as they
+/// were. A notice names what was undone or redone (the words kept with the step), with the way
+/// back as its button.
 async function travel(from, to, nothing, verb, back) {
   if (!from.length) return notify(nothing, "info");
-  const target = from.pop();
+  const step = from.pop();
   const here = store.revision;
-  if (await revert(target, { undoable: false })) {
-    to.push(here);
-    tellTravel(verb, verb === "Undone" ? here : target, back);
-  } else from.push(target);
+  if (await revert(step.revision, { undoable: false })) {
+    to.push({ revision: here, what: step.what });
+    notify(`${verb}: ${step.what || `revision ${step.revision}`}.`, "info", back, "undo");
+  } else from.push(step);
   emit("undo");
-}
-
-async function tellTravel(verb, revision, back) {
-  let what = `revision ${revision}`;
-  try {
-    const r = (await api.get(`/scenes/${store.sceneId}/revisions?limit=50`)).revisions.find((x) => x.revision === revision);
-    if (r && r.op) what = r.op;
-  } catch { /* the revision number will do */ }
-  notify(`${verb}: ${what}.`, "info", back, "undo");
 }
 
 export const undo = () => travel(undoStack, redoStack, "Nothing to undo.", "Undone", { label: "Redo", run: () => redo() });
 export const redo = () => travel(redoStack, undoStack, "Nothing to redo.", "Redone", { label: "Undo", run: () => undo() });
 
-/// A stream of edits from one gesture (a drag, a slider). send(value) queues the newest value
-/// (the first leaves one interval after the stream starts, so a gesture cancelled at once sends
-/// nothing);
-/// finish() resolves once the last value is on the server. cancel() sends nothing more and, when
-/// edits were already sent, reverts to the revision before the gesture.
+/// The edits of one gesture (a drag, a slider). send(value) keeps the newest value; finish()
+/// sends it (one edit, one revision) and records one undo step named `what`; cancel() drops it.
+/// With `live` (joint sliders: the frame shows the stored pose), values also leave while the
+/// gesture runs — the first one interval after it starts, at most one in flight, at least
+/// `interval` ms apart — and cancel() reverts to the revision before the gesture.
 export class Stream {
-  constructor(apply, interval = 70) {
+  constructor(apply, { live = false, interval = 70, what = null } = {}) {
     this.apply = apply;       // async (value) => answer | null
+    this.live = live;
     this.interval = interval;
+    this.what = what;         // the gesture in words (undo notices), or a function of the last value
     this.pending = undefined; // newest value not yet sent
+    this.last = undefined;    // newest value seen
     this.inFlight = null;
     this.lastSent = performance.now(); // the first edit leaves one interval after the gesture starts
     this.sent = 0;
+    this.ok = 0;
     this.before = store.revision;
     this.timer = null;
     this.done = false;
@@ -158,7 +193,14 @@ export class Stream {
   send(value) {
     if (this.done) return;
     this.pending = value;
-    this.pump();
+    this.last = value;
+    if (this.live) this.pump();
+  }
+  go(value) {
+    ++this.sent;
+    this.lastSent = performance.now();
+    this.inFlight = this.apply(value).then((a) => { if (a) ++this.ok; return a; }).finally(() => { this.inFlight = null; if (this.live && !this.done) this.pump(); });
+    return this.inFlight;
   }
   pump() {
     if (this.inFlight || this.pending === undefined || this.timer) return;
@@ -169,27 +211,22 @@ export class Stream {
     }
     const value = this.pending;
     this.pending = undefined;
-    this.lastSent = performance.now();
-    ++this.sent;
-    this.inFlight = this.apply(value).finally(() => { this.inFlight = null; this.pump(); });
+    this.go(value);
   }
+  /// Sends the last value (when it was not sent yet); resolves once it is answered.
   async finish() {
     this.done = true;
     if (this.timer) { clearTimeout(this.timer); this.timer = null; }
-    while (this.inFlight || this.pending !== undefined) {
-      if (this.inFlight) await this.inFlight;
-      if (this.pending !== undefined) {
-        const value = this.pending;
-        this.pending = undefined;
-        ++this.sent;
-        this.inFlight = this.apply(value).finally(() => { this.inFlight = null; });
-      }
+    if (this.inFlight) await this.inFlight;
+    if (this.pending !== undefined) {
+      const value = this.pending;
+      this.pending = undefined;
+      await this.go(value);
     }
     this.end();
-    if (this.sent > 0) {
-      undoStack.push(this.before);
-      redoStack.length = 0;
-      emit("undo");
+    if (this.ok > 0) {
+      const what = typeof this.what === "function" ? this.what(this.last) : this.what;
+      pushUndo(this.before, what);
     }
   }
   async cancel() {
@@ -197,7 +234,7 @@ export class Stream {
     this.pending = undefined;
     if (this.timer) { clearTimeout(this.timer); this.timer = null; }
     if (this.inFlight) await this.inFlight;
-    if (this.sent > 0) await revert(this.before, { undoable: false });
+    if (this.ok > 0) await revert(this.before, { undoable: false });
     this.end(); // after the revert: a gesture counts until the scene is back
   }
 }

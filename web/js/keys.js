@@ -3,7 +3,8 @@
 
 import { store, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
-import { patchPlacement, removePlacements, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
+import { removePlacements, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
+import { nudge } from "./pending.js";
 import { cancelDrag, dragging, viewCentreUV, zoomBy, panBy } from "./texture_view.js";
 import { setPlaceTool, placeToolOn } from "./frame_view.js";
 import { currentPattern, choosePattern } from "./panels/library.js";
@@ -14,7 +15,7 @@ import { notify } from "./notice.js";
 
 export const SHORTCUTS = [
   ["1 – 9", "place the library's n-th pattern at the pointer (texture view)"],
-  ["click / Shift+click", "select / add to the selection (either view, or the list)"],
+  ["click / Shift+click", "select one / add to the selection (Ctrl or Cmd+click adds too; either view, or the list)"],
   ["N / Shift+N", "select the next / previous placement"],
   ["← ↑ → ↓", "nudge the selection one texel (Shift: 10); with nothing selected, pan the texture view (Shift: further)"],
   ["[  ]", "rotate −5° / +5° (Shift: 15°)"],
@@ -78,7 +79,6 @@ function onKey(e, { dlg, fitTexture }) {
   }
   tabSwitchedTo = null;
   const sel = store.selection.filter((id) => placementById(id));
-  const each = (fn) => sel.forEach((id) => fn(placementById(id)));
   const k = e.key;
   let handled = true;
   if (k === "?") dlg.showModal();
@@ -89,16 +89,16 @@ function onKey(e, { dlg, fitTexture }) {
   else if (k.startsWith("Arrow") && sel.length) {
     const step = (e.shiftKey ? 10 : 1) / heightmapSize()[0];
     const d = ARROWS[k].map((c) => c * step);
-    each((p) => patchPlacement(p.id, now(p.id, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }))));
+    nudge(sel, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }), "move");
   } else if (k.startsWith("Arrow") && inTextureView()) {
     const step = e.shiftKey ? 200 : 40; // css px; nothing is selected: the arrows pan
     panBy(...ARROWS[k].map((c) => c * step));
   } else if ((k === "[" || k === "]" || k === "{" || k === "}") && sel.length) {
     const step = (e.shiftKey ? 15 : 5) * (k === "[" || k === "{" ? -1 : 1);
-    each((p) => patchPlacement(p.id, now(p.id, (q) => ({ rotation: geo.round4(geo.wrapDegrees(q.rotation + step)) }))));
+    nudge(sel, (q) => ({ rotation: geo.round4(geo.wrapDegrees(q.rotation + step)) }), "rotate");
   } else if ((k === "+" || k === "=" || k === "-" || k === "_") && sel.length) {
     const f = k === "+" || k === "=" ? 1.05 : 1 / 1.05;
-    each((p) => patchPlacement(p.id, now(p.id, (q) => ({ scale: [geo.round4(q.scale[0] * f), geo.round4(q.scale[1] * f)] }))));
+    nudge(sel, (q) => ({ scale: [geo.round4(q.scale[0] * f), geo.round4(q.scale[1] * f)] }), "scale");
   } else if ((k === "Delete" || k === "Backspace") && sel.length) {
     removePlacements(sel);
     set({ selection: [] });
@@ -124,11 +124,6 @@ const ARROWS = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], Arrow
 
 const inTextureView = () => !!(document.activeElement && document.activeElement.closest && document.activeElement.closest("#textureView"));
 
-/// An edit body computed from placement `id` as it is when the edit's turn comes (null: gone).
-const now = (id, fn) => (doc) => {
-  const q = doc && doc.placements.find((p) => p.id === id);
-  return q ? fn(q) : null;
-};
 
 /// Switches the single view between texture and 3D; side by side, moves focus to the other view.
 export function switchView() {

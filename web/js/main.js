@@ -4,12 +4,12 @@
 // placements, and "Copy link".
 
 import { Api, makeClientName, ApiError } from "./api.js";
-import { store, set, on, emit, whenIdle } from "./store.js";
+import { store, set, on, emit, whenIdle, placementById } from "./store.js";
 import { signIn } from "./signin.js";
 import { notify } from "./notice.js";
 import { initImages, forget } from "./images.js";
 import { initEdits, accept, clearUndo, canUndo, canRedo, putScene, undo, redo, revert } from "./edits.js";
-import { initTextureView, fit, screenGeometry, dragPreview, labelLayout } from "./texture_view.js";
+import { initTextureView, fit, screenGeometry, dragPreview, labelLayout, panBy } from "./texture_view.js";
 import { initFrameView, setPatternSource, setPreviewSource, setFrameSize, frameStats, frameUrl, pickAt } from "./frame_view.js";
 import { initLibrary, currentPattern, uploadPattern } from "./panels/library.js";
 import { initPlacements } from "./panels/placements.js";
@@ -22,6 +22,7 @@ import { initLive, connect, disconnect } from "./live.js";
 import { initPermalink, readLink, copyLink } from "./permalink.js";
 import { openCopyDialog } from "./copy_placements.js";
 import { trace, clearTrace } from "./trace.js";
+import { bursting, withPending } from "./pending.js";
 
 const $ = (id) => document.getElementById(id);
 const api = new Api({ client: makeClientName(), signIn });
@@ -67,9 +68,15 @@ async function openScene(id, link = {}) {
   fit();
 }
 
+/// The scene menu: each scene by its model's name and placement count (the id in the tooltip).
 async function refreshSceneList(select) {
-  const scenes = (await api.get("/scenes")).scenes;
-  $("scene").innerHTML = scenes.map((s) => `<option value="${s.id}">${s.id} — ${s.model} (${s.placements})</option>`).join("");
+  const [scenes, models] = await Promise.all([api.get("/scenes").then((a) => a.scenes), api.get("/models").then((a) => a.models).catch(() => [])]);
+  const names = new Map(models.map((m) => [m.id, m.name || m.id]));
+  const esc = (t) => String(t).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]);
+  $("scene").innerHTML = scenes.map((s) => {
+    const name = names.get(s.model) || s.model.replace(/^builtin:/, "");
+    return `<option value="${esc(s.id)}" title="scene ${esc(s.id)} on ${esc(s.model)}">${esc(name)} · ${s.placements} placement${s.placements === 1 ? "" : "s"}</option>`;
+  }).join("");
   if (select) $("scene").value = select;
   return scenes;
 }
@@ -83,12 +90,15 @@ function wireToolbar() {
   on("revision", () => { $("revision").textContent = `r${store.revision}`; });
   on("busy saveError online revision", showSaveState);
   // Closing or reloading the window while an edit is still on its way would lose it: ask first.
-  window.addEventListener("beforeunload", (e) => { if (store.busy > 0) { e.preventDefault(); e.returnValue = ""; } });
-  for (const b of document.querySelectorAll("[data-layout]"))
-    b.onclick = () => set({ layoutMode: b.dataset.layout });
+  window.addEventListener("beforeunload", (e) => { if (store.busy > 0 || bursting()) { e.preventDefault(); e.returnValue = ""; } });
+  // The layout buttons only: <main class="workspace"> carries data-layout too, and a click in the
+  // workspace must not switch (and re-fit) the views.
+  const layoutButtons = document.querySelectorAll("button[data-layout]");
+  for (const b of layoutButtons)
+    b.onclick = () => { if (store.layoutMode !== b.dataset.layout) set({ layoutMode: b.dataset.layout }); };
   on("layoutMode", () => {
     document.querySelector(".workspace").dataset.layout = store.layoutMode;
-    for (const b of document.querySelectorAll("[data-layout]")) b.classList.toggle("on", b.dataset.layout === store.layoutMode);
+    for (const b of layoutButtons) b.classList.toggle("on", b.dataset.layout === store.layoutMode);
   });
   $("newScene").onclick = () => $("newSceneFile").click();
   $("newSceneFile").onchange = () => { const f = $("newSceneFile").files[0]; if (f) newSceneFromModel(f); $("newSceneFile").value = ""; };
@@ -145,7 +155,8 @@ async function newSceneFromModel(f) {
     const scene = await api.send("POST", "/scenes", { format: "dermis.scene/1", model: model.id, placements: [] });
     await refreshSceneList(scene.id);
     await openScene(scene.id);
-    notify(`New scene ${scene.id} on ${model.name || model.id} (${model.triangles} triangles, ${model.joint_count} joints).`, "info");
+    const joints = model.joint_count ?? model.joints;
+    notify(`New scene on ${model.name || model.id}: ${model.triangles} triangles, ${joints} joint${joints === 1 ? "" : "s"}${model.has_uvs ? "" : ", no UVs"}.`, "info");
   } catch (e) { notify(`New scene from ${f.name}: ${e.message}`, "error"); }
 }
 
@@ -200,6 +211,7 @@ async function start() {
 }
 
 // For tests and benchmarks: a read-only look at the editor's state and its frame statistics.
-window.dermisEditor = { store, frameStats, frameUrl, pickAt, disconnect, connect, api, screenGeometry, labelLayout, trace, clearTrace };
+window.dermisEditor = { store, frameStats, frameUrl, pickAt, disconnect, connect, api, screenGeometry, labelLayout, trace, clearTrace,
+  select: (ids) => set({ selection: ids }), shownPlacement: (id) => withPending(placementById(id)), panTexture: panBy };
 
 start();

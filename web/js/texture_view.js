@@ -9,13 +9,15 @@
 // its placement is hovered or selected. Keys (keys.js) zoom (Ctrl/Cmd+= / −) and pan (arrows
 // with nothing selected) through zoomBy and panBy.
 //
-// Draws from the store; edits go through edits.js (a Stream per drag).
+// Draws from the store; edits go through edits.js (a Stream per drag: one edit when it ends).
 
 import { store, on, emit, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
 import { image, heightOverlay, onImageLoaded, patternImagePath } from "./images.js";
 import { Stream, patchPlacement } from "./edits.js";
+import { withPending, pendingPreview, hold, release } from "./pending.js";
 import { trace } from "./trace.js";
+import { addsToSelection } from "./selection.js";
 
 const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26, ZOOM_MIN = 0.2, ZOOM_MAX = 40;
 
@@ -34,10 +36,9 @@ const toScreen = (uv) => [ox + uv[0] * zoom * S(), oy + uv[1] * zoom * S()];
 const toUV = (x, y) => [(x - ox) / (zoom * S()), (y - oy) / (zoom * S())];
 const pxToUV = (px) => px / (zoom * S());
 
-/// The placement as drawn: the document's, with a running drag's value on top.
-function shown(p) {
-  return drag && drag.id === p.id && drag.value ? { ...p, ...drag.value } : p;
-}
+/// The placement as drawn: the document's, with pending changes (a drag's value, a key burst, a
+/// gesture's edit on its way) on top.
+const shown = withPending;
 
 export function initTextureView(section) {
   section.innerHTML = `
@@ -65,7 +66,7 @@ export function initTextureView(section) {
   canvas.addEventListener("pointercancel", () => cancelDrag());
   canvas.addEventListener("wheel", wheel, { passive: false });
   canvas.addEventListener("contextmenu", (e) => e.preventDefault());
-  on("doc selection lint presence overlay layout model revision solo", redraw);
+  on("doc selection lint presence overlay layout model revision solo drag", redraw);
   on("layoutMode", () => requestAnimationFrame(fit)); // the stage changed size: fit the UV square again
   onImageLoaded(redraw);
 }
@@ -86,10 +87,8 @@ export function redraw() {
   requestAnimationFrame(draw);
 }
 
-/// The running drag's placement as the frame should preview it ({id: fields}), or null.
-export function dragPreview() {
-  return drag && drag.kind !== "pan" && drag.value ? { [drag.id]: drag.value } : null;
-}
+/// What the frame should preview ({id: fields}: a drag, a key burst), or null.
+export const dragPreview = pendingPreview;
 
 /// True while a drag runs (Esc cancels it; see cancelDrag).
 export const dragging = () => drag !== null && drag.kind !== "pan";
@@ -117,7 +116,8 @@ function draw() {
   // The UV square, its texture and the overlay.
   ctx.fillStyle = "#1a1f26";
   ctx.fillRect(ox, oy, s, s);
-  const tex = store.model.has_uvs ? image(`/models/${encodeURIComponent(store.model.id)}/texture?size=1024`) : null;
+  // Only a model with a base-colour texture is asked for one (no 404 on a clean load).
+  const tex = store.model.has_uvs && store.model.has_texture ? image(`/models/${encodeURIComponent(store.model.id)}/texture?size=1024`) : null;
   if (tex) {
     ctx.globalAlpha = 0.55;
     ctx.drawImage(tex, ox, oy, s, s);
@@ -239,7 +239,9 @@ function layoutLabels(w, h) {
                    [cx - lw / 2, cy - lh / 2], [x1 + 2, cy - lh / 2], [x0 - lw - 2, cy - lh / 2]]
       .map(([x, y]) => ({ id: p.id, text, x: Math.round(x), y: Math.round(y), w: lw, h: lh }));
     const must = r !== Infinity; // selected or hovered
-    const box = spots.find((b) => free(b) && inside(b)) || spots.find(free) || (must ? spots[0] : null);
+    // A spot that fits nowhere inside the stage is moved inside it (never cut at the view's edge).
+    const clamp = (b) => ({ ...b, x: Math.round(Math.min(Math.max(b.x, 0), Math.max(w - b.w, 0))), y: Math.round(Math.min(Math.max(b.y, 0), Math.max(h - b.h, 0))) });
+    const box = spots.find((b) => free(b) && inside(b)) || spots.map(clamp).find(free) || (must ? clamp(spots[0]) : null);
     if (box) placed.push(box);
     else hidden.push(p.id);
   }
@@ -361,24 +363,27 @@ function pointerDown(e) {
   if (e.button !== 0) return;
   const what = under(x, y);
   if (!what) {
-    if (!e.shiftKey) set({ selection: [] });
+    if (!addsToSelection(e)) set({ selection: [] });
     drag = { kind: "pan", start: [x, y], orig: [ox, oy] };
     canvas.classList.add("grab");
     capture(e);
     return;
   }
   if (what.kind === "move") {
-    if (e.shiftKey) {
+    if (addsToSelection(e)) {
       const sel = store.selection.includes(what.id) ? store.selection.filter((i) => i !== what.id) : [what.id, ...store.selection];
       set({ selection: sel });
       return;
     }
-    if (store.selection[0] !== what.id) set({ selection: [what.id, ...store.selection.filter((i) => i !== what.id)] });
+    // A plain click selects this placement alone, as in every editor.
+    if (store.selection.length !== 1 || store.selection[0] !== what.id) set({ selection: [what.id] });
   }
   if (store.pinnedRevision !== null) return; // an old revision is shown: no edits until the person leaves it
-  const orig = { ...placementById(what.id) };
+  const orig = withPending(placementById(what.id));
+  const verb = { move: "move", scale: "scale", rotate: "rotate" }[what.kind];
   drag = { ...what, start: uv, orig, value: null,
-           stream: new Stream((fields) => patchPlacement(what.id, fields, { undoable: false })) };
+           stream: new Stream((fields) => patchPlacement(what.id, fields, { undoable: false }),
+                              { what: `${verb} "${orig.label || orig.id}"` }) };
   capture(e);
 }
 
@@ -409,7 +414,7 @@ function pointerMove(e) {
   else drag.value = geo.scaled(o, drag.corner, uv, e.shiftKey);
   if (trace.on) trace.moves.push(performance.now());
   drag.stream.send(drag.value);
-  emit("drag");
+  hold(drag.id, drag.value); // shown and previewed until the one edit of the gesture is answered
   redraw();
 }
 
@@ -420,7 +425,8 @@ async function pointerUp(e) {
   drag = null;
   if (d.kind === "pan") return;
   if (!d.value) { d.stream.done = true; d.stream.end(); return; }
-  await d.stream.finish();
+  await d.stream.finish(); // one edit: the gesture's last value
+  release(d.id);
   redraw();
 }
 
@@ -429,6 +435,7 @@ export function cancelDrag() {
   if (!drag || drag.kind === "pan") return false;
   const d = drag;
   drag = null;
+  release(d.id);
   d.stream.cancel().then(redraw);
   redraw();
   return true;

@@ -65,6 +65,9 @@ function draw() {
     return;
   }
   const ids = store.doc.placements.map((p) => p.id).filter((id) => data.placements[id]);
+  // Lanes are named as the placements list names them: the label, else the id.
+  const nameOf = (id) => { const p = store.doc.placements.find((q) => q.id === id); return (p && p.label) || id; };
+  canvas.dataset.lanes = JSON.stringify(ids.map(nameOf));
   // Lanes of 12 px (labels readable at 11 px): the strip grows with the placements up to 200 px,
   // then lanes shrink. Setting the height redraws through the ResizeObserver.
   const wantH = Math.round(Math.min(200, Math.max(110, 12 + ids.length * 12)));
@@ -85,7 +88,7 @@ function draw() {
       g.font = `${Math.min(11, Math.floor(lane - 1))}px system-ui, sans-serif`;
       g.fillStyle = selected ? "#ffb454" : "#b8c2cf";
       g.textBaseline = "middle";
-      g.fillText(id, 4, y + (lane - 1) / 2, lw - 10);
+      g.fillText(nameOf(id), 4, y + (lane - 1) / 2, lw - 10);
       g.textBaseline = "alphabetic";
     }
   });
@@ -105,5 +108,5 @@ function draw() {
     g.fillStyle = "#ffffff";
     g.fillRect(x - 1, 0, 2, H);
   }
-  canvas.title = data.flags.map((f) => `${f.placement}: ${f.kind.replace("_", " ")}${f.at != null ? ` at ${(+f.at).toFixed(2)} s` : ""}`).join("\n");
+  canvas.title = data.flags.map((f) => `${nameOf(f.placement)}: ${f.kind.replace("_", " ")}${f.at != null ? ` at ${(+f.at).toFixed(2)} s` : ""}`).join("\n");
 }

@@ -4,7 +4,7 @@
 // "go to pose" buttons (pose the driver at θmin / θmax) and the sweep contact sheet. Each field
 // is sent when it changes (Enter or leaving it).
 
-import { store, on, primary, shownTime, whenIdle } from "../store.js";
+import { store, on, primary, placementById, shownTime, whenIdle } from "../store.js";
 import { patchPlacement, patchPose, mirrorPlacement } from "../edits.js";
 import { height, normalizedT } from "../deform.js";
 import { escapeHtml } from "./library.js";
@@ -18,7 +18,9 @@ export function initParams(section, theApi) {
   section.innerHTML = `<h2>Parameters <span class="grow"></span><span id="paramsId" class="badge"></span></h2><div id="paramsBody"></div>`;
   box = section.querySelector("#paramsBody");
   on("selection model patterns", render);
-  on("doc", refreshValues);
+  on("doc", () => refreshValues(false));
+  // A refused edit: every field shows the document's value again, the one being typed in too.
+  on("refused", () => refreshValues(true));
   on("selection doc time revision", () => whenIdle("drivers", loadDrivers, 60));
   on("drivers", drawLive);
 }
@@ -76,11 +78,12 @@ function render() {
     </div>`;
   const $ = (id) => box.querySelector("#" + id);
   const send = (fields) => patchPlacement(p.id, fields);
+  const cur = () => placementById(p.id) || p; // the buttons act on the placement as it is now
   const num = (el) => { const v = +el.value; return Number.isFinite(v) && el.value !== "" ? v : null; };
   $("pLabel").onchange = (e) => send({ label: e.target.value });
   $("pPattern").onchange = (e) => send({ pattern: e.target.value });
   $("pJoint").onchange = (e) => {
-    if (!joints.includes(e.target.value)) { notify(`The model has no joint named "${e.target.value}".`, "error"); e.target.value = p.joint; return; }
+    if (!joints.includes(e.target.value)) { notify(`The model has no joint named "${e.target.value}".`, "error"); e.target.value = cur().joint; return; }
     send({ joint: e.target.value });
   };
   $("pAxis").onchange = (e) => send({ axis: e.target.value });
@@ -93,10 +96,10 @@ function render() {
   const pairSend = (a, b, key) => () => { const x = num($(a)), y = num($(b)); if (x !== null && y !== null) send({ [key]: [x, y] }); };
   $("pU").onchange = $("pV").onchange = pairSend("pU", "pV", "center");
   $("pSX").onchange = $("pSY").onchange = pairSend("pSX", "pSY", "scale");
-  $("goMin").onclick = () => goToPose(p, p.theta_min);
-  $("goMax").onclick = () => goToPose(p, p.theta_max);
-  $("clearPose").onclick = () => patchPose({ joints: { [p.joint]: null } });
-  $("sweep").onclick = () => openSweep(p);
+  $("goMin").onclick = () => goToPose(cur(), cur().theta_min);
+  $("goMax").onclick = () => goToPose(cur(), cur().theta_max);
+  $("clearPose").onclick = () => patchPose({ joints: { [cur().joint]: null } });
+  $("sweep").onclick = () => openSweep(cur());
   $("mirror").onclick = () => mirrorPlacement(p.id);
   drawLive();
 }
@@ -104,11 +107,11 @@ function render() {
 let shownId = null;
 
 /// The document changed: the same placement's fields take the new values in place (the field
-/// being typed in keeps its text); another placement, or a vanished one, renders anew.
-function refreshValues() {
+/// being typed in keeps its text unless `all`); another placement, or a vanished one, renders anew.
+function refreshValues(all) {
   const p = primary();
   if (!p || p.id !== shownId || !box.querySelector("#pH")) { render(); return; }
-  const set = (id, v) => { const el = box.querySelector("#" + id); if (el && el !== document.activeElement) el.value = String(v); };
+  const set = (id, v) => { const el = box.querySelector("#" + id); if (el && (all || el !== document.activeElement)) el.value = String(v); };
   set("pLabel", p.label || ""); set("pPattern", p.pattern); set("pJoint", p.joint); set("pAxis", p.axis);
   set("pMin", p.theta_min); set("pMax", p.theta_max); set("pH", p.h); set("pModel", p.model); set("pTarget", p.target);
   set("pResponse", p.response); set("pU", p.center[0]); set("pV", p.center[1]); set("pSX", p.scale[0]); set("pSY", p.scale[1]);

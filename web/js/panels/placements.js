@@ -1,6 +1,6 @@
 // Placements panel: one row per placement — pattern thumbnail, label (or id), lint badge, enabled
 // toggle (H), solo (S) — in document order; drag a row to reorder (PUT of the document with the
-// new order); click selects in both views (Shift adds). The list is one tab stop (roving focus, on
+// new order); click selects in both views (Shift, Ctrl or Cmd adds). The list is one tab stop (roving focus, on
 // the selected row): ↑/↓, Home and End move to a row and select it, Alt+↑/↓ moves the row in the
 // document; H and S toggle the focused selection as everywhere.
 
@@ -9,6 +9,7 @@ import { patternImagePath } from "../images.js";
 import { patchPlacement, putScene } from "../edits.js";
 import { escapeHtml } from "./library.js";
 import { rowForListKey } from "../list_keys.js";
+import { addsToSelection } from "../selection.js";
 
 let list, count, empty;
 
@@ -83,7 +84,7 @@ function render() {
       <button type="button" class="mini enabled" aria-pressed="${p.enabled}" aria-label="enabled ${escapeHtml(p.id)}" title="Enabled (H)">${p.enabled ? "◉" : "○"}</button>
       <button type="button" class="mini solo" aria-pressed="${store.solo.includes(p.id)}" aria-label="solo ${escapeHtml(p.id)}" title="Solo in the 3D view (S)">S</button>`;
     li.querySelector(".name").onclick = (e) => {
-      const sel = e.shiftKey ? (store.selection.includes(p.id) ? store.selection.filter((i) => i !== p.id) : [p.id, ...store.selection]) : [p.id];
+      const sel = addsToSelection(e) ? (store.selection.includes(p.id) ? store.selection.filter((i) => i !== p.id) : [p.id, ...store.selection]) : [p.id];
       set({ selection: sel });
     };
     li.querySelector(".enabled").onclick = () => toggleEnabled([p.id]);

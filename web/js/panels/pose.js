@@ -97,7 +97,7 @@ function renderJoints() {
       <span class="badge">${cur === undefined ? "anim" : cur.toFixed(1) + "°"}</span>`;
     const input = label.querySelector("input"), badge = label.querySelector(".badge");
     input.oninput = () => {
-      if (!jointStream) jointStream = new Stream((v) => patchPose(v, { undoable: false }));
+      if (!jointStream) jointStream = new Stream((v) => patchPose(v, { undoable: false }), { live: true, what: `pose ${d.joint} ${d.axis}` });
       const base = overrides[d.joint] && overrides[d.joint].axis_angles ? { ...overrides[d.joint].axis_angles } : {};
       base[d.axis] = +input.value;
       badge.textContent = `${(+input.value).toFixed(1)}°`;
