@@ -157,6 +157,14 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       await page.keyboard.press("Control+z");
       await settled(page, api);
       assert.deepEqual((await doc(sceneId)).scene.placements[4].center, before, "one undo takes the whole burst back");
+      // Ctrl+Z while a burst still waits: the burst is sent, then it is what is undone.
+      const r1 = (await doc(sceneId)).revision;
+      for (let i = 0; i < 3; ++i) await page.keyboard.press("ArrowDown");
+      await page.keyboard.press("Control+z");
+      await settled(page, api);
+      assert.deepEqual((await doc(sceneId)).scene.placements[4].center, before, "the waiting burst was undone");
+      assert.equal((await doc(sceneId)).revision, r1 + 2, "sent, then reverted");
+      assert.ok((await notices(page)).some((t) => /Undone: move "/.test(t)), "the notice names the burst");
     }],
     ["labels stay inside the texture view, also at its edge", async () => {
       const d = (await doc(sceneId)).scene;
@@ -175,13 +183,18 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       await page.click("#fitTexture");
     }],
     ["the activation strip names its lanes as the placements list does", async () => {
+      // Two placements get labels (the default set has none): their lanes must show them.
+      const d0 = (await doc(sceneId)).scene;
+      for (const [k, label] of [[1, "Left elbow crease"], [5, "Stomach folds"]])
+        assert.equal((await api("PATCH", `/scenes/${sceneId}/placements/${d0.placements[k].id}`, { label })).status, 200);
       await api("PATCH", `/scenes/${sceneId}/pose`, { animation: (await api("GET", "/models/builtin%3Adefault")).body.clips[0].name });
       const d = (await doc(sceneId)).scene;
-      await until(async () => (await page.$eval("#activation", (c) => c.dataset.lanes || "")).length > 2, "the strip has lanes");
+      await until(async () => (await page.$eval("#activation", (c) => c.dataset.lanes || "")).includes("Stomach folds"), "the strip has the new names");
       const lanes = JSON.parse(await page.$eval("#activation", (c) => c.dataset.lanes));
       const list = await page.$$eval("#placementList .name", (bs) => bs.map((b) => b.textContent));
       assert.deepEqual(lanes, list.filter((n) => lanes.includes(n)), "lanes carry the list's names");
-      assert.ok(lanes.some((n) => d.placements.some((p) => p.label && p.label === n)), "labels, not ids");
+      assert.ok(lanes.includes("Left elbow crease") && lanes.includes("Stomach folds"), `labels, not ids (${lanes})`);
+      assert.ok(!lanes.includes(d.placements[1].id), "the labelled placement's id is not a lane name");
     }],
     ["M on a placement whose twin exists adds no second twin and says so", async () => {
       await settled(page, api);

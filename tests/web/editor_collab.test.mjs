@@ -49,7 +49,7 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       await a.keyboard.press("Shift+ArrowDown");
       const afterA = await until(async () => { const p = await serverPlacement("neck"); return p.center[1] > neck0.center[1] && p; }, "A's nudge on the server");
       await b.keyboard.press("Shift+ArrowLeft");
-      await b.waitForFunction(() => [...document.querySelectorAll("#notices .notice")].some((n) => /Someone else changed this scene/.test(n.textContent)), null, { timeout: 5000 });
+      await b.waitForFunction(() => [...document.querySelectorAll("#notices .notice")].some((n) => /Someone else changed this placement/.test(n.textContent)), null, { timeout: 5000 });
       await sleep(300);
       assert.deepEqual(await serverPlacement("neck"), afterA, "A's change is intact");
       // B re-read the scene: it shows A's change now.

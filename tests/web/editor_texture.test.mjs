@@ -2,7 +2,7 @@
 // (playwright-core) against a real dermis-server on 127.0.0.1 with a fresh data folder.
 // Usage: node editor_texture.test.mjs <dermis-server executable>   (exit 0 = pass)
 // Checks: one outline per placement and a decoded frame; dragging a footprint moves it (server
-// within one texel) and changes the frame; a 2 s drag sends ≤ 30 edits and ends where the
+// within one texel) and changes the frame; a 2 s drag sends one edit and ends where the
 // pointer stopped; Shift-rotate snaps to 15°; Esc cancels (server unchanged); a number key
 // places a pattern; nudge / rotate / scale keys; Delete, undo, redo; a history click reverts; the
 // history list is one Tab stop (arrows / Home / End move, Enter reverts);
@@ -70,7 +70,7 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       const hash1 = await settledFrameHash(page);
       assert.notEqual(hash1, hash0, "the frame changed");
     }],
-    ["a 2 s drag sends at most 30 edits and ends where the pointer stopped", async () => {
+    ["a 2 s drag sends one edit, when it ends, where the pointer stopped", async () => {
       await settle();
       const before = await serverPlacement("neck");
       const g = await footprint(page, "neck");
@@ -99,7 +99,7 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       const sent = edits.filter((e) => e.path.endsWith("/placements/neck")).length;
       assert.ok(i >= 45, `${i} pointer moves`);
       await until(async () => !(await page.evaluate(() => window.dermisEditor.store.busy)), "idle");
-      assert.ok(sent >= 3 && sent <= 30, `${sent} edits for ${i} moves`);
+      assert.equal(sent, 1, `one edit for the whole gesture (${sent} edits for ${i} moves)`);
       const p = await serverPlacement("neck");
       const want = [before.center[0] + (last[0] - g.center[0]) / g.pxPerUV, before.center[1] + (last[1] - g.center[1]) / g.pxPerUV];
       assert.ok(Math.abs(p.center[0] - want[0]) <= texel && Math.abs(p.center[1] - want[1]) <= texel, `${p.center} vs ${want}`);

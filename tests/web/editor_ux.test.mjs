@@ -203,12 +203,12 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       const r1 = await rotation();
       await settled(page, api);
       await page.keyboard.press("Control+z");
-      const redo = await page.waitForSelector('#notices .notice:has-text("Undone: patch placement thigh_l") button.action', { timeout: 10000 });
+      const redo = await page.waitForSelector(`#notices .notice:has-text('Undone: rotate "thigh_l"') button.action`, { timeout: 10000 });
       assert.equal(await redo.textContent(), "Redo");
       await until(async () => (await rotation()) === r0, "the rotation undone on the server");
       await redo.click();
       await until(async () => (await rotation()) === r1, "redone by the notice's button");
-      const again = await page.waitForSelector('#notices .notice:has-text("Redone: patch placement thigh_l") button.action', { timeout: 10000 });
+      const again = await page.waitForSelector(`#notices .notice:has-text('Redone: rotate "thigh_l"') button.action`, { timeout: 10000 });
       assert.equal(await again.textContent(), "Undo");
       assert.equal(await page.$$eval('#notices .notice[data-key="undo"]', (n) => n.length), 1, "one undo notice at a time");
       // Someone else on the scene (the window closed above is still shown for a while, or a new

@@ -39,7 +39,7 @@ export function pushUndo(revision, what) {
 
 let beforeEdit = () => {};
 /// `fn` runs before every edit is queued (pending.js sends a waiting key burst first, so edits
-/// stay in the order the person made them).
+/// stay in the order the person made them); undo and redo wait for the promise it returns.
 export function setBeforeEdit(fn) { beforeEdit = fn; }
 
 /// Applies an edit answer ({id, revision, scene}) to the state.
@@ -152,6 +152,7 @@ export async function revert(revision, { undoable = true, what = null } = {}) {
 /// were. A notice names what was undone or redone (the words kept with the step), with the way
 /// back as its button.
 async function travel(from, to, nothing, verb, back) {
+  await beforeEdit(); // a key burst still waiting is sent (and becomes the step undone) first
   if (!from.length) return notify(nothing, "info");
   const step = from.pop();
   const here = store.revision;

@@ -34,9 +34,18 @@ export function hold(id, fields) {
   emit("drag");
 }
 
-/// Stops showing placement `id`'s pending fields (its edit is on the server, or was dropped).
-export function release(id) {
-  if (shownFields.delete(id)) emit("drag");
+/// Stops showing placement `id`'s pending fields (its edit is on the server, or was dropped):
+/// all of them, or with `sent` only those still as they were sent (a newer change made while
+/// that edit was on its way stays shown until its own edit is answered).
+export function release(id, sent = null) {
+  const cur = shownFields.get(id);
+  if (!cur) return;
+  if (sent) {
+    const rest = Object.fromEntries(Object.entries(cur).filter(([k, v]) => sent[k] !== v));
+    if (Object.keys(rest).length) shownFields.set(id, rest);
+    else shownFields.delete(id);
+  } else shownFields.delete(id);
+  emit("drag");
 }
 
 /// True while a key burst waits to be committed.
@@ -69,7 +78,7 @@ export async function commitBurst() {
   clearTimeout(b.timer);
   const edits = [...b.ids].map((id) => {
     const fields = shownFields.get(id);
-    return fields ? patchPlacement(id, fields, { undoable: false }).finally(() => release(id)) : null;
+    return fields ? patchPlacement(id, fields, { undoable: false }).finally(() => release(id, fields)) : null;
   }).filter(Boolean);
   --store.gestures;
   emit("gestures");
@@ -86,6 +95,6 @@ function describeBurst({ ids, verbs }) {
 }
 
 // Another edit, a new selection or leaving the page sends a waiting burst first.
-setBeforeEdit(() => { if (burst) commitBurst(); });
+setBeforeEdit(() => (burst ? commitBurst() : Promise.resolve()));
 on("selection", () => { if (burst) commitBurst(); });
 window.addEventListener("pagehide", () => { if (burst) commitBurst(); });

@@ -426,7 +426,7 @@ async function pointerUp(e) {
   if (d.kind === "pan") return;
   if (!d.value) { d.stream.done = true; d.stream.end(); return; }
   await d.stream.finish(); // one edit: the gesture's last value
-  release(d.id);
+  release(d.id, d.value);
   redraw();
 }
 
