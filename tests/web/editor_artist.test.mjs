@@ -15,7 +15,8 @@ import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { startServer, launch, apiClient, openEditor, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep, countEdits } from "./editor_lib.mjs";
 
-const server = await startServer(process.argv[2], [], "dermis-editor-artist-");
+// $DERMIS_TEST_WEB serves another editor folder (e.g. an older web/, to see these checks fail there).
+const server = await startServer(process.argv[2], process.env.DERMIS_TEST_WEB ? ["--web", process.env.DERMIS_TEST_WEB] : [], "dermis-editor-artist-");
 const api = apiClient(server.base);
 const browser = await launch();
 await runSuite("WebEditorArtistBrowserTest", async () => {

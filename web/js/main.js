@@ -149,15 +149,15 @@ function showSaveState() {
 
 async function newSceneFromModel(f) {
   try {
-    notify(`Uploading ${f.name}…`, "info");
+    notify(`Uploading ${f.name}…`, "info", null, "newscene");
     const model = await api.json("POST", `/models?name=${encodeURIComponent(f.name.replace(/\.glb$/i, ""))}`,
                                  { body: f, headers: { "Content-Type": "model/gltf-binary" } });
     const scene = await api.send("POST", "/scenes", { format: "dermis.scene/1", model: model.id, placements: [] });
     await refreshSceneList(scene.id);
     await openScene(scene.id);
     const joints = model.joint_count ?? model.joints;
-    notify(`New scene on ${model.name || model.id}: ${model.triangles} triangles, ${joints} joint${joints === 1 ? "" : "s"}${model.has_uvs ? "" : ", no UVs"}.`, "info");
-  } catch (e) { notify(`New scene from ${f.name}: ${e.message}`, "error"); }
+    notify(`New scene on ${model.name || model.id}: ${model.triangles} triangles, ${joints} joint${joints === 1 ? "" : "s"}${model.has_uvs ? "" : ", no UVs"}.`, "info", null, "newscene");
+  } catch (e) { notify(`New scene from ${f.name}: ${e.message}`, "error", null, "newscene"); }
 }
 
 function downloadScene() {
