@@ -398,6 +398,10 @@ void Api::Impl::install() {
     // Statuses httplib produces itself (404 no route, 413 payload, 400 bad request) get JSON too.
     // A known path asked with a method it does not serve is 405 with Allow, not "no such route".
     s.set_error_handler([this](const Req& req, Res& res) {
+        // Every error answered before its request's body was read to the end (401 in
+        // pre-routing, a multipart body httplib gave up on, …) closes the connection: the rest of
+        // the body must never run as the next request (request smuggling).
+        if (GuardedServer::bodyUnread(req)) GuardedServer::closeAfterAnswer(req);
         if (!res.body.empty()) return;
         if (GuardedServer::bodyOverLimit()) { // a streamed body went past its limit: 413, close
             GuardedServer::closeAfterAnswer(req);

@@ -13,6 +13,9 @@
 //   * every read and write must make progress within Limits::stallSeconds (serve --timeout); a
 //     connection whose answer could not be written for that long (the client stopped reading)
 //     is reset, which frees what the kernel still holds for it;
+//   * an answer sent before its request's body was read to the end (an early refusal: 401 in
+//     pre-routing, 413, a multipart body httplib gave up on, …) closes the connection: what is
+//     left of the body is dropped, never parsed as the next request (request smuggling);
 //   * closeAll() (Api::stop) shuts every connection, so stopping never waits for a slow client.
 #include "http/api_internal.hpp"
 
@@ -22,8 +25,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
+#include <limits>
 #include <thread>
 
 namespace dermis::api_detail {
@@ -81,6 +87,8 @@ public:
         inHead_ = true;
         headDeadline_ = deadline;
         bodyRead_ = 0;
+        declared_ = 0;
+        chunked_ = false;
         overLimit_ = false;
     }
     /// The head is complete: at most `budget` body bytes follow.
@@ -90,6 +98,16 @@ public:
     }
     bool overLimit() const { return overLimit_; }
     std::size_t bodyBudget() const { return bodyBudget_; }
+    /// Body bytes of the current request read so far.
+    std::size_t bodyRead() const { return bodyRead_; }
+    /// The current request's declared body: its Content-Length (0 without one), or chunked.
+    void declareBody(std::size_t length, bool chunked) {
+        declared_ = length;
+        chunked_ = chunked;
+    }
+    /// True when fewer bytes than the declared Content-Length were read.
+    bool shortOfContentLength() const { return !chunked_ && bodyRead_ < declared_; }
+    bool chunked() const { return chunked_; }
     bool closeAfter = false;
     /// True when bytes already received wait in the buffer.
     bool buffered() const { return off_ < len_; }
@@ -169,6 +187,8 @@ private:
     bool inHead_ = true;
     Clock::time_point headDeadline_{};
     std::size_t bodyBudget_ = 0, bodyRead_ = 0;
+    std::size_t declared_ = 0;
+    bool chunked_ = false;
     bool overLimit_ = false;
     bool writeStalled_ = false;
 };
@@ -266,6 +286,30 @@ void GuardedServer::closeAfterAnswer(const Req& req) {
     headers.emplace("Connection", "close");
 }
 
+bool GuardedServer::bodyUnread(const Req& req) {
+    (void)req;
+    return tCurrent && (tCurrent->chunked() || tCurrent->shortOfContentLength());
+}
+
+namespace {
+
+/// The request's declared body: {Content-Length (0 when absent or malformed), chunked}.
+std::pair<std::size_t, bool> declaredBody(const httplib::Request& req) {
+    const std::string te = req.get_header_value("Transfer-Encoding");
+    std::string lower(te);
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (lower.find("chunked") != std::string::npos) return {0, true};
+    const std::string v = req.get_header_value("Content-Length");
+    if (v.empty()) return {0, false};
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long n = std::strtoull(v.c_str(), &end, 10);
+    if (*end != '\0' || errno == ERANGE) return {std::numeric_limits<std::size_t>::max(), false};
+    return {static_cast<std::size_t>(n), false};
+}
+
+} // namespace
+
 bool GuardedServer::admit(Conn& c) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (closing_) return false;
@@ -319,7 +363,11 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
         ret = process_request(strm, closeConnection, closed, [&](httplib::Request& req) {
             conn.idle = false;
             strm.beginBody(bodyLimit ? bodyLimit(req) : payload_max_length_);
+            const auto [length, chunked] = declaredBody(req);
+            strm.declareBody(length, chunked);
         });
+        // An answer that left part of its body unread (whatever sent it): the rest is not a request.
+        if (strm.shortOfContentLength()) strm.closeAfter = true;
         if (!ret || closed || closeConnection || strm.closeAfter) break;
     }
     tCurrent = nullptr;

@@ -211,6 +211,11 @@ public:
     /// On a handler's thread: answer this request with Connection: close, then close (its body,
     /// if any, is not read).
     static void closeAfterAnswer(const Req& req);
+    /// On a handler's thread: true when the current request's body may not have been read to its
+    /// end — fewer bytes than its Content-Length were read, or it is chunked (whose end is not
+    /// tracked here; callers ask only for answers sent early, i.e. errors). Bytes left unread
+    /// must never be parsed as the next request (request smuggling): answer and close.
+    static bool bodyUnread(const Req& req);
 
     struct Conn;
     struct Threads;
