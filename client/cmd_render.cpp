@@ -67,10 +67,9 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             if (frame->count("--yaw")) q.push_back({"yaw", nlohmann::json(o->yaw).dump()});
             if (frame->count("--pitch")) q.push_back({"pitch", nlohmann::json(o->pitch).dump()});
             if (frame->count("--distance")) q.push_back({"distance", nlohmann::json(o->distance).dump()});
-            Reply r = ctx.http().get(scenePath(o->id) + "/frame?" + queryString(q));
-            writeFileAtomically(o->out, r.body);
+            Reply r = ctx.http().download(scenePath(o->id) + "/frame?" + queryString(q), o->out, fileKindOf(format));
             if (!ctx.global.json) std::cout << o->out << "\n";
-            else printJson({{"file", o->out}, {"bytes", r.body.size()}, {"backend", r.header("X-Dermis-Backend")}});
+            else printJson({{"file", o->out}, {"bytes", std::stoull(r.header("X-Dermis-Bytes"))}, {"backend", r.header("X-Dermis-Backend")}});
             return kExitOk;
         };
     });
@@ -87,10 +86,10 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             else if (ext == "exr") format = "exr";
             else if (ext == "f32" && o->map != "normal") format = "f32";
             else throw usageError("the file name must end in .png, .exr" + std::string(o->map == "normal" ? "" : " or .f32"), "--out");
-            Reply r = ctx.http().get(scenePath(o->id) + "/heightmaps/" + o->map + "?format=" + format);
-            writeFileAtomically(o->out, r.body);
+            Reply r = ctx.http().download(scenePath(o->id) + "/heightmaps/" + o->map + "?format=" + format, o->out,
+                                          fileKindOf(format == "png16" ? "png" : format));
             if (!ctx.global.json) std::cout << o->out << "\n";
-            else printJson({{"file", o->out}, {"bytes", r.body.size()}});
+            else printJson({{"file", o->out}, {"bytes", std::stoull(r.header("X-Dermis-Bytes"))}});
             return kExitOk;
         };
     });

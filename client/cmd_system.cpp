@@ -123,7 +123,8 @@ void addSystemCommands(CLI::App& app, Context& ctx) {
                         if (done || (o->count > 0 && seen >= o->count)) return false;
                     }
                     return true;
-                });
+                },
+                false); // an event stream runs until stopped: no --deadline (only --max-time)
             return g_interrupted ? kExitInterrupted : kExitOk;
         };
     });

@@ -45,6 +45,8 @@ struct GlobalOptions {
     std::string server = "http://127.0.0.1:8080"; ///< --server / DERMIS_SERVER
     std::string token;                              ///< --token / DERMIS_TOKEN
     double timeout = 120.0;                         ///< --timeout: seconds per read or connect
+    double deadline = 600.0;                        ///< --deadline: seconds per request, whole
+    double maxTime = 0.0;                           ///< --max-time: seconds for the command (0: none)
     int retries = 2;                                ///< --retries: idempotent requests only
     bool json = false;                              ///< --json: print the server's JSON
     std::string client;                             ///< --client: X-Dermis-Client of edits

@@ -1,12 +1,87 @@
 // cpp-httplib client calls with retries, and answers mapped to CliError.
 #include "http_client.hpp"
 
+#include "frames.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <chrono>
+#include <cmath>
+#include <condition_variable>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <mutex>
 #include <regex>
 #include <thread>
 
 namespace dermis::cli {
+
+/// Stops the client's request in flight (Client::stop shuts its socket) when `seconds` pass
+/// before the watchdog is destroyed; fired() says whether it did.
+class Http::Watchdog {
+public:
+    Watchdog(httplib::Client& client, double seconds) : client_(client) {
+        if (!(seconds > 0) || !std::isfinite(seconds)) return;
+        thread_ = std::thread([this, seconds] {
+            std::unique_lock<std::mutex> lock(mutex_);
+            if (!wake_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return done_; })) {
+                fired_ = true;
+                client_.stop();
+            }
+        });
+    }
+    ~Watchdog() {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            done_ = true;
+        }
+        wake_.notify_all();
+        if (thread_.joinable()) thread_.join();
+    }
+    Watchdog(const Watchdog&) = delete;
+    Watchdog& operator=(const Watchdog&) = delete;
+    bool fired() const { return fired_; }
+
+private:
+    httplib::Client& client_;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    bool done_ = false;
+    std::atomic<bool> fired_{false};
+    std::thread thread_;
+};
+
+namespace {
+
+/// The CliError for a redirect: never followed.
+CliError redirectError(int status, const httplib::Headers& headers, const std::string& what) {
+    auto it = headers.find("Location");
+    const std::string where = it == headers.end() ? std::string("nowhere") : "\"" + it->second.substr(0, 200) + "\"";
+    CliError e(kExitServerSaidNo,
+               "the server answered " + what + " with " + std::to_string(status) + ", a redirect to " + where +
+                   ": not followed (is --server the address of dermis-server's API?)",
+               "--server");
+    e.httpStatus = status;
+    return e;
+}
+
+CliError tooLargeError(const std::string& what) {
+    return CliError(kExitCannotConnect,
+                    "the answer to " + what + " is over " + std::to_string(kMaxAnswerBytes >> 20) +
+                        " MiB: stopped reading it (an answer kept in memory is never that large)",
+                    "--server");
+}
+
+} // namespace
+
+FileKind fileKindOf(const std::string& format) {
+    if (format == "jpeg") return FileKind::Jpeg;
+    if (format == "exr") return FileKind::Exr;
+    if (format == "f32") return FileKind::RawFloats;
+    return FileKind::Png;
+}
 
 std::string Reply::header(const std::string& name) const {
     auto it = headers.find(name);
@@ -54,7 +129,27 @@ Http::Http(const GlobalOptions& options) : options_(options) {
     if (!options.token.empty()) client_->set_bearer_token_auth(options.token);
 }
 
-void Http::throwTransport(httplib::Error error) const {
+double Http::requestSeconds(bool deadline) const {
+    double seconds = deadline ? options_.deadline : 0.0;
+    if (options_.maxTime > 0) {
+        const double left = options_.maxTime - std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+        if (left <= 0)
+            throw CliError(kExitCannotConnect, "the command ran past --max-time " + nlohmann::json(options_.maxTime).dump() + " s", "--max-time");
+        seconds = seconds > 0 ? std::min(seconds, left) : left;
+    }
+    return seconds;
+}
+
+void Http::throwTransport(httplib::Error error, bool deadlinePassed) const {
+    if (deadlinePassed) {
+        const bool command = options_.maxTime > 0 &&
+                             std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count() >= options_.maxTime;
+        throw CliError(kExitCannotConnect,
+                       command ? "the command ran past --max-time " + nlohmann::json(options_.maxTime).dump() + " s"
+                               : "no complete answer from " + options_.server + " within --deadline " +
+                                     nlohmann::json(options_.deadline).dump() + " s",
+                       command ? "--max-time" : "--deadline");
+    }
     std::string why;
     switch (error) {
     case httplib::Error::Connection: why = "connection refused or host unreachable"; break;
@@ -73,16 +168,34 @@ Reply Http::perform(const httplib::Request& req, bool retry) {
         httplib::Request r = req;
         httplib::Response res;
         httplib::Error error = httplib::Error::Success;
-        const bool ok = client_->send(r, res, error);
-        const bool last = k + 1 >= attempts || g_interrupted;
+        // The answer is kept in memory: at most kMaxAnswerBytes of it.
+        std::string body;
+        bool tooLarge = false;
+        r.content_receiver = [&](const char* data, std::size_t n, std::uint64_t, std::uint64_t) {
+            if (body.size() + n > kMaxAnswerBytes) {
+                tooLarge = true;
+                return false;
+            }
+            body.append(data, n);
+            return true;
+        };
+        bool ok, late;
+        {
+            Watchdog watchdog(*client_, requestSeconds(true));
+            ok = client_->send(r, res, error);
+            late = watchdog.fired();
+        }
+        if (tooLarge) throw tooLargeError(req.method + " " + req.path);
+        const bool last = k + 1 >= attempts || g_interrupted || late;
         double wait = 0.25 * double(1 << std::min(k, 5));
-        if (!ok) {
-            if (last) throwTransport(error);
+        if (!ok || late) {
+            if (last) throwTransport(error, late);
         } else if (res.status == 503 && !last) {
             if (res.has_header("Retry-After")) wait = std::min(5.0, std::atof(res.get_header_value("Retry-After").c_str()));
         } else {
-            if (res.status >= 400) throw serverError(res.status, res.body);
-            return Reply{res.status, std::move(res.body), std::move(res.headers)};
+            if (res.status >= 400) throw serverError(res.status, body);
+            if (res.status >= 300) throw redirectError(res.status, res.headers, req.method + " " + req.path);
+            return Reply{res.status, std::move(body), std::move(res.headers)};
         }
         std::this_thread::sleep_for(std::chrono::duration<double>(wait));
     }
@@ -141,18 +254,23 @@ Reply Http::postMultipart(const std::string& path, const httplib::MultipartFormD
 bool Http::stream(const std::string& method, const std::string& path, const std::string& body,
                   const std::string& contentType,
                   const std::function<bool(int, const httplib::Headers&)>& onHeaders,
-                  const std::function<bool(const char*, std::size_t)>& onData) {
+                  const std::function<bool(const char*, std::size_t)>& onData, bool deadline) {
     httplib::Request req;
     req.method = method;
     req.path = url(path);
     if (!contentType.empty()) req.headers.emplace("Content-Type", contentType);
     req.body = body;
-    bool stopped = false;
+    bool stopped = false, tooLarge = false;
     int status = 0;
     std::string errorBody;
+    httplib::Headers redirectHeaders;
     req.response_handler = [&](const httplib::Response& res) {
         status = res.status;
-        if (status >= 400) return true; // read the error body whole
+        if (status >= 300 && status < 400) { // never followed, nor its body read
+            redirectHeaders = res.headers;
+            return false;
+        }
+        if (status >= 400) return true; // read the error body (up to kMaxAnswerBytes)
         if (!onHeaders(status, res.headers)) {
             stopped = true;
             return false;
@@ -161,6 +279,10 @@ bool Http::stream(const std::string& method, const std::string& path, const std:
     };
     req.content_receiver = [&](const char* data, std::size_t n, std::uint64_t, std::uint64_t) {
         if (status >= 400) {
+            if (errorBody.size() + n > kMaxAnswerBytes) {
+                tooLarge = true;
+                return false;
+            }
             errorBody.append(data, n);
             return true;
         }
@@ -172,11 +294,90 @@ bool Http::stream(const std::string& method, const std::string& path, const std:
     };
     httplib::Response res;
     httplib::Error error = httplib::Error::Success;
-    const bool ok = client_->send(req, res, error);
+    bool ok, late;
+    {
+        Watchdog watchdog(*client_, requestSeconds(deadline));
+        ok = client_->send(req, res, error);
+        late = watchdog.fired();
+    }
+    if (late) throwTransport(error, true);
+    if (status >= 300 && status < 400) throw redirectError(status, redirectHeaders, method + " " + path);
     if (stopped) return false;
+    if (tooLarge) throw tooLargeError(method + " " + path);
     if (status >= 400) throw serverError(status, errorBody);
     if (!ok) throwTransport(error);
     return true;
+}
+
+Reply Http::download(const std::string& path, const std::string& out, FileKind kind) {
+    namespace fs = std::filesystem;
+    static const char* const kTypes[] = {"image/png", "image/jpeg", "image/x-exr", "application/octet-stream"};
+    const std::string wanted = kTypes[static_cast<int>(kind)];
+    std::error_code ec;
+    const fs::path parent = fs::path(out).parent_path();
+    if (!parent.empty()) fs::create_directories(parent, ec);
+    const std::string tmp = partialPathOf(out);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) throw usageError("cannot write " + tmp, out);
+    // Whatever goes wrong, no file (and no part file) is left behind.
+    struct Cleanup {
+        int fd;
+        std::string tmp;
+        bool keep = false;
+        ~Cleanup() {
+            if (fd >= 0) ::close(fd);
+            if (!keep) ::unlink(tmp.c_str());
+        }
+    } cleanup{fd, tmp};
+    Reply reply;
+    std::string head, why;
+    std::size_t bytes = 0;
+    bool writeFailed = false;
+    const bool whole = stream(
+        "GET", path, "", "",
+        [&](int status, const httplib::Headers& headers) {
+            reply.status = status;
+            reply.headers = headers;
+            auto it = headers.find("Content-Type");
+            const std::string type = it == headers.end() ? "" : it->second.substr(0, it->second.find(';'));
+            if (status != 200) why = "the server answered " + std::to_string(status) + " without the file";
+            else if (type != wanted)
+                why = "the server answered " + (type.empty() ? std::string("no Content-Type") : "\"" + type.substr(0, 80) + "\"") +
+                      " where " + wanted + " was asked for";
+            return why.empty();
+        },
+        [&](const char* data, std::size_t n) {
+            if (head.size() < 8) head.append(data, std::min(n, 8 - head.size()));
+            for (std::size_t done = 0; done < n;) {
+                const ssize_t w = ::write(fd, data + done, n - done);
+                if (w < 0 && errno == EINTR) continue;
+                if (w <= 0) {
+                    writeFailed = true;
+                    return false;
+                }
+                done += static_cast<std::size_t>(w);
+            }
+            bytes += n;
+            return true;
+        });
+    if (writeFailed) throw usageError("cannot write " + tmp, out);
+    if (!whole) throw CliError(kExitServerSaidNo, why.empty() ? "the answer to GET " + path + " was cut short" : why, "--server");
+    static const std::string kPng("\x89PNG\r\n\x1a\n", 8), kJpeg("\xff\xd8\xff", 3), kExr("\x76\x2f\x31\x01", 4);
+    const std::string* sig = kind == FileKind::Png ? &kPng : kind == FileKind::Jpeg ? &kJpeg : kind == FileKind::Exr ? &kExr : nullptr;
+    const bool valid = sig ? head.compare(0, sig->size(), *sig) == 0 && bytes > sig->size() : bytes > 0 && bytes % 4 == 0;
+    if (!valid)
+        throw CliError(kExitServerSaidNo,
+                       "the server's " + std::to_string(bytes) + "-byte answer is not a " +
+                           (kind == FileKind::RawFloats ? std::string("whole number of floats") : wanted + " file") +
+                           ": nothing written",
+                       "--server");
+    if (::close(fd) != 0) throw usageError("cannot write " + tmp, out);
+    cleanup.fd = -1;
+    if (::rename(tmp.c_str(), out.c_str()) != 0) throw usageError("cannot write " + out, out);
+    cleanup.keep = true;
+    reply.body.clear();
+    reply.headers.emplace("X-Dermis-Bytes", std::to_string(bytes));
+    return reply;
 }
 
 } // namespace dermis::cli

@@ -7,6 +7,11 @@
 //     ({"error": {"code", "message", "field"}}), or "HTTP <status>" when the body is not that.
 // Retried (--retries times, backoff 0.25 s · 2^k, or the server's Retry-After up to 5 s): GET,
 // PUT, DELETE and content-addressed uploads (`retry` true), on no connection or 503 only.
+// Bounded (issue #27): every request must be answered whole within --deadline (a watchdog stops
+// it, exit 3: `--timeout` alone is per read, and a byte a second never ends), and the command
+// within --max-time when set; answers kept in memory (JSON) stop at kMaxAnswerBytes (exit 3);
+// frames and maps stream to their file (download). A redirect (3xx) is never followed: exit 1,
+// naming where it pointed.
 // Not thread-safe: one Http per thread.
 #pragma once
 
@@ -15,6 +20,7 @@
 #include <httplib.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
@@ -29,6 +35,15 @@ struct Reply {
     httplib::Headers headers;
     std::string header(const std::string& name) const;
 };
+
+/// The most bytes of an answer kept in memory (JSON answers, error bodies): 64 MiB.
+inline constexpr std::size_t kMaxAnswerBytes = std::size_t(64) << 20;
+
+/// What a download may be: content types accepted and the file's signature check.
+enum class FileKind { Png, Jpeg, Exr, RawFloats };
+
+/// The kind of a frame or map file by its format name (png, png16, jpeg, exr, f32).
+FileKind fileKindOf(const std::string& format);
 
 /// "a=1&b=x%20y" from (name, value) pairs, values percent-encoded; "" for none.
 std::string queryString(const std::vector<std::pair<std::string, std::string>>& params);
@@ -52,22 +67,37 @@ public:
 
     /// A streamed request: `onHeaders` sees the status and headers first (return false to stop);
     /// then `onData` each piece of the body as it arrives (return false to stop). An error status
-    /// is read whole and thrown (exit 1) without calling onData. Not retried. Returns false when
-    /// a callback stopped it; throws exit 3 when the connection failed or broke.
+    /// is read (up to kMaxAnswerBytes) and thrown (exit 1), a redirect too, without calling
+    /// onData. Not retried. Returns false when a callback stopped it; throws exit 3 when the
+    /// connection failed or broke, or --deadline passed (`deadline` false: an event stream, which
+    /// --max-time alone bounds).
     bool stream(const std::string& method, const std::string& path, const std::string& body,
                 const std::string& contentType,
                 const std::function<bool(int status, const httplib::Headers&)>& onHeaders,
-                const std::function<bool(const char*, std::size_t)>& onData);
+                const std::function<bool(const char*, std::size_t)>& onData, bool deadline = true);
+
+    /// GETs `path` into file `out`, streamed (never whole in memory), through "<out>.dermis-part"
+    /// renamed into place only when the answer is a 200 of `kind`'s content type whose bytes
+    /// start with its signature (PNG, JPEG, OpenEXR; raw floats: a whole number of floats) and
+    /// arrived whole. Anything else leaves no file: a redirect or an error answer → exit 1, a
+    /// wrong content type or signature → exit 1 naming what came, a broken connection or
+    /// --deadline → exit 3. Not retried. Returns the answer's status, headers and byte count.
+    Reply download(const std::string& path, const std::string& out, FileKind kind);
 
     /// The full path for a route: prefix + "/api/v1" + `path`.
     std::string url(const std::string& path) const { return prefix_ + path; }
     const std::string& server() const { return server_; }
 
+    class Watchdog;
+
 private:
     Reply perform(const httplib::Request& req, bool retry);
-    [[noreturn]] void throwTransport(httplib::Error error) const;
+    [[noreturn]] void throwTransport(httplib::Error error, bool deadlinePassed = false) const;
+    /// Seconds the next request may take: --deadline, less when --max-time ends sooner.
+    double requestSeconds(bool deadline) const;
 
     GlobalOptions options_;
+    std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
     std::string server_, prefix_;
     std::unique_ptr<httplib::Client> client_;
 };

@@ -1,5 +1,5 @@
 // dermis — the command-line client of dermis-server (issue #14; usage in client/README.md).
-//   dermis [--server URL] [--token T] [--timeout S] [--retries N] [--json] <command> …
+//   dermis [--server URL] [--token T] [--timeout S] [--deadline S] [--max-time S] [--retries N] [--json] <command> …
 // Exit codes: 0 ok, 1 the server said no, 2 usage, 3 cannot connect, 4 some frames failed (render)
 // or some cases differ (check), 130 interrupted (Ctrl-C: finished files stay, no partial file).
 #include "commands.hpp"
@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
     app.add_option("--token", ctx.global.token, "Bearer token (env DERMIS_TOKEN)");
     app.add_option("--timeout", ctx.global.timeout, "Seconds to wait for a connection or a read (default 120)")
         ->check(CLI::PositiveNumber);
+    app.add_option("--deadline", ctx.global.deadline, "Seconds one request may take in all, answer included (default 600; event streams: none)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--max-time", ctx.global.maxTime, "Seconds the whole command may take (default: no limit)")
+        ->check(CLI::NonNegativeNumber);
     app.add_option("--retries", ctx.global.retries, "Retries of idempotent requests on no connection or 503 (default 2)")
         ->check(CLI::Range(0, 100));
     app.add_flag("--json", ctx.global.json, "Print the server's JSON instead of tables");
