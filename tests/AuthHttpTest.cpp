@@ -43,7 +43,11 @@ TEST_F(AuthHttpNoTokenTest, SessionWithoutAServerTokenSetsNoCookie) {
 class AuthHttpTest : public ::testing::Test {
   protected:
     static constexpr const char* kToken = "s3cret-t0ken";
-    static void SetUpTestSuite() { server_ = LiveServer::start(mainLimits(), kToken, error_); }
+    static void SetUpTestSuite() {
+        ApiOptions opt;
+        opt.authFreeFailures = 1 << 30; // these tests make hundreds of wrong attempts on purpose
+        server_ = LiveServer::start(mainLimits(), kToken, error_, opt);
+    }
     static void TearDownTestSuite() { server_.reset(); }
     void SetUp() override {
         ASSERT_TRUE(server_ && error_.empty()) << "the server did not start: " << error_;
@@ -267,6 +271,66 @@ TEST_F(AuthHttpSessionLimitTest, TheOldestSessionIsEvictedAndSessionsExpire) {
     std::this_thread::sleep_for(std::chrono::milliseconds(3500));
     for (const std::string& id : ids)
         expectError(anon.call("GET", "/scenes", "", "", cookieHeader(id)), 401); // expired
+}
+
+// ================================================================================================
+// Failed sign-ins are throttled per address (issue #27, item 6; a fourth server, defaults)
+// ================================================================================================
+
+class AuthHttpThrottleTest : public ::testing::Test {
+  protected:
+    static constexpr const char* kToken = "throttle-t0ken-0123456789";
+    static void SetUpTestSuite() { server_ = LiveServer::start(mainLimits(), kToken, error_); }
+    static void TearDownTestSuite() { server_.reset(); }
+    void SetUp() override {
+        ASSERT_TRUE(server_ && error_.empty()) << "the server did not start: " << error_;
+    }
+    static inline std::unique_ptr<LiveServer> server_;
+    static inline std::string error_;
+};
+
+TEST_F(AuthHttpThrottleTest, AfterTenFailuresAnAddressWaitsAndItsGuessesAreNotChecked) {
+    Http anon(server_->port());
+    const httplib::Headers wrongBearer = {{"Authorization", "Bearer wrong"}};
+    // Ten failures cost nothing; the eleventh is still checked (and starts the wait).
+    for (int i = 0; i < 11; ++i) {
+        Reply r = i % 2 ? anon.post("/session", {{"token", "guess" + std::to_string(i)}})
+                        : anon.call("GET", "/scenes", "", "", wrongBearer);
+        expectError(r, 401);
+    }
+    // Inside the wait every credentialed attempt is 429 with Retry-After — the right token too,
+    // so a right guess inside the wait tells nothing.
+    Reply guess = anon.post("/session", {{"token", "guess-12"}});
+    expectError(guess, 429, "/token");
+    EXPECT_EQ(guess.header("Retry-After"), "1");
+    expectError(anon.post("/session", {{"token", kToken}}), 429);
+    expectError(anon.call("GET", "/scenes", "", "", {{"Authorization", std::string("Bearer ") + kToken}}), 429);
+    // A request without credentials is not a guess: 401 as always.
+    expectError(anon.get("/scenes"), 401);
+    // Guessing as fast as possible for 2 s: how many guesses are checked?
+    const auto t0 = std::chrono::steady_clock::now();
+    int checked = 0, refused = 0;
+    while (std::chrono::steady_clock::now() - t0 < std::chrono::seconds(2)) {
+        const int status = anon.post("/session", {{"token", "guess"}}).status;
+        checked += status == 401;
+        refused += status == 429;
+    }
+    EXPECT_LE(checked, 3) << "at most one guess per wait (1 s, then 2 s)";
+    EXPECT_GT(refused, 20);
+    std::cout << "[ figures ] 2 s of guessing after 11 failures: " << checked << " checked, " << refused
+              << " answered 429\n";
+    // After the wait, the right token signs in and the address starts afresh.
+    int wait = 1;
+    for (int i = 0; i < 70; ++i) {
+        Reply r = anon.post("/session", {{"token", kToken}});
+        if (r.status == 204) break;
+        ASSERT_EQ(r.status, 429) << r;
+        wait = std::atoi(r.header("Retry-After").c_str());
+        ASSERT_GE(wait, 1);
+        ASSERT_LE(wait, 60);
+        std::this_thread::sleep_for(std::chrono::milliseconds(wait * 1000 + 50));
+    }
+    expectError(anon.post("/session", {{"token", "wrong-again"}}), 401);
 }
 
 } // namespace

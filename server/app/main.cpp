@@ -134,6 +134,10 @@ int runServe(ServeArgs a) {
     using namespace dermis;
     if (a.token.empty())
         if (const char* env = std::getenv("DERMIS_TOKEN")) a.token = env;
+    // A short token is guessed quickly even at the throttled rate (README "Reliability").
+    if (!a.token.empty() && a.token.size() < 16)
+        std::cerr << "dermis-server: warning: the token is " << a.token.size()
+                  << " characters; use at least 16 random ones (e.g. `openssl rand -hex 16`)\n";
     a.limits.maxUploadBytes = static_cast<std::size_t>(a.maxUploadMb * 1024.0 * 1024.0);
     a.limits.contentCacheBytes = static_cast<std::size_t>(a.contentCacheMb * 1024.0 * 1024.0);
     // SIGINT/SIGTERM are taken by a waiting thread (blocked here, before any thread starts).

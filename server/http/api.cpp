@@ -55,6 +55,13 @@ void sendError(Res& res, int status, const std::string& code, const std::string&
     sendJson(res, status, {{"error", {{"code", code}, {"message", message}, {"field", field}}}});
 }
 
+void tooManyFailures(Res& res, int wait, const std::string& field) {
+    res.set_header("Retry-After", std::to_string(wait));
+    sendError(res, 429, "too_many_requests",
+              "dermis-server: too many failed sign-ins from this address: try again in " + std::to_string(wait) + " s",
+              field);
+}
+
 void sendError(Res& res, const Error& e) {
     if (e.currentRevision) { // 412: the body also says which revision is current
         sendJson(res, statusOf(e.code),
@@ -386,8 +393,19 @@ void Api::Impl::install() {
         }
         if (opt.token.empty() || req.path.rfind(kPrefix, 0) != 0)
             return httplib::Server::HandlerResponse::Unhandled;
-        if (isOpen(req.method, req.path.substr(kPrefix.size())) || authorized(req))
+        if (isOpen(req.method, req.path.substr(kPrefix.size())))
             return httplib::Server::HandlerResponse::Unhandled;
+        // Credentials are guesses until proven: an address that failed too often waits first,
+        // and inside its wait they are not even looked at (AuthThrottle).
+        const bool credentialed = req.has_header("Authorization") || !cookieValues(req, kSessionCookie).empty();
+        if (credentialed) {
+            if (const int wait = authThrottle.waitSeconds(req.remote_addr); wait > 0) {
+                tooManyFailures(res, wait, "Authorization");
+                return httplib::Server::HandlerResponse::Handled;
+            }
+        }
+        if (authorized(req)) return httplib::Server::HandlerResponse::Unhandled;
+        if (credentialed) authThrottle.failed(req.remote_addr);
         res.set_header("WWW-Authenticate", "Bearer");
         sendError(res, 401, "unauthorized",
                   "dermis-server: a valid bearer token (or a session cookie from POST " + kPrefix +

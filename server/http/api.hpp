@@ -39,6 +39,9 @@ struct ApiOptions {
     std::size_t maxJsonBytes = 8u << 20;
     int maxSessions = 256; ///< browser sessions kept at once; the oldest is forgotten beyond
     int sessionMaxAgeSeconds = 12 * 3600; ///< a session's lifetime (and its cookie's Max-Age)
+    /// Failed sign-ins (a wrong bearer token or session cookie, a wrong token on POST /session)
+    /// an address may make before it must wait between attempts (README "Reliability").
+    int authFreeFailures = 10;
 };
 
 /// A route of the API: method and OpenAPI path template ("/scenes/{id}"); `open` routes need no

@@ -29,6 +29,7 @@
 #include <deque>
 #include <functional>
 #include <initializer_list>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <regex>
@@ -172,6 +173,36 @@ private:
     std::deque<Entry> entries_; ///< oldest first
 };
 
+/// Per-address back-off after failed sign-ins (issue #27: 11,500 guesses a second were checked):
+/// an address's first `freeFailures` failures cost nothing; then it must wait 2^(n − free) s (at
+/// most 60 s) after its n-th failure, and every credentialed attempt inside the wait is answered
+/// 429 with Retry-After without its credentials being looked at (so a right guess inside the wait
+/// tells nothing). A success forgets the address; so do 10 minutes without a failure. At most
+/// 4096 addresses are tracked (the stalest forgotten first). Thread-safe (one mutex).
+class AuthThrottle {
+public:
+    explicit AuthThrottle(int freeFailures) : free_(std::max(0, freeFailures)) {}
+    /// Whole seconds `ip` must still wait before its credentials are checked (0: check them now).
+    int waitSeconds(const std::string& ip);
+    /// A failed attempt of `ip`.
+    void failed(const std::string& ip);
+    /// A successful attempt of `ip`: its failures are forgotten.
+    void succeeded(const std::string& ip);
+
+private:
+    struct Entry {
+        int failures = 0;
+        std::chrono::steady_clock::time_point last, until;
+    };
+    const int free_;
+    std::mutex mutex_;
+    std::map<std::string, Entry> byAddress_;
+};
+
+/// Answers 429 `too_many_requests` with Retry-After: `wait` seconds before this address's
+/// credentials are looked at again (AuthThrottle).
+void tooManyFailures(Res& res, int wait, const std::string& field);
+
 /// The values of cookie `name` in the request's Cookie headers (all of them: a browser may send
 /// more than one), at most 16.
 std::vector<std::string> cookieValues(const Req& req, const std::string& name);
@@ -245,6 +276,7 @@ struct Api::Impl {
     /// tabs, or one client, would leave no thread to answer anything else: a hang).
     std::atomic<int> streams{0};
     api_detail::SessionStore sessions;
+    api_detail::AuthThrottle authThrottle{opt.authFreeFailures};
 
     Impl(Service& s, ApiOptions o);
     int maxStreams() const { return std::max(1, opt.threads / 2); }

@@ -127,6 +127,42 @@ std::vector<std::string> cookieValues(const Req& req, const std::string& name) {
     return out;
 }
 
+// --- failed sign-ins --------------------------------------------------------------------------------
+
+int AuthThrottle::waitSeconds(const std::string& ip) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = byAddress_.find(ip);
+    if (it == byAddress_.end()) return 0;
+    const auto now = std::chrono::steady_clock::now();
+    if (it->second.until <= now) return 0;
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(it->second.until - now).count();
+    return static_cast<int>((ms + 999) / 1000);
+}
+
+void AuthThrottle::failed(const std::string& ip) {
+    using namespace std::chrono;
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto now = steady_clock::now();
+    // Forget addresses quiet for 10 minutes; past 4096, the stalest.
+    for (auto it = byAddress_.begin(); it != byAddress_.end();)
+        it = now - it->second.last > minutes(10) && it->first != ip ? byAddress_.erase(it) : std::next(it);
+    while (byAddress_.size() >= 4096 && !byAddress_.count(ip)) {
+        auto stalest = std::min_element(byAddress_.begin(), byAddress_.end(),
+                                        [](const auto& a, const auto& b) { return a.second.last < b.second.last; });
+        byAddress_.erase(stalest);
+    }
+    Entry& e = byAddress_[ip];
+    if (now - e.last > minutes(10)) e.failures = 0;
+    ++e.failures;
+    e.last = now;
+    if (e.failures > free_) e.until = now + seconds(std::min(60, 1 << std::min(6, e.failures - free_ - 1)));
+}
+
+void AuthThrottle::succeeded(const std::string& ip) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    byAddress_.erase(ip);
+}
+
 // --- routes --------------------------------------------------------------------------------------
 
 void installSessionRoutes(RouteTable& t) {
@@ -145,11 +181,15 @@ void installSessionRoutes(RouteTable& t) {
             res.status = 204;
             return;
         }
+        if (const int wait = a.authThrottle.waitSeconds(req.remote_addr); wait > 0)
+            return tooManyFailures(res, wait, "/token");
         if (!constantTimeEquals(token->get<std::string>(), a.opt.token)) {
+            a.authThrottle.failed(req.remote_addr);
             res.set_header("WWW-Authenticate", "Bearer");
             return sendError(res, 401, "unauthorized", "dermis-server: /token: wrong token",
                              "/token");
         }
+        a.authThrottle.succeeded(req.remote_addr);
         auto id = a.sessions.create();
         if (!id) return sendError(res, id.error());
         res.set_header("Set-Cookie", sessionCookie(*id, std::max(1, a.opt.sessionMaxAgeSeconds)));
