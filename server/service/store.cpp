@@ -65,7 +65,7 @@ bool Store::isGeneratedId(const std::string& id, char prefix) {
     return true;
 }
 
-Status Store::putBlob(const std::string& kind, const std::string& id, const std::string& ext,
+Status Store::putBlobImpl(const std::string& kind, const std::string& id, const std::string& ext,
                       const std::vector<std::uint8_t>& bytes, nlohmann::json meta) {
     const fs::path folder = fs::path(dir_) / kind;
     const std::string file = (folder / (id + "." + ext)).string();
@@ -85,7 +85,7 @@ bool Store::isSafeFileName(const std::string& name) {
     return true;
 }
 
-Status Store::putBlobFolder(const std::string& kind, const std::string& id,
+Status Store::putBlobFolderImpl(const std::string& kind, const std::string& id,
                             const std::map<std::string, std::vector<std::uint8_t>>& files,
                             const std::string& mainFile, nlohmann::json meta) {
     const char* where = "dermis::Store::putBlobFolder";
@@ -150,7 +150,7 @@ std::vector<Store::Blob> Store::listBlobs(const std::string& kind,
     return out;
 }
 
-Status Store::removeBlob(const std::string& kind, const std::string& id) {
+Status Store::removeBlobImpl(const std::string& kind, const std::string& id) {
     std::vector<std::string> skipped;
     const fs::path folder = fs::path(dir_) / kind;
     std::error_code ec;
@@ -184,5 +184,18 @@ std::vector<Store::SceneRecord> Store::listScenes(std::vector<std::string>& skip
               [](const SceneRecord& a, const SceneRecord& b) { return a.id < b.id; });
     return out;
 }
+
+// --- the public entry points: the data folder is "<data>" in every message ---------------------------
+
+Status Store::putBlob(const std::string& kind, const std::string& id, const std::string& ext,
+                      const std::vector<std::uint8_t>& bytes, nlohmann::json meta) {
+    return hidden(putBlobImpl(kind, id, ext, bytes, std::move(meta)));
+}
+Status Store::putBlobFolder(const std::string& kind, const std::string& id,
+                            const std::map<std::string, std::vector<std::uint8_t>>& files,
+                            const std::string& mainFile, nlohmann::json meta) {
+    return hidden(putBlobFolderImpl(kind, id, files, mainFile, std::move(meta)));
+}
+Status Store::removeBlob(const std::string& kind, const std::string& id) { return hidden(removeBlobImpl(kind, id)); }
 
 } // namespace dermis

@@ -98,6 +98,30 @@ public:
     std::vector<SceneRecord> listScenes(std::vector<std::string>& skipped) const;
 
 private:
+    // The work behind the public methods of the same name; those return what these do with the
+    // data folder written "<data>" in every message and field (an answer never names a server
+    // path, e.g. an io_error when the disk is full).
+    Status putBlobImpl(const std::string& kind, const std::string& id, const std::string& ext,
+                       const std::vector<std::uint8_t>& bytes, nlohmann::json meta);
+    Status putBlobFolderImpl(const std::string& kind, const std::string& id,
+                             const std::map<std::string, std::vector<std::uint8_t>>& files,
+                             const std::string& mainFile, nlohmann::json meta);
+    Status removeBlobImpl(const std::string& kind, const std::string& id);
+    Status putSceneImpl(const std::string& id, const RevisionInfo& info, const nlohmann::json& doc);
+    Status removeSceneImpl(const std::string& id);
+    Result<nlohmann::json> readRevisionImpl(const std::string& id, std::uint64_t revision) const;
+    Result<std::vector<RevisionInfo>> loadHistoryImpl(const std::string& id, std::uint64_t current,
+                                                      const nlohmann::json& currentDoc);
+    /// `r` with the data folder written "<data>" in its error's message and field.
+    template <class R> R hidden(R r) const {
+        if (r) return r;
+        Error e = r.error();
+        for (std::string* text : {&e.message, &e.field})
+            for (std::size_t at = text->find(dir_); !dir_.empty() && at != std::string::npos; at = text->find(dir_, at + 6))
+                text->replace(at, dir_.size(), "<data>");
+        return R(std::move(e));
+    }
+
     std::string dir_;
 };
 

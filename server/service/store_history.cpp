@@ -89,7 +89,7 @@ Status putRevision(const fs::path& hist, const Store::RevisionInfo& info,
 
 } // namespace
 
-Status Store::putScene(const std::string& id, const RevisionInfo& info, const nlohmann::json& doc) {
+Status Store::putSceneImpl(const std::string& id, const RevisionInfo& info, const nlohmann::json& doc) {
     if (auto s = putRevision(historyDir(dir_, id), info, doc); !s) return s;
     const nlohmann::json record = {{"id", id}, {"revision", info.revision}, {"scene", doc}};
     return writeFileAtomically((fs::path(dir_) / "scenes" / (id + ".json")).string(),
@@ -100,7 +100,7 @@ Status Store::putScene(const std::string& id, std::uint64_t revision, const nloh
     return putScene(id, RevisionInfo{revision, now(), "", ""}, doc);
 }
 
-Status Store::removeScene(const std::string& id) {
+Status Store::removeSceneImpl(const std::string& id) {
     const fs::path folder = fs::path(dir_) / "scenes";
     std::error_code ec;
     fs::remove(folder / (id + ".json"), ec);
@@ -112,7 +112,7 @@ Status Store::removeScene(const std::string& id) {
     return Ok{};
 }
 
-Result<nlohmann::json> Store::readRevision(const std::string& id, std::uint64_t revision) const {
+Result<nlohmann::json> Store::readRevisionImpl(const std::string& id, std::uint64_t revision) const {
     const char* where = "dermis::Store::readRevision";
     const fs::path file = historyDir(dir_, id) / revisionFile(revision);
     auto bytes = readWholeFile(file.string(), std::size_t(1) << 30, where);
@@ -129,7 +129,7 @@ Result<nlohmann::json> Store::readRevision(const std::string& id, std::uint64_t 
     return std::move(record["scene"]);
 }
 
-Result<std::vector<Store::RevisionInfo>> Store::loadHistory(const std::string& id,
+Result<std::vector<Store::RevisionInfo>> Store::loadHistoryImpl(const std::string& id,
                                                             std::uint64_t current,
                                                             const nlohmann::json& currentDoc) {
     const fs::path hist = historyDir(dir_, id);
@@ -161,6 +161,20 @@ Result<std::vector<Store::RevisionInfo>> Store::loadHistory(const std::string& i
     for (auto& [revision, info] : byRevision)
         out.push_back(std::move(info));
     return out;
+}
+
+// --- the public entry points: the data folder is "<data>" in every message ---------------------------
+
+Status Store::putScene(const std::string& id, const RevisionInfo& info, const nlohmann::json& doc) {
+    return hidden(putSceneImpl(id, info, doc));
+}
+Status Store::removeScene(const std::string& id) { return hidden(removeSceneImpl(id)); }
+Result<nlohmann::json> Store::readRevision(const std::string& id, std::uint64_t revision) const {
+    return hidden(readRevisionImpl(id, revision));
+}
+Result<std::vector<Store::RevisionInfo>> Store::loadHistory(const std::string& id, std::uint64_t current,
+                                                            const nlohmann::json& currentDoc) {
+    return hidden(loadHistoryImpl(id, current, currentDoc));
 }
 
 } // namespace dermis
