@@ -236,7 +236,12 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
                    "idle one is closed, or the new one answered 503 when none is idle")
         ->check(CLI::Range(1, 65536));
     app.add_option("--max-connections", s.api.maxConnections,
-                   "Connections open at once in all (one thread each); past it: 503, closed")
+                   "Connections open at once in all (one thread each); past it the oldest connection "
+                   "that never finished a request head is closed for the new one, else 503, closed")
+        ->check(CLI::Range(1, 65536));
+    app.add_option("--max-streams-per-address", s.api.maxStreamsPerAddress,
+                   "Event streams one peer address may hold (default: half of the server's 16); "
+                   "raise it behind a reverse proxy, where every stream comes from its address")
         ->check(CLI::Range(1, 65536));
 }
 

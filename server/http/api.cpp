@@ -132,7 +132,7 @@ bool editContext(const Req& req, Res& res, EditContext& out) {
                 ok = std::isdigit(static_cast<unsigned char>(v[k])) && revision < 100000000000000000ull;
                 revision = revision * 10 + static_cast<std::uint64_t>(v[k] - '0');
             }
-            if (!ok || revision == 0) {
+            if (!ok) { // "r0" is well-formed: no scene is at revision 0, so it is a 412, not a 400
                 sendError(res, 400, "parse_error",
                           "dermis::Api: If-Match: expected one strong ETag \"r<revision>\" as "
                           "the scene's ETag header gives it (or *), got " +

@@ -29,6 +29,9 @@ struct ApiOptions {
     std::string token;     ///< every route but the open ones needs it (or a session); empty = none
     std::string webDir;    ///< static files served at / (the editor); empty = none
     int threads = 32;      ///< event streams open at once: threads / 2 (each holds a thread)
+    /// Event streams one peer address may hold at once; 0: half the streams (so one client can
+    /// never take them all). Behind a proxy every stream comes from its address: raise it there.
+    int maxStreamsPerAddress = 0;
     /// Connections (README "Reliability"): one thread each, at most maxConnections at once and
     /// maxConnectionsPerAddress per peer address; a request head must arrive within headSeconds.
     int maxConnections = 1024;

@@ -1,7 +1,8 @@
 // Dermis HTTP shell — connections (issue #12): GuardedServer replaces httplib's fixed thread pool
 // and its per-connection loop. httplib still parses and routes each request
 // (Server::process_request); what a connection may cost is decided here:
-//   * one thread per connection (Threads), at most Limits::maxConnections; past it: 503, closed;
+//   * one thread per connection (Threads), at most Limits::maxConnections; past it the oldest
+//     connection that never sent a whole request head is shut to make room, else 503, closed;
 //   * per peer address at most Limits::maxPerAddress connections: a new one past the cap evicts
 //     that address's oldest connection that is idle or still sending its head; when none is,
 //     the new one is answered 503 and closed;
@@ -215,7 +216,8 @@ void refuse(int sock) {
 struct GuardedServer::Conn {
     int sock;
     std::string ip;
-    std::atomic<bool> idle{true}; ///< waiting for a request or reading its head: evictable
+    std::atomic<bool> idle{true};      ///< waiting for a request or reading its head: evictable
+    std::atomic<bool> headDone{false}; ///< one request head arrived whole on this connection
 };
 
 /// One thread per connection, at most maxConnections at once; past it the task runs inline on
@@ -225,7 +227,12 @@ struct GuardedServer::Threads final : httplib::TaskQueue {
     void enqueue(std::function<void()> fn) override {
         {
             std::lock_guard<std::mutex> lock(server.mutex_);
-            if (server.threads_ < server.limits.maxConnections && !server.closing_) {
+            // Full: the oldest connection that never sent a whole request head makes room (a
+            // handful of addresses trickling heads cannot keep every slot; nginx sheds the same
+            // way). Its thread ends at once; until it has, up to kShedSlack threads run over.
+            const bool room = server.threads_ < server.limits.maxConnections ||
+                              (server.threads_ < server.limits.maxConnections + kShedSlack && server.shedUnfinishedHead());
+            if (room && !server.closing_) {
                 ++server.threads_;
                 std::thread([this, fn = std::move(fn)] {
                     fn();
@@ -310,6 +317,22 @@ std::pair<std::size_t, bool> declaredBody(const httplib::Request& req) {
 
 } // namespace
 
+bool GuardedServer::shedUnfinishedHead() {
+    for (Conn* o : conns_) // oldest first
+        if (!o->headDone && o->idle) {
+            ::shutdown(o->sock, SHUT_RDWR); // its thread sees the hang-up and closes it
+            o->idle = false;                // shed once
+            ++shed_;
+            return true;
+        }
+    return false;
+}
+
+std::uint64_t GuardedServer::shedCount() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return shed_;
+}
+
 bool GuardedServer::admit(Conn& c) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (closing_) return false;
@@ -362,6 +385,7 @@ bool GuardedServer::process_and_close_socket(socket_t sock) {
         const bool closeConnection = count == 1;
         ret = process_request(strm, closeConnection, closed, [&](httplib::Request& req) {
             conn.idle = false;
+            conn.headDone = true;
             strm.beginBody(bodyLimit ? bodyLimit(req) : payload_max_length_);
             const auto [length, chunked] = declaredBody(req);
             strm.declareBody(length, chunked);

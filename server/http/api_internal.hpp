@@ -247,6 +247,8 @@ public:
     /// tracked here; callers ask only for answers sent early, i.e. errors). Bytes left unread
     /// must never be parsed as the next request (request smuggling): answer and close.
     static bool bodyUnread(const Req& req);
+    /// Connections shut so far to make room for new ones (tests, /info).
+    std::uint64_t shedCount();
 
     struct Conn;
     struct Threads;
@@ -258,6 +260,11 @@ private:
 
     std::mutex mutex_;
     std::condition_variable idle_;
+    /// Caller holds mutex_: shuts the oldest connection still in its first request head; false
+    /// when there is none.
+    bool shedUnfinishedHead();
+    static constexpr int kShedSlack = 64; ///< threads over maxConnections while shed ones end
+    std::uint64_t shed_ = 0;              ///< connections shed so far (mutex_)
     std::vector<Conn*> conns_; ///< open connections, oldest first
     int threads_ = 0;          ///< connection threads running
     bool closing_ = false;
@@ -275,11 +282,21 @@ struct Api::Impl {
     /// half the workers may stream; more are refused with 503 (otherwise a few dozen open editor
     /// tabs, or one client, would leave no thread to answer anything else: a hang).
     std::atomic<int> streams{0};
+    std::mutex streamsMutex;
+    std::map<std::string, int> streamsByAddress; ///< open streams per peer address (streamsMutex)
     api_detail::SessionStore sessions;
     api_detail::AuthThrottle authThrottle{opt.authFreeFailures};
 
     Impl(Service& s, ApiOptions o);
     int maxStreams() const { return std::max(1, opt.threads / 2); }
+    int maxStreamsPerAddress() const {
+        return opt.maxStreamsPerAddress > 0 ? std::min(opt.maxStreamsPerAddress, maxStreams())
+                                            : std::max(1, maxStreams() / 2);
+    }
+    /// Takes an event-stream slot for peer `ip`: "" when taken, else why not (the global or
+    /// the per-address cap). Each taken slot is given back once with giveStream.
+    std::string takeStream(const std::string& ip);
+    void giveStream(const std::string& ip);
     /// Configures the server and registers every route of the table.
     void install();
     /// The methods served for `path` (under the prefix), comma-separated; "" when no route.
