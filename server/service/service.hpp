@@ -73,7 +73,7 @@ struct EncodedImage {
     std::int64_t changedPixels = -1; ///< frame-diff only: pixels that differ (−1: not a diff)
     /// Frames: the camera the renderer used, "auto" distance and target resolved: distance,
     /// target x, y, z (headers X-Dermis-Camera-Distance / -Target). Absent for other images.
-    std::optional<std::array<double, 4>> camera;
+    std::optional<std::array<double, 4>> camera = std::nullopt;
 };
 
 /// One file of a multi-file upload.

@@ -75,7 +75,12 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       }
     return null;
   }, id);
-  const settledSeq = async () => { await settledFrameHash(page); return page.$eval("#frame", (i) => +i.dataset.seq); };
+  // GET focus at the time the editor shows (the default scene is posed mid-clip).
+  const focusOf = async (pid) => {
+    const t = await page.evaluate(async () => (await import("/js/frame_view.js")).frameParams().time);
+    return (await api("GET", `/scenes/${sceneId}/focus?placement=${pid}&time=${t}`)).body;
+  };
+  const closeDialogs = () => page.evaluate(() => document.querySelectorAll("dialog[open]").forEach((d) => d.close()));
 
   const failures = await runChecks("WebEditor3dBrowserTest", [
     ["the selection is outlined on the skin; without a selection the frame is the plain one", async () => {
@@ -95,8 +100,8 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       await page.focus("#frameStage");
       await page.keyboard.press("f");
       const cam = await until(async () => { const c = await camera(); return c.target && c; }, "F set a target");
-      const focus = (await api("GET", `/scenes/${sceneId}/focus?placement=stomach&time=0`)).body;
-      assert.deepEqual(cam.target.map((x) => +x.toFixed(3)), focus.target.map((x) => +x.toFixed(3)));
+      const focus = (await focusOf("stomach"));
+      assert.deepEqual(cam.target.map((x) => +x.toFixed(3)), focus.target.map((x) => +x.toFixed(3)), JSON.stringify({ cam, focus }));
       assert.ok(cam.distance < 0.6 * (before.distance ?? 1e9) || before.distance === null, "closer");
       assert.equal(await param("target"), cam.target.join(","));
       await settledFrameHash(page);
@@ -108,7 +113,7 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       const c0 = await camera();
       await page.evaluate(async () => { const m = await import("/js/camera3d.js"); m.panBy(60, -30, 512); });
       const c1 = await until(async () => { const c = await camera(); return c.target.join() !== c0.target.join() && c; }, "panned");
-      const focus = (await api("GET", `/scenes/${sceneId}/focus?placement=stomach&time=0`)).body;
+      const focus = (await focusOf("stomach"));
       const p1 = project(c1, focus.target, n);
       const [cx, cy] = await client([n * 0.5, n * 0.5]);
       await page.mouse.move(cx, cy);
@@ -117,7 +122,7 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       await page.mouse.up();
       const c2 = await until(async () => { const c = await camera(); return c.yaw !== c1.yaw && c; }, "orbited");
       const p2 = project(c2, focus.target, n);
-      assert.ok(Math.hypot(p2[0] - p1[0], p2[1] - p1[1]) < 1.5, `the pivot stays at its pixel: ${p1} → ${p2}`);
+      assert.ok(Math.hypot(p2[0] - p1[0], p2[1] - p1[1]) < 1.5, `the pivot stays at its pixel: ${p1} → ${p2} ${JSON.stringify({ c1, c2, focus })}`);
       assert.notDeepEqual(c2.target, c1.target, "the target turned about the pivot");
     }],
     ["Shift+drag and middle drag pan: the picture follows the pointer", async () => {
@@ -204,18 +209,19 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       await page.evaluate(async () => { const m = await import("/js/sweep_view.js"); m.openSweep(window.dermisEditor.store.doc.placements.find((p) => p.id === "elbow_l")); });
       const src = await page.waitForFunction(() => { const i = document.querySelector("#sweepDialog img"); return i && i.complete && i.naturalWidth > 0 && i.src; }, null, { timeout: 60000 });
       const u = new URL(await src.jsonValue());
-      assert.equal(+u.searchParams.get("yaw"), cam.yaw);
-      assert.equal(u.searchParams.get("target"), cam.target.join(","));
+      assert.equal(+u.searchParams.get("yaw"), cam.yaw, u.href);
+      assert.equal(u.searchParams.get("target"), cam.target.join(","), u.href);
       await page.click("#sweepZoom");
       const zoomed = await page.waitForFunction((old) => { const i = document.querySelector("#sweepDialog img"); return i && i.src !== old && i.complete && i.naturalWidth > 0 && i.src; }, u.href, { timeout: 60000 });
       const z = new URL(await zoomed.jsonValue());
-      const focus = (await api("GET", `/scenes/${sceneId}/focus?placement=elbow_l&time=0`)).body;
+      const focus = (await focusOf("elbow_l"));
       assert.equal(z.searchParams.get("size"), "256", "larger cells");
       assert.deepEqual(z.searchParams.get("target").split(",").map((x) => +(+x).toFixed(3)), focus.target.map((x) => +x.toFixed(3)));
       await screenshot(page, "editor-3d-sweep-zoom.png");
-      await page.keyboard.press("Escape");
+      await closeDialogs();
     }],
     ["the turntable button opens an animated WebP of the selection's range of motion", async () => {
+      await closeDialogs();
       if (await page.isVisible("#viewMore")) await page.click("#viewMore");
       assert.equal(await page.$eval("#turntable", (b) => b.disabled), false);
       await page.click("#turntable");
@@ -228,11 +234,12 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       assert.equal(frames, 36);
       assert.match(await page.$eval("#turntableDownload", (a) => a.getAttribute("download")), /turntable-elbow_l\.webp/);
       await screenshot(page, "editor-3d-turntable.png");
-      await page.keyboard.press("Escape");
+      await closeDialogs();
       await page.evaluate(async () => { const m = await import("/js/store.js"); m.set({ selection: [] }); });
       assert.equal(await page.$eval("#turntable", (b) => b.disabled), true, "no selection: disabled");
     }],
     ["the compare menu says Compare and the 3D bar is one row in every mode at 1600 and 1280 px", async () => {
+      await closeDialogs();
       for (const [w, h] of [[1600, 1000], [1280, 720]]) {
         await page.setViewportSize({ width: w, height: h });
         await page.click('[data-layout="both"]');
@@ -240,19 +247,44 @@ await runSuite("WebEditor3dBrowserTest", async () => {
           await page.selectOption("#compareMode", mode);
           if (mode !== "off") await page.selectOption("#compareAgainst", "off");
           await sleep(100);
-          const bar = await page.$eval("#frameView .viewbar", (e) => ({ h: e.getBoundingClientRect().height, over: e.scrollWidth > e.clientWidth + 1 }));
+          const bar = await page.$eval("#frameView .viewbar", (e) => {
+            const r = e.getBoundingClientRect();
+            // Every control shown in the row: inside the bar and clear of the others.
+            const shown = [...e.querySelectorAll("select, button, input, .badge, .title")].filter((c) => {
+              const b = c.getBoundingClientRect();
+              return b.width > 0 && b.height > 0 && getComputedStyle(c).visibility !== "hidden" && b.top >= r.top - 1 && b.bottom <= r.bottom + 1;
+            }).map((c) => ({ id: c.id || c.className || c.tagName, b: c.getBoundingClientRect() }));
+            const clash = [];
+            for (let i = 0; i < shown.length; ++i) {
+              const a = shown[i].b;
+              if (a.left < r.left - 1 || a.right > r.right + 1) clash.push(`${shown[i].id} outside`);
+              for (let j = i + 1; j < shown.length; ++j) {
+                const b = shown[j].b;
+                if (a.left < b.right - 1 && b.left < a.right - 1 && a.top < b.bottom - 1 && b.top < a.bottom - 1) clash.push(`${shown[i].id} × ${shown[j].id}`);
+              }
+            }
+            return { h: r.height, clash, n: shown.length };
+          });
           assert.ok(bar.h < 40, `${w}px, ${mode}: one row (${bar.h} px)`);
-          assert.ok(!bar.over, `${w}px, ${mode}: nothing cut off`);
+          assert.deepEqual(bar.clash, [], `${w}px, ${mode}: every control whole and apart`);
+          assert.ok(bar.n >= 5, `${w}px, ${mode}: the controls are there (${bar.n})`);
+          if (mode !== "off") assert.ok(await page.isVisible("#compareAgainst"), `${w}px, ${mode}: "against" is shown`);
+          if (mode === "diff") await until(() => page.isVisible("#diffText"), "the diff count is shown");
           const label = await page.$eval("#compareMode", (s) => { const l = s.closest("label").querySelector(".lbl"); return l && getComputedStyle(l).display !== "none" && l.getBoundingClientRect().width > 0 ? l.textContent : null; });
           assert.equal(label, "Compare", `${w}px, ${mode}: the compare menu's visible label`);
         }
-        if (w === 1280) { await settledSeq(); await screenshot(page, "editor-3d-diff-1280.png"); }
+        if (w === 1280) {
+          await page.selectOption("#compareMode", "diff");
+          await until(async () => /^\d+ px changed$/.test(await page.$eval("#diffText", (e) => e.textContent)), "the diff count");
+          await screenshot(page, "editor-3d-diff-1280.png");
+        }
         await page.selectOption("#compareMode", "off");
       }
     }],
     ["1280×720 with a highlighted, framed selection (screenshot)", async () => {
       await page.setViewportSize({ width: 1280, height: 720 });
       await page.click('[data-layout="both"]');
+      await page.selectOption("#compareMode", "off");
       await page.evaluate(async () => { const m = await import("/js/store.js"); m.set({ selection: ["elbow_l"] }); });
       await page.focus("#frameStage");
       await page.keyboard.press("f");

@@ -93,22 +93,24 @@ export function initFrameView(section, theApi) {
       <label><span class="lbl">View</span> <select id="viewMode" aria-label="view mode" title="View mode">
         <option value="shaded">shaded</option><option value="bump">bump</option>
         <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
-      <label><span class="lbl keep">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame">
+      <label><span class="lbl keep">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame: split, flicker, or a diff heat map">
         <option value="off">off</option><option value="split">split</option>
-        <option value="flicker">flicker</option><option value="diff">diff heat map</option></select></label>
-      <label id="compareAgainstLabel" hidden><span class="lbl">against</span> <select id="compareAgainst" aria-label="compare against" title="Compare against"><option value="off">patterns off</option></select></label>
-      <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
+        <option value="flicker">flicker</option><option value="diff" title="diff heat map">diff</option></select></label>
+      <span class="comparebits">
+        <label id="compareAgainstLabel" hidden><span class="lbl">against</span> <select id="compareAgainst" aria-label="compare against" title="Compare against"><option value="off">patterns off</option></select></label>
+        <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
+        <span id="diffText" class="badge" title="pixels that differ" hidden></span>
+      </span>
       <button type="button" id="placeTool" aria-pressed="false" title="Place tool (P): click the model to add a placement there">Place</button>
-      <button type="button" id="frameSelection" title="Frame the selection (F): centre and zoom on the selected placement's skin" disabled>Frame</button>
       <div class="more" id="viewMoreWrap">
-        <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: turntable, frame size, reset camera">⋯</button>
+        <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: frame the selection, turntable, frame size, reset camera">⋯</button>
         <div class="moremenu" id="viewMoreMenu" role="group" aria-label="more 3D view settings">
+          <button type="button" id="frameSelection" title="Frame the selection (F): centre and zoom on the selected placement's skin" disabled>Frame</button>
           <button type="button" id="turntable" title="Turntable: the selection's range of motion (θmin → θmax → θmin) while the camera turns, as an animated WebP" disabled>Turntable</button>
           <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
           <button type="button" id="resetCamera" title="Reset the camera (orbit about the whole character)">Reset</button>
         </div>
       </div>
-      <span id="diffText" class="badge" title="pixels that differ" hidden></span>
     </div>
     <div class="stage" id="frameStage" tabindex="0" aria-label="3D view: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom at the pointer, F frames the selection, click to select">
       <img id="frame" alt="" draggable="false">
