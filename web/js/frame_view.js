@@ -103,12 +103,12 @@ export function initFrameView(section, theApi) {
       </span>
       <button type="button" id="placeTool" aria-pressed="false" title="Place tool (P): click the model to add a placement there">Place</button>
       <div class="more" id="viewMoreWrap">
-        <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: frame the selection, turntable, frame size, reset camera">⋯</button>
+        <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: frame size, reset camera, frame the selection, turntable">⋯</button>
         <div class="moremenu" id="viewMoreMenu" role="group" aria-label="more 3D view settings">
-          <button type="button" id="frameSelection" title="Frame the selection (F): centre and zoom on the selected placement's skin" disabled>Frame</button>
-          <button type="button" id="turntable" title="Turntable: the selection's range of motion (θmin → θmax → θmin) while the camera turns, as an animated WebP" disabled>Turntable</button>
           <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
           <button type="button" id="resetCamera" title="Reset the camera (orbit about the whole character)">Reset</button>
+          <button type="button" id="frameSelection" title="Frame the selection (F): centre and zoom on the selected placement's skin" disabled>Frame</button>
+          <button type="button" id="turntable" title="Turntable: the selection's range of motion (θmin → θmax → θmin) while the camera turns, as an animated WebP" disabled>Turntable</button>
         </div>
       </div>
     </div>
@@ -178,7 +178,7 @@ function initMoreMenu(wrap) {
   const open = (yes, focusBack = false) => {
     wrap.classList.toggle("open", yes);
     button.setAttribute("aria-expanded", String(yes));
-    if (yes) wrap.querySelector(".moremenu select, .moremenu button")?.focus();
+    if (yes) wrap.querySelector(".moremenu select:not(:disabled), .moremenu button:not(:disabled)")?.focus();
     else if (focusBack) button.focus();
   };
   button.onclick = () => open(!wrap.classList.contains("open"));
