@@ -21,6 +21,14 @@ layout(std140, binding = 1) uniform FrameBlock {
     vec4 u_viewport;       // frame width, height, target edge length of a tessellated edge (px), max level
 };
 
+// Outlines on the skin (the editor's selection, hover and place brush): footprint rectangles in
+// UV space (SPEC §2: centre, size, rotation), drawn as a band where v_uv lies on their border.
+layout(std140, binding = 3) uniform OutlineBlock {
+    ivec4 u_outlineCount;    // outlines in use (0..8), 0, 0, 0
+    vec4 u_outlineRect[8];   // centre u, v; size u, v
+    vec4 u_outlineStyle[8];  // cos(rotation), sin(rotation), kind (0 selected, 1 hovered, 2 brush), 0
+};
+
 // Per-part constants of the skin pass.
 layout(std140, binding = 2) uniform PartBlock {
     vec4 u_baseColor;  // material base colour factor (linear)

@@ -7,6 +7,11 @@
 // maps on the surface for authoring: 1 bump / 2 displacement height as grey byte 128 + 127·height
 // (clamped to [−1, 1]), 3 the perturbed world normal as bytes 255·(n·0.5 + 0.5). Those are
 // picture values: written through the sRGB EOTF so that the target's encoding gives them back.
+//
+// Outlines (OutlineBlock, common.glsl): footprint rectangles in UV space drawn over any view as
+// a band about 2 pixels wide where v_uv lies on their border — selected (orange, with a faint
+// tint inside and a dark rim outside), hovered (pale blue), the place brush (dashed cyan). With
+// u_outlineCount.x = 0 nothing runs and the frame is exactly the one without outlines.
 
 layout(binding = 0) uniform sampler2D u_heightMap;        // RG32F: bump, displacement
 layout(binding = 2) uniform sampler2D u_baseColorTexture; // sRGB8_A8, decoded to linear by the sampler
@@ -47,6 +52,37 @@ vec3 pictureValue(vec3 c) {
     return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
 }
 
+// Linear colours of the outline kinds (sRGB 255,170,40 / 200,225,255 / 60,205,255).
+const vec3 kOutlineColor[3] = vec3[3](vec3(1.0, 0.402, 0.021), vec3(0.578, 0.753, 1.0),
+                                      vec3(0.045, 0.610, 1.0));
+
+// `color` with every outline drawn over it.
+vec3 outlined(vec3 color) {
+    for (int i = 0; i < u_outlineCount.x; ++i) {
+        vec4 r = u_outlineRect[i];
+        vec4 st = u_outlineStyle[i];
+        int kind = int(st.z);
+        // s − 0.5 = R(−rotation)·(uv − centre) / size (SPEC §2): q in [−0.5, 0.5]² inside.
+        vec2 d = v_uv - r.xy;
+        vec2 q = vec2(st.x * d.x + st.y * d.y, -st.y * d.x + st.x * d.y) / r.zw;
+        vec2 perPixel = max(fwidth(q), vec2(1e-7));
+        vec2 e = (abs(q) - 0.5) / perPixel; // pixels beyond each edge (negative inside)
+        float dist = length(max(e, vec2(0.0))) + min(max(e.x, e.y), 0.0); // signed, to the border
+        if (dist > 4.0) continue;
+        float halfWidth = kind == 1 ? 0.9 : 1.3;
+        float band = 1.0 - smoothstep(halfWidth - 0.5, halfWidth + 0.5, abs(dist));
+        if (kind == 2) { // dashes of 6 pixels along the border
+            float along = e.x > e.y ? q.y / perPixel.y : q.x / perPixel.x;
+            band *= step(0.5, fract(along / 12.0));
+        }
+        vec3 c = kOutlineColor[clamp(kind, 0, 2)];
+        if (dist < 0.0 && kind != 1) color = mix(color, c, kind == 0 ? 0.10 : 0.06); // tint inside
+        if (kind == 0) color *= 1.0 - 0.6 * (1.0 - smoothstep(0.0, 1.0, abs(dist - halfWidth - 1.0))); // rim
+        color = mix(color, c, band);
+    }
+    return color;
+}
+
 void main() {
     vec3 n = normalize(v_normal);
     vec3 toCamera = normalize(u_cameraPos.xyz - v_position);
@@ -56,11 +92,11 @@ void main() {
     if (u_part.w == 1 || u_part.w == 2) { // bump or displacement height as grey
         vec2 heights = u_part.z != 0 ? textureLod(u_heightMap, v_uv, 0.0).rg : vec2(0.0);
         float height = clamp(u_part.w == 1 ? heights.r : heights.g, -1.0, 1.0);
-        o_color = vec4(pictureValue(vec3((128.0 + 127.0 * height) / 255.0)), 1.0);
+        o_color = vec4(outlined(pictureValue(vec3((128.0 + 127.0 * height) / 255.0))), 1.0);
         return;
     }
     if (u_part.w == 3) { // the perturbed world normal
-        o_color = vec4(pictureValue(n * 0.5 + 0.5), 1.0);
+        o_color = vec4(outlined(pictureValue(n * 0.5 + 0.5)), 1.0);
         return;
     }
 
@@ -73,5 +109,5 @@ void main() {
     vec3 h = normalize(l + toCamera);
     float specular = pow(max(dot(n, h), 0.0), 48.0) * 0.15 * step(0.0, dot(n, l));
     vec3 color = base.rgb * (0.85 * diffuse + u_lightDir.w * fill) + vec3(specular);
-    o_color = vec4(color, 1.0);
+    o_color = vec4(outlined(color), 1.0);
 }

@@ -179,3 +179,29 @@ TEST(CameraTest, TheLightComesFromAboveLeftOfTheEye) {
     EXPECT_GT(glm::dot(c.lightDir, c.up), 0.0f);
     EXPECT_LT(glm::dot(c.lightDir, c.forward), 0.0f); // towards the viewer's side
 }
+
+TEST(CameraTest, ATargetIsLookedAtAndOrbitedAboutAndTheCharacterStaysInTheDepthRange) {
+    const glm::vec3 target(0.35f, 1.6f, 0.1f); // the top-right corner of the character: a hand
+    for (double yaw : {0.0, 60.0, -150.0})
+        for (double pitch : {-30.0, 10.0, 70.0}) {
+            Camera cam = orbit(yaw, pitch, 0.5);
+            cam.target = std::array<double, 3>{target.x, target.y, target.z};
+            const FrameCamera c = frameCamera(kLo, kHi, 0.02, cam, 320, 240);
+            EXPECT_EQ(c.target, target);
+            EXPECT_NEAR(glm::length(c.eye - target), 0.5f, 1e-5f); // orbits at `distance` about it
+            auto p = projectToPixel(c, target);
+            ASSERT_TRUE(p);
+            EXPECT_NEAR(p->x, 160.0, 1e-3);
+            EXPECT_NEAR(p->y, 120.0, 1e-3);
+            // Every corner of the bounds lies in front of the far plane and beyond the near one
+            // along the view direction (or behind the eye, which a near plane cannot help).
+            for (int k = 0; k < 8; ++k) {
+                const glm::vec3 q((k & 1) ? kHi.x : kLo.x, (k & 2) ? kHi.y : kLo.y, (k & 4) ? kHi.z : kLo.z);
+                const float depth = glm::dot(q - c.eye, c.forward);
+                EXPECT_LT(depth, c.zFar) << k;
+            }
+        }
+    // Without a target: the bounds centre.
+    const FrameCamera a = frameCamera(kLo, kHi, 0.02, orbit(30, 20, 3.0), 256, 256);
+    EXPECT_EQ(a.target, 0.5f * (kLo + kHi));
+}

@@ -174,6 +174,8 @@ TEST(RenderSettingsTest, EveryRangeIsCheckedWithItsField) {
         {[](RenderSettings& r) { r.camera.pitch = 90.5; }, "/render/camera/pitch", ErrorCode::InvalidArgument},
         {[](RenderSettings& r) { r.camera.pitch = NAN; }, "/render/camera/pitch", ErrorCode::InvalidArgument},
         {[](RenderSettings& r) { r.camera.distance = 0.0; }, "/render/camera/distance", ErrorCode::InvalidArgument},
+        {[](RenderSettings& r) { r.camera.target = std::array<double, 3>{0.0, NAN, 0.0}; }, "/render/camera/target", ErrorCode::InvalidArgument},
+        {[](RenderSettings& r) { r.camera.target = std::array<double, 3>{2e6, 0.0, 0.0}; }, "/render/camera/target", ErrorCode::InvalidArgument},
         {[](RenderSettings& r) { r.displacementScale = -0.1; }, "/render/displacement_scale", ErrorCode::InvalidArgument},
         {[](RenderSettings& r) { r.bumpStrength = NAN; }, "/render/bump_strength", ErrorCode::InvalidArgument},
         {[](RenderSettings& r) { r.msaa = 8; }, "/render/msaa", ErrorCode::InvalidArgument},

@@ -127,6 +127,11 @@ TEST_F(RendererGLTest, UniformBlocksMatchTheirCppMirrors) {
          {sizeof(gl::PartBlock),
           {{"u_baseColor", offsetof(gl::PartBlock, baseColor)},
            {"u_part", offsetof(gl::PartBlock, part)}}}},
+        {"OutlineBlock",
+         {sizeof(gl::OutlineBlock),
+          {{"u_outlineCount", offsetof(gl::OutlineBlock, count)},
+           {"u_outlineRect[0]", offsetof(gl::OutlineBlock, rect)},
+           {"u_outlineStyle[0]", offsetof(gl::OutlineBlock, style)}}}},
     };
     for (const auto& [block, want] : expected) {
         auto layout = gl().blockLayout(block);
@@ -668,6 +673,75 @@ TEST_F(DefaultCharacterGLTest, FrameOptionsAreValidated) {
     // Still renders after the errors.
     auto ok = renderDefault(gl(), *loaded_, model_, pose("squat", 0.5), settings_);
     ASSERT_TRUE(ok) << ok.error().message;
+}
+
+TEST_F(DefaultCharacterGLTest, OutlinesDrawOnTheFootprintBorderAndNothingWithoutThem) {
+    Scene scene = loaded_->scene;
+    scene.pose = pose("squat", 1.25);
+    scene.render = settings_;
+    auto frame = makeSceneFrame(scene, model_, loaded_->images, nullptr);
+    ASSERT_TRUE(frame) << frame.error().message;
+    auto plain = gl().renderFrame(frame->request);
+    ASSERT_TRUE(plain) << plain.error().message;
+    const Placement& stomach = scene.placements.at(0);
+    ASSERT_EQ(stomach.id, "stomach");
+    FrameRequest outlined = frame->request;
+    outlined.outlines.push_back({glm::vec2(stomach.center[0], stomach.center[1]),
+                                 glm::vec2(stomach.scale[0], stomach.scale[1]),
+                                 static_cast<float>(stomach.rotation), FrameOutline::Selected});
+    auto a = gl().renderFrame(outlined);
+    ASSERT_TRUE(a) << a.error().message;
+    // Some pixels change, fewer than a tenth of the frame, and the band's pixels are orange.
+    std::size_t changed = 0, orange = 0;
+    for (std::size_t p = 0; p + 3 < a->image.rgba.size(); p += 4) {
+        const auto* x = &a->image.rgba[p];
+        const auto* y = &plain->image.rgba[p];
+        if (x[0] == y[0] && x[1] == y[1] && x[2] == y[2]) continue;
+        ++changed;
+        if (x[0] > 200 && x[1] > 110 && x[1] < 200 && x[2] < 90) ++orange;
+    }
+    EXPECT_GT(changed, 60u);
+    EXPECT_LT(changed, 256u * 256u / 10u);
+    EXPECT_GT(orange, 30u) << changed;
+    // The brush and hover kinds draw too, differently from the selection.
+    outlined.outlines[0].kind = FrameOutline::Brush;
+    auto b = gl().renderFrame(outlined);
+    ASSERT_TRUE(b) << b.error().message;
+    EXPECT_NE(b->image.rgba, a->image.rgba);
+    EXPECT_NE(b->image.rgba, plain->image.rgba);
+    // No outlines: byte for byte the frame without (the outline block is uploaded empty).
+    auto again = gl().renderFrame(frame->request);
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->image.rgba, plain->image.rgba);
+    // Bad outlines are refused.
+    outlined.outlines[0].scale = glm::vec2(0.0f, 0.1f);
+    EXPECT_FALSE(gl().renderFrame(outlined));
+    outlined.outlines.assign(kMaxFrameOutlines + 1, FrameOutline{});
+    EXPECT_FALSE(gl().renderFrame(outlined));
+}
+
+TEST_F(DefaultCharacterGLTest, ACameraTargetAtTheBoundsCentreGivesTheSameFrameAndAnotherOneMovesIt) {
+    Scene scene = loaded_->scene;
+    scene.pose = pose("squat", 1.25);
+    scene.render = settings_;
+    auto frame = makeSceneFrame(scene, model_, loaded_->images, nullptr);
+    ASSERT_TRUE(frame) << frame.error().message;
+    auto plain = gl().renderFrame(frame->request);
+    ASSERT_TRUE(plain) << plain.error().message;
+    const glm::vec3 c = plain->cameraTarget;
+    EXPECT_EQ(c, 0.5f * (plain->boundsMin + plain->boundsMax));
+    EXPECT_GT(plain->cameraDistance, 0.0f);
+    FrameRequest at = frame->request;
+    at.render.camera.target = std::array<double, 3>{c.x, c.y, c.z};
+    auto same = gl().renderFrame(at);
+    ASSERT_TRUE(same) << same.error().message;
+    EXPECT_EQ(same->image.rgba, plain->image.rgba);
+    at.render.camera.target = std::array<double, 3>{c.x, plain->boundsMax.y, c.z}; // the head
+    at.render.camera.distance = 0.5 * plain->cameraDistance;
+    auto head = gl().renderFrame(at);
+    ASSERT_TRUE(head) << head.error().message;
+    EXPECT_EQ(head->cameraTarget.y, plain->boundsMax.y);
+    EXPECT_GT(meanAbsDiff(head->image, plain->image), 1.0);
 }
 
 TEST_F(DefaultCharacterGLTest, SkipsTheHeightPassWhenNoDriverChanged) {

@@ -27,7 +27,12 @@ FrameCamera frameCamera(glm::vec3 boundsMin, glm::vec3 boundsMax, double displac
     c.width = width;
     c.height = height;
     const glm::vec3 lo = boundsMin, hi = boundsMax;
-    const glm::vec3 centre = 0.5f * (lo + hi);
+    const glm::vec3 boundsCentre = 0.5f * (lo + hi);
+    const glm::vec3 centre =
+        camera.target ? glm::vec3(static_cast<float>((*camera.target)[0]),
+                                  static_cast<float>((*camera.target)[1]),
+                                  static_cast<float>((*camera.target)[2]))
+                      : boundsCentre;
     const float radius =
         std::max(0.5f * glm::length(hi - lo) + static_cast<float>(displacementScale), 1e-4f);
     const float fovY = glm::radians(30.0f);
@@ -43,8 +48,11 @@ FrameCamera frameCamera(glm::vec3 boundsMin, glm::vec3 boundsMax, double displac
     const glm::vec3 eye = centre + dir * distance;
     const glm::vec3 worldUp =
         std::abs(dir.y) > 0.999f ? glm::vec3(0, 0, -dir.y) : glm::vec3(0, 1, 0);
-    const float zNear = std::max({distance - radius * 1.5f, distance * 0.01f, 1e-4f});
-    const float zFar = distance + radius * 1.5f;
+    // A target away from the bounds centre: the depth range grows by that offset, so that the
+    // whole character stays between the planes (without a target the offset is 0: unchanged).
+    const float reach = camera.target ? radius + glm::length(centre - boundsCentre) : radius;
+    const float zNear = std::max({distance - reach * 1.5f, distance * 0.01f, 1e-4f});
+    const float zFar = distance + reach * 1.5f;
 
     c.view = glm::lookAt(eye, centre, worldUp);
     // Flip y so that GL's first row (bottom) holds the top of the picture: readback is row 0 first.

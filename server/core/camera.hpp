@@ -2,14 +2,17 @@
 // bounds, view and projection matrices, the key light, and the mapping between world points and
 // frame pixels that a pick (SPEC §4 "Pick") needs to cast a ray from a pixel of a frame.
 //
-//   framing:  centre = middle of the posed bounds; radius = half their diagonal + the
-//             displacement scale (the furthest a unit height can push the surface), at least 1e-4;
+//   framing:  centre = middle of the posed bounds, or the camera's `target` when it has one (a
+//             world point: the editor's pan, frame-selection and orbit-about); radius = half the
+//             bounds' diagonal + the displacement scale (the furthest a unit height can push the
+//             surface), at least 1e-4;
 //   lens:     30° vertical field of view, aspect = width / height;
 //   distance: explicit, or "auto": the bounding sphere fits the narrower field of view, + 2%;
 //   orbit:    the eye sits at centre + distance · (sin yaw · cos pitch, sin pitch,
 //             cos yaw · cos pitch) (degrees; yaw 0 looks along −z from +z); world up is +y,
 //             except within ~2.6° of the poles (|pitch| ≈ 90), where it is −z·sign(pitch);
-//   depth:    near = max(distance − 1.5·radius, 1% of distance, 1e-4), far = distance + 1.5·radius;
+//   depth:    near = max(distance − 1.5·reach, 1% of distance, 1e-4), far = distance + 1.5·reach,
+//             reach = radius + |target − bounds centre| (= radius without a target);
 //   picture:  the projection is flipped in y so that row 0 of a read-back frame is the top of the
 //             picture (GL's first row is its bottom);
 //   light:    a key light above-left of the eye, towards the scene, fixed to the camera.
@@ -54,7 +57,7 @@ struct FrameCamera {
     glm::mat4 proj{1.0f};                 ///< eye → clip, y flipped (row 0 = top)
     glm::mat4 viewProj{1.0f};             ///< proj · view
     glm::vec3 eye{0.0f};                  ///< camera position
-    glm::vec3 target{0.0f};               ///< the point looked at: the centre of the bounds
+    glm::vec3 target{0.0f};               ///< the point looked at: Camera::target or the bounds' centre
     glm::vec3 forward{0.0f, 0.0f, -1.0f}; ///< unit, from the eye towards the target
     glm::vec3 right{1.0f, 0.0f, 0.0f};    ///< unit, the picture's +x in world space
     glm::vec3 up{0.0f, 1.0f, 0.0f};       ///< unit, the picture's up (towards row 0)

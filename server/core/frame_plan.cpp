@@ -17,6 +17,7 @@ Result<FramePlan> planFrame(const Scene& scene, const Model& model, const Patter
     if (o.yaw) r.camera.yaw = *o.yaw;
     if (o.pitch) r.camera.pitch = *o.pitch;
     if (o.distance) r.camera.distance = *o.distance;
+    if (o.target) r.camera.target = *o.target;
     if (auto s = validateRenderSettings(r, limits, where); !s) return s.error();
     if (o.time && !(std::isfinite(*o.time) && *o.time >= 0.0))
         return makeError(ErrorCode::InvalidArgument, where, "/pose/time", "must be a finite number >= 0");

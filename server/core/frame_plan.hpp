@@ -37,6 +37,7 @@ struct FrameOverrides {
     std::optional<double> time; ///< overrides pose.time
     std::optional<int> width, height, msaa;
     std::optional<double> yaw, pitch, distance;
+    std::optional<std::array<double, 3>> target; ///< the camera's target (Camera::target)
     FrameView view = FrameView::Shaded; ///< what the frame shows (never in the scene)
 };
 

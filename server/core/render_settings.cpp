@@ -55,6 +55,12 @@ Status validateRenderSettings(const RenderSettings& r, const RenderLimits& limit
     if (c.distance && !(std::isfinite(*c.distance) && *c.distance > 0.0 && *c.distance <= kMaxCameraDistance))
         return bad("/render/camera/distance", "must be in (0, " + fmt(kMaxCameraDistance) +
                                                   "] (or \"auto\"), got " + fmt(*c.distance));
+    if (c.target)
+        for (double x : *c.target)
+            if (!(std::isfinite(x) && std::abs(x) <= kMaxCameraTarget))
+                return bad("/render/camera/target", "each coordinate must be a finite number in [" +
+                                                        fmt(-kMaxCameraTarget) + ", " + fmt(kMaxCameraTarget) +
+                                                        "], got " + fmt(x));
     if (r.displacementScale &&
         !(std::isfinite(*r.displacementScale) && *r.displacementScale >= 0.0 &&
           *r.displacementScale <= kMaxDisplacementScale))

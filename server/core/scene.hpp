@@ -77,6 +77,7 @@ constexpr double kMaxTurnAngle = 3600.0; ///< degrees: footprint rotation, camer
                                          ///< (ten turns: editors may accumulate, they are periodic)
 constexpr double kMaxPoseTime = 86400.0;        ///< pose time ∈ [0, 86400] s
 constexpr double kMaxCameraDistance = 10000.0;  ///< camera distance ∈ (0, 10000] model units
+constexpr double kMaxCameraTarget = 1.0e6;      ///< each camera target coordinate ∈ [−1e6, 1e6]
 constexpr double kMaxDisplacementScale = 1000.0; ///< displacement_scale ∈ [0, 1000]
 constexpr double kMaxBumpStrength = 100.0;       ///< bump_strength ∈ [0, 100]
 
@@ -95,6 +96,10 @@ struct Pose {
 struct Camera {
     double yaw = 0.0, pitch = 10.0;
     std::optional<double> distance; ///< absent = "auto"
+    /// The world point looked at (and orbited about); absent = the centre of the posed bounds.
+    /// Set by a frame's `target` query parameter (the editor's pan, frame-selection and
+    /// orbit-about); not a member of the scene document.
+    std::optional<std::array<double, 3>> target;
 };
 
 enum class DisplacementMode { Vertex, Tessellated };

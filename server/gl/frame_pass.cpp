@@ -9,11 +9,14 @@
 #include "core/render_settings.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace dermis {
 
 using namespace gl;
+
+static_assert(static_cast<std::size_t>(kOutlineSlots) == kMaxFrameOutlines);
 
 namespace {
 
@@ -91,6 +94,16 @@ Status Renderer::Impl::checkFrameRequest(const FrameRequest& req) const {
     if (static_cast<int>(req.view) < static_cast<int>(FrameView::Shaded) ||
         static_cast<int>(req.view) > static_cast<int>(FrameView::Normal))
         return makeError(ErrorCode::InvalidArgument, kWhere, "view", "not a FrameView");
+    if (req.outlines.size() > kMaxFrameOutlines)
+        return makeError(ErrorCode::InvalidArgument, kWhere, "outlines",
+                         "at most " + std::to_string(kMaxFrameOutlines) + " outlines");
+    for (const FrameOutline& o : req.outlines)
+        if (!(std::isfinite(o.center.x) && std::isfinite(o.center.y) && o.scale.x > 0.0f &&
+              o.scale.y > 0.0f && std::isfinite(o.scale.x) && std::isfinite(o.scale.y) &&
+              std::isfinite(o.rotation)) ||
+            o.kind < FrameOutline::Selected || o.kind > FrameOutline::Brush)
+            return makeError(ErrorCode::InvalidArgument, kWhere, "outlines",
+                             "an outline needs a finite centre and rotation, a size > 0 and a kind");
     return Ok{};
 }
 
@@ -123,7 +136,10 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     out.boundsMin = bounds.min;
     out.boundsMax = bounds.max;
     const FrameCamera camera = frameCamera(bounds.min, bounds.max, dispScale, rs.camera, W, H);
+    out.cameraTarget = camera.target;
+    out.cameraDistance = camera.distance;
     uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
+    uploadOutlineBlock(req.outlines);
     const std::size_t partStride = uploadPartBlocks(model, **gm, req.view);
     const GLuint readFbo = drawSkinPass(model, **gm, rs, heightSource->texture, partStride, samples);
     if (auto s = checkGl("skin pass"); !s) return s.error();
@@ -170,6 +186,22 @@ void Renderer::Impl::uploadFrameBlock(const FrameCamera& camera, double dispScal
     glBindBuffer(GL_UNIFORM_BUFFER, frameUbo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof fb, &fb);
     glBindBufferBase(GL_UNIFORM_BUFFER, kFrameBinding, frameUbo);
+}
+
+/// The frame's outlines into outlineUbo (count 0 when there are none: the shader draws nothing).
+void Renderer::Impl::uploadOutlineBlock(const std::vector<FrameOutline>& outlines) {
+    OutlineBlock ob{};
+    const std::size_t n = std::min(outlines.size(), static_cast<std::size_t>(kOutlineSlots));
+    ob.count = glm::ivec4(static_cast<int>(n), 0, 0, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const FrameOutline& o = outlines[i];
+        const float a = glm::radians(o.rotation);
+        ob.rect[i] = glm::vec4(o.center, o.scale);
+        ob.style[i] = glm::vec4(std::cos(a), std::sin(a), static_cast<float>(o.kind), 0.0f);
+    }
+    glBindBuffer(GL_UNIFORM_BUFFER, outlineUbo);
+    glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof ob, &ob);
+    glBindBufferBase(GL_UNIFORM_BUFFER, kOutlineBinding, outlineUbo);
 }
 
 /// One PartBlock per part in partUbo (bound by range per draw), each with the frame's view in

@@ -113,15 +113,18 @@ Status Renderer::Impl::buildPrograms() {
 /// The vertex array, buffers and 1×1 textures every job shares.
 void Renderer::Impl::createSharedObjects() {
     glGenVertexArrays(1, &emptyVao);
-    GLuint bufs[5];
-    glGenBuffers(5, bufs);
+    GLuint bufs[6];
+    glGenBuffers(6, bufs);
     heightUbo = bufs[0];
     frameUbo = bufs[1];
     partUbo = bufs[2];
     paletteSsbo = bufs[3];
     feedbackBuffer = bufs[4];
+    outlineUbo = bufs[5];
     glBindBuffer(GL_UNIFORM_BUFFER, frameUbo);
     glBufferData(GL_UNIFORM_BUFFER, sizeof(FrameBlock), nullptr, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_UNIFORM_BUFFER, outlineUbo);
+    glBufferData(GL_UNIFORM_BUFFER, sizeof(OutlineBlock), nullptr, GL_DYNAMIC_DRAW);
     const float zero[2] = {0.0f, 0.0f};
     flatTexture = makeFloatTexture(1, 1, zero, GL_NEAREST, 2);
     glGenTextures(1, &whiteTexture);
@@ -146,8 +149,8 @@ void Renderer::Impl::shutdown() {
     frame.destroy();
     for (GLuint p : {heightProgram, heightBaseProgram, skinProgram, skinTessProgram, captureProgram})
         glDeleteProgram(p);
-    GLuint bufs[5] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer};
-    glDeleteBuffers(5, bufs);
+    GLuint bufs[6] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer, outlineUbo};
+    glDeleteBuffers(6, bufs);
     glDeleteVertexArrays(1, &emptyVao);
     glDeleteTextures(1, &flatTexture);
     glDeleteTextures(1, &whiteTexture);

@@ -97,6 +97,19 @@ struct FrameTimings {
     double readbackMs = 0.0; ///< pixel-pack readback into the frame
 };
 
+/// An outline drawn on the skin where the surface's UV lies on the border of a footprint
+/// rectangle (SPEC §2 footprint: centre, size, rotation in degrees about the centre): the
+/// editor's selection, hover and place brush. A band about 2 pixels wide, any view.
+struct FrameOutline {
+    enum Kind { Selected = 0, Hovered = 1, Brush = 2 };
+    glm::vec2 center{0.5f}, scale{0.1f};
+    float rotation = 0.0f; ///< degrees
+    Kind kind = Selected;
+};
+
+/// Most outlines of one frame (the size of the shader's array).
+inline constexpr std::size_t kMaxFrameOutlines = 8;
+
 struct FrameRequest {
     std::shared_ptr<const Model> model;
     std::vector<glm::mat4> world; ///< worldMatrices(model, pose): one per node
@@ -107,6 +120,8 @@ struct FrameRequest {
     const HeightMaps* cpuMaps = nullptr;
     bool readHeightMaps = false; ///< also return the maps the frame used (GPU pass only)
     bool profile = false;        ///< glFinish after each stage so that timings are per stage
+    /// Outlines on the skin (at most kMaxFrameOutlines; none: the frame is exactly as without).
+    std::vector<FrameOutline> outlines;
 };
 
 struct FrameResult {
@@ -114,6 +129,8 @@ struct FrameResult {
     std::optional<HeightMaps> maps; ///< when readHeightMaps and the GPU pass ran
     FrameTimings timings;
     glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< posed bounds used for framing
+    glm::vec3 cameraTarget{0.0f}; ///< the point the camera looked at (FrameCamera::target)
+    float cameraDistance = 0.0f;  ///< eye to target ("auto" resolved)
 };
 
 /// What a service needs of a renderer, so that it can be injected: Renderer is the GL one; tests
@@ -179,7 +196,8 @@ public:
     void forgetPatterns();
 
     /// Introspection for UniformBlockGLTest: the GL's size of a uniform block and the offsets of
-    /// its members, from the linked programs ("HeightPassBlock", "FrameBlock", "PartBlock").
+    /// its members, from the linked programs ("HeightPassBlock", "FrameBlock", "PartBlock",
+    /// "OutlineBlock").
     struct BlockLayout {
         int size = -1;
         std::vector<std::pair<std::string, int>> offsets; ///< member name → byte offset

@@ -185,7 +185,7 @@ struct Renderer::Impl {
     GLuint heightProgram = 0, heightBaseProgram = 0, skinProgram = 0, skinTessProgram = 0,
            captureProgram = 0;
     GLuint emptyVao = 0, heightUbo = 0, frameUbo = 0, partUbo = 0, paletteSsbo = 0,
-           feedbackBuffer = 0;
+           feedbackBuffer = 0, outlineUbo = 0;
     GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
     GLuint whiteTexture = 0; ///< 1×1 white, for parts without a base-colour texture
     GLint uboAlignment = 256;
@@ -261,6 +261,7 @@ struct Renderer::Impl {
     Status ensureFrameTargets(int w, int h, int samples);
     void uploadFrameBlock(const FrameCamera& camera, double dispScale, double bumpScale,
                           glm::vec2 heightmapSize);
+    void uploadOutlineBlock(const std::vector<FrameOutline>& outlines);
     std::size_t uploadPartBlocks(const Model& model, const gl::GpuModel& gm, FrameView view);
     GLuint drawSkinPass(const Model& model, const gl::GpuModel& gm, const RenderSettings& rs,
                         GLuint heightTexture, std::size_t partStride, int samples);

@@ -37,11 +37,20 @@ struct PartBlock {
     glm::ivec4 part; ///< first palette matrix, has texture, has UVs, view (FrameView as int)
 };
 
+/// OutlineBlock, binding 3: the outlines of a frame's skin pass (FrameOutline in renderer.hpp).
+struct OutlineBlock {
+    glm::ivec4 count;        ///< outlines in use (0..kOutlineSlots), 0, 0, 0
+    glm::vec4 rect[8];       ///< centre u, v; size u, v
+    glm::vec4 style[8];      ///< cos(rotation), sin(rotation), kind (0 selected, 1 hovered, 2 brush), 0
+};
+inline constexpr int kOutlineSlots = 8; ///< the GLSL arrays' length (= dermis::kMaxFrameOutlines)
+
 /// GLSL binding points of the blocks above and of the palette storage buffer.
 enum BlockBinding : unsigned {
     kHeightPassBinding = 0,
     kFrameBinding = 1,
     kPartBinding = 2,
+    kOutlineBinding = 3,
     kPaletteBinding = 0, // shader storage buffer binding
 };
 
@@ -49,5 +58,6 @@ static_assert(sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
 static_assert(sizeof(HeightPassBlock) == 80);
 static_assert(sizeof(FrameBlock) == 144);
 static_assert(sizeof(PartBlock) == 32);
+static_assert(sizeof(OutlineBlock) == 16 + 2 * 8 * 16);
 
 } // namespace dermis::gl

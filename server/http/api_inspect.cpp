@@ -27,7 +27,8 @@ void installInspectRoutes(RouteTable& t) {
         if (!numberParam(req, res, "x", x) || !numberParam(req, res, "y", y) ||
             !intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
             !numberParam(req, res, "yaw", p.yaw) || !numberParam(req, res, "pitch", p.pitch) ||
-            !numberParam(req, res, "distance", p.distance) || !numberParam(req, res, "time", p.time))
+            !numberParam(req, res, "distance", p.distance) || !numberParam(req, res, "time", p.time) ||
+            !targetParam(req, res, p.target))
             return;
         if (!x || !y)
             return sendError(res, 422, "invalid_argument", "dermis::Api: x and y are required",

@@ -76,6 +76,9 @@ std::vector<std::uint8_t> bytesOf(const std::string& s);
 /// present but malformed.
 bool intParam(const Req& req, Res& res, const char* name, std::optional<int>& out);
 bool numberParam(const Req& req, Res& res, const char* name, std::optional<double>& out);
+/// The camera's `target=x,y,z` (three finite numbers, comma-separated; api_renders.cpp).
+/// False (and the 422 sent, field "target") when malformed.
+bool targetParam(const Req& req, Res& res, std::optional<std::array<double, 3>>& out);
 /// The edit context of a request (SPEC §6 Concurrency): `If-Match: "r<N>"` (or `*`: any) and
 /// `X-Dermis-Client`. False (and a 400 sent, field "If-Match" / "X-Dermis-Client") for a weak,
 /// malformed or multiple ETag or a client name over 64 characters or not printable ASCII.

@@ -6,13 +6,59 @@
 #include "http/api_internal.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <vector>
 
 namespace dermis::api_detail {
 
+/// `name` as `count` finite numbers separated by commas; false (422 sent, field `name`) otherwise.
+static bool numbersParam(const Req& req, Res& res, const char* name, std::size_t minCount,
+                         std::size_t maxCount, std::vector<double>& out, const char* what) {
+    const std::string v = req.get_param_value(name);
+    out.clear();
+    std::size_t start = 0;
+    bool ok = !v.empty();
+    while (ok && start <= v.size() && out.size() <= maxCount) {
+        const std::size_t comma = std::min(v.find(',', start), v.size());
+        const std::string item = v.substr(start, comma - start);
+        char* end = nullptr;
+        const double d = std::strtod(item.c_str(), &end);
+        ok = !item.empty() && *end == '\0' && std::isfinite(d);
+        out.push_back(d);
+        start = comma + 1;
+    }
+    if (!ok || out.size() < minCount || out.size() > maxCount) {
+        sendError(res, 422, "invalid_argument", std::string("dermis::Api: ") + name + ": " + what, name);
+        return false;
+    }
+    return true;
+}
+
+bool targetParam(const Req& req, Res& res, std::optional<std::array<double, 3>>& out) {
+    if (!req.has_param("target")) return true;
+    std::vector<double> xyz;
+    if (!numbersParam(req, res, "target", 3, 3, xyz, "three finite numbers x,y,z (a world point)"))
+        return false;
+    out = std::array<double, 3>{xyz[0], xyz[1], xyz[2]};
+    return true;
+}
+
 namespace {
+
+/// Splits a comma-separated list of ids (empty items skipped).
+std::vector<std::string> idList(const std::string& v) {
+    std::vector<std::string> ids;
+    std::size_t start = 0;
+    while (start <= v.size()) {
+        const std::size_t comma = std::min(v.find(',', start), v.size());
+        if (comma > start) ids.push_back(v.substr(start, comma - start));
+        start = comma + 1;
+    }
+    return ids;
+}
 
 /// The frame query: size, camera, time, format, view and what to compare (patterns, only,
 /// revision). False (and the 422 sent) when a parameter is malformed.
@@ -21,8 +67,38 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
     if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
         !intParam(req, res, "msaa", p.msaa) || !numberParam(req, res, "yaw", p.yaw) ||
         !numberParam(req, res, "pitch", p.pitch) || !numberParam(req, res, "distance", p.distance) ||
-        !numberParam(req, res, "time", p.time))
+        !numberParam(req, res, "time", p.time) || !targetParam(req, res, p.target))
         return false;
+    if (req.has_param("highlight")) {
+        p.highlight = idList(req.get_param_value("highlight"));
+        if (p.highlight.empty() || p.highlight.size() > kMaxHighlights) {
+            sendError(res, 422, "invalid_argument",
+                      "dermis::Api: highlight: 1 to " + std::to_string(kMaxHighlights) +
+                          " comma-separated placement ids", "highlight");
+            return false;
+        }
+    }
+    if (req.has_param("hover")) {
+        p.hover = req.get_param_value("hover");
+        if (p.hover.empty()) {
+            sendError(res, 422, "invalid_argument", "dermis::Api: hover: a placement id", "hover");
+            return false;
+        }
+    }
+    if (req.has_param("brush")) {
+        std::vector<double> b;
+        const char* what = "u,v,size_u,size_v[,rotation]: a footprint's UV centre (each in [-16, 16]), "
+                           "size (each in (0, 16]) and rotation (degrees, |r| <= 3600)";
+        if (!numbersParam(req, res, "brush", 4, 5, b, what)) return false;
+        b.resize(5, 0.0);
+        if (std::abs(b[0]) > kMaxPlacementCenter || std::abs(b[1]) > kMaxPlacementCenter ||
+            !(b[2] > 0.0 && b[2] <= kMaxPlacementScale) || !(b[3] > 0.0 && b[3] <= kMaxPlacementScale) ||
+            std::abs(b[4]) > kMaxTurnAngle) {
+            sendError(res, 422, "invalid_argument", std::string("dermis::Api: brush: ") + what, "brush");
+            return false;
+        }
+        p.brush = std::array<double, 5>{b[0], b[1], b[2], b[3], b[4]};
+    }
     if (req.has_param("view")) {
         const auto view = frameViewFromString(req.get_param_value("view"));
         if (!view) {
@@ -75,6 +151,19 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
     return true;
 }
 
+/// A frame answer: the image and the camera the renderer used (X-Dermis-Camera-Distance,
+/// X-Dermis-Camera-Target: "x,y,z"), which the editor needs to pan and zoom from an "auto" camera.
+void sendFrame(Res& res, EncodedImage&& img) {
+    const auto camera = img.camera;
+    sendImage(res, std::move(img));
+    if (!camera) return;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%.9g", (*camera)[0]);
+    res.set_header("X-Dermis-Camera-Distance", buf);
+    std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g", (*camera)[1], (*camera)[2], (*camera)[3]);
+    res.set_header("X-Dermis-Camera-Target", buf);
+}
+
 /// The sweep query: placement, clip, steps, size, format (png | json) and the frame's camera,
 /// msaa, time and compare parameters (width/height are refused: cells are size × size). False
 /// (and the 422 sent) when a parameter is malformed.
@@ -112,7 +201,7 @@ void installRenderRoutes(RouteTable& t) {
         if (!frameParams(req, res, p)) return;
         auto r = a.svc.frame(req.matches[1], p);
         if (!r) return sendError(res, r.error());
-        sendImage(res, std::move(*r));
+        sendFrame(res, std::move(*r));
     });
     t.add("GET", "/scenes/{id}/frame-diff", [](Api::Impl& a, const Req& req, Res& res) {
         FrameParams p;
@@ -121,7 +210,7 @@ void installRenderRoutes(RouteTable& t) {
             return sendError(res, 422, "invalid_argument", "dermis::Api: against: off or a revision number is required", "against");
         auto r = a.svc.frameDiff(req.matches[1], p, req.get_param_value("against"));
         if (!r) return sendError(res, r.error());
-        sendImage(res, std::move(*r));
+        sendFrame(res, std::move(*r));
     });
     t.add("GET", "/scenes/{id}/sweep", [](Api::Impl& a, const Req& req, Res& res) {
         SweepParams p;
@@ -134,6 +223,41 @@ void installRenderRoutes(RouteTable& t) {
         auto r = a.svc.sweep(req.matches[1], p);
         if (!r) return sendError(res, r.error());
         sendImage(res, std::move(*r));
+    });
+    t.add("GET", "/scenes/{id}/focus", [](Api::Impl& a, const Req& req, Res& res) {
+        FrameParams p;
+        if (!frameParams(req, res, p)) return;
+        if (!req.has_param("placement"))
+            return sendError(res, 422, "invalid_argument", "dermis::Api: placement is required", "placement");
+        auto r = a.svc.focus(req.matches[1], req.get_param_value("placement"), p);
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
+    t.add("GET", "/scenes/{id}/turntable", [](Api::Impl& a, const Req& req, Res& res) {
+        TurntableParams p;
+        if (!frameParams(req, res, p.frame)) return;
+        if (req.has_param("width") || req.has_param("height"))
+            return sendError(res, 422, "invalid_argument",
+                             "dermis::Api: width/height: a turntable's frames are size x size: use size",
+                             req.has_param("width") ? "width" : "height");
+        if (req.has_param("format") && p.frame.format != "webp")
+            return sendError(res, 422, "invalid_argument", "dermis::Api: format: a turntable is webp", "format");
+        p.frame.format = "webp";
+        std::optional<int> frames, size;
+        std::optional<double> fps;
+        if (!intParam(req, res, "frames", frames) || !intParam(req, res, "size", size) ||
+            !numberParam(req, res, "fps", fps))
+            return;
+        if (frames) p.frames = *frames;
+        if (size) p.size = *size;
+        if (fps) p.fps = *fps;
+        if (!req.has_param("placement"))
+            return sendError(res, 422, "invalid_argument", "dermis::Api: placement is required", "placement");
+        p.placement = req.get_param_value("placement");
+        auto r = a.svc.turntable(req.matches[1], p);
+        if (!r) return sendError(res, r.error());
+        sendImage(res, std::move(*r));
+        res.set_header("Content-Disposition", "inline; filename=\"turntable-" + p.placement + ".webp\"");
     });
     t.add("GET", "/scenes/{id}/heightmaps/{map}", [](Api::Impl& a, const Req& req, Res& res) {
         const std::string map = req.matches[2];

@@ -16,7 +16,8 @@
 // Files: service.cpp (open, info), service_models.cpp, service_patterns.cpp,
 // service_scenes.cpp (documents and edits), service_history.cpp (revisions, revert, presence),
 // service_inspect.cpp (pick, probe, activation, lint), service_sweep.cpp (sweeps),
-// service_renders.cpp (frames, maps, batch), service_events.cpp; shared private state in
+// service_renders.cpp (frames, maps, batch), service_view.cpp (focus, turntable),
+// service_events.cpp; shared private state in
 // service_state.hpp.
 //
 // Documents that arrive here name models and patterns only by generated ids ("m_…", "p_…") or
@@ -30,6 +31,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -69,6 +71,9 @@ struct EncodedImage {
     std::string contentType;
     std::string backend; ///< which GL backend rendered it ("" for CPU-only answers)
     std::int64_t changedPixels = -1; ///< frame-diff only: pixels that differ (−1: not a diff)
+    /// Frames: the camera the renderer used, "auto" distance and target resolved: distance,
+    /// target x, y, z (headers X-Dermis-Camera-Distance / -Target). Absent for other images.
+    std::optional<std::array<double, 4>> camera = std::nullopt;
 };
 
 /// One file of a multi-file upload.
@@ -86,6 +91,14 @@ struct FrameParams {
     std::string format = "png"; ///< png | jpeg | webp (lossless); see isFrameFormat
     std::optional<int> width, height, msaa;
     std::optional<double> yaw, pitch, distance, time;
+    std::optional<std::array<double, 3>> target; ///< the camera's target (core Camera::target)
+    // Outlines on the skin (the editor's selection, hover and place brush; nothing when empty:
+    // the frame is byte for byte the one without them). Unknown ids fail (field "highlight" /
+    // "hover").
+    std::vector<std::string> highlight; ///< placements outlined as selected (≤ kMaxHighlights)
+    std::string hover;                  ///< a placement outlined as hovered ("" = none)
+    /// A brush footprint outlined at UV centre (u, v), size (su, sv), rotation (degrees).
+    std::optional<std::array<double, 5>> brush;
     // Compare (SPEC §6): which version of the scene the frame shows.
     bool patternsOff = false;          ///< no dynamic patterns (every placement disabled)
     std::vector<std::string> only;     ///< solo: only these placements (others disabled)
@@ -109,6 +122,23 @@ struct SweepParams {
 
 /// Most cells of one contact sheet.
 inline constexpr int kMaxSweepCells = 64;
+
+/// Most placements one frame outlines as selected (FrameParams::highlight).
+inline constexpr std::size_t kMaxHighlights = 6;
+
+/// Query parameters of a turntable (range-of-motion preview): `frames` frames of `size` × `size`
+/// pixels in which the placement's driver joint goes θmin → θmax → θmin while the camera's yaw
+/// turns once (starting at `frame`'s yaw); `frame` carries camera, time, msaa, view, compare and
+/// outlines as for a frame. `fps` sets the WebP's frame delay.
+struct TurntableParams {
+    std::string placement;
+    int frames = 36;  ///< kMinTurntableFrames..kMaxTurntableFrames
+    int size = 256;   ///< kMinTurntableSize..kMaxTurntableSize
+    double fps = 12;  ///< 1..50
+    FrameParams frame;
+};
+inline constexpr int kMinTurntableFrames = 4, kMaxTurntableFrames = 120;
+inline constexpr int kMinTurntableSize = 64, kMaxTurntableSize = 512;
 
 /// A server-sent-events subscription to one scene: events (whole SSE messages) queue up until
 /// taken. A reader that falls kMaxQueued events behind loses them: the queue is replaced by one
@@ -315,6 +345,21 @@ public:
     /// 1..8192 (InvalidArgument) or over the render-side limit, alone or as the sheet's side
     /// (TooLarge).
     Result<EncodedImage> sweep(const std::string& id, const SweepParams& params);
+
+    // --- 3D view helpers (service_view.cpp)
+    /// Where the camera should look to frame placement `pid` (the editor's F): {placement,
+    /// target: [x, y, z] (the posed surface point at the footprint's centre, or the centre of the
+    /// posed skin inside the footprint when no triangle lies under the centre), radius (of the
+    /// posed skin inside the footprint), distance (that fits a sphere of 1.5 × radius in a
+    /// square frame's 30° field of view), hit (a triangle lies under the centre)}; the pose is
+    /// the frame's (params: time, revision, preview). NotFound "placement"; InvalidArgument
+    /// "placement" when no skin lies inside the footprint or the model has no UVs.
+    Result<nlohmann::json> focus(const std::string& id, const std::string& pid, const FrameParams& params);
+    /// An animated WebP (lossy, looping) of the range of motion of a placement: see
+    /// TurntableParams. Holds one render-queue slot for every frame. Fails: NotFound
+    /// "placement"; InvalidArgument "frames", "size", "fps" out of range; TooLarge "size" over
+    /// the render-side limit; like frame() otherwise.
+    Result<EncodedImage> turntable(const std::string& id, const TurntableParams& params);
 
     // --- renders
     /// A frame of scene `id` with `params`' overrides; `patternsOff`, `only` (unknown ids fail,

@@ -22,6 +22,7 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     o.yaw = p.yaw;
     o.pitch = p.pitch;
     o.distance = p.distance;
+    o.target = p.target;
     o.time = p.time;
     o.view = p.view;
     RenderLimits rl;
@@ -31,11 +32,50 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     return planned;
 }
 
-Result<Image8> Service::State::renderImage(const Snapshot& snap, const FrameParams& p) {
+namespace {
+
+/// The outlines `p` asks for, from the snapshot's placements (previews applied): the highlighted
+/// ones as selected, the hovered one, the brush. Unknown ids fail (field highlight / hover).
+Result<std::vector<FrameOutline>> outlinesOf(const Scene& scene, const FrameParams& p) {
+    std::vector<FrameOutline> out;
+    auto add = [&](const std::string& pid, FrameOutline::Kind kind, const char* field) -> Status {
+        for (const Placement& pl : scene.placements)
+            if (pl.id == pid) {
+                out.push_back({glm::vec2(static_cast<float>(pl.center[0]), static_cast<float>(pl.center[1])),
+                               glm::vec2(static_cast<float>(pl.scale[0]), static_cast<float>(pl.scale[1])),
+                               static_cast<float>(pl.rotation), kind});
+                return Ok{};
+            }
+        return bad(field, "no placement \"" + pid + "\" in the scene");
+    };
+    for (const std::string& pid : p.highlight)
+        if (auto s = add(pid, FrameOutline::Selected, "highlight"); !s) return s.error();
+    if (!p.hover.empty())
+        if (auto s = add(p.hover, FrameOutline::Hovered, "hover"); !s) return s.error();
+    if (p.brush) {
+        const auto& b = *p.brush;
+        out.push_back({glm::vec2(static_cast<float>(b[0]), static_cast<float>(b[1])),
+                       glm::vec2(static_cast<float>(b[2]), static_cast<float>(b[3])),
+                       static_cast<float>(b[4]), FrameOutline::Brush});
+    }
+    return out;
+}
+
+} // namespace
+
+Result<Image8> Service::State::renderImage(const Snapshot& snap, const FrameParams& p,
+                                           std::optional<std::array<double, 4>>* camera) {
     auto plan = this->plan(snap, p);
     if (!plan) return plan.error();
-    auto result = renderer->renderFrame(frameRequest(*plan, snap.model));
+    auto outlines = outlinesOf(snap.scene, p);
+    if (!outlines) return outlines.error();
+    FrameRequest request = frameRequest(*plan, snap.model);
+    request.outlines = std::move(*outlines);
+    auto result = renderer->renderFrame(request);
     if (!result) return result.error();
+    if (camera)
+        *camera = std::array<double, 4>{result->cameraDistance, result->cameraTarget.x,
+                                        result->cameraTarget.y, result->cameraTarget.z};
     return std::move(result->image);
 }
 
@@ -102,9 +142,9 @@ Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string
 }
 
 Result<EncodedImage> Service::State::render(const Snapshot& snap, const FrameParams& p) {
-    auto image = renderImage(snap, p);
-    if (!image) return image.error();
     EncodedImage out;
+    auto image = renderImage(snap, p, &out.camera);
+    if (!image) return image.error();
     out.backend = renderer->info().backend;
     auto bytes = p.format == "jpeg"   ? encodeJpeg(*image, 90)
                  : p.format == "webp" ? encodeWebpLossless(*image, false)
@@ -132,6 +172,7 @@ Error asParamError(Error e, const FrameParams& p) {
                {"/render/camera/yaw", "yaw", p.yaw.has_value()},
                {"/render/camera/pitch", "pitch", p.pitch.has_value()},
                {"/render/camera/distance", "distance", p.distance.has_value()},
+               {"/render/camera/target", "target", p.target.has_value()},
                {"/pose/time", "time", p.time.has_value()}};
     for (const auto& m : map)
         if (m.given && e.field == m.field) {
@@ -154,8 +195,12 @@ Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p)
     return img;
 }
 
-Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams& p,
+Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams& given,
                                         const std::string& against) {
+    FrameParams p = given; // a heat map of the patterns: outlines would only add noise
+    p.highlight.clear();
+    p.hover.clear();
+    p.brush.reset();
     FrameParams other = p;
     if (against == "off") {
         other.patternsOff = true;
@@ -177,7 +222,8 @@ Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams
     if (!a) return a.error();
     auto b = state_->frameSnapshot(id, other);
     if (!b) return b.error();
-    auto ia = state_->renderImage(*a, p);
+    std::optional<std::array<double, 4>> camera;
+    auto ia = state_->renderImage(*a, p, &camera);
     if (!ia) return asParamError(ia.error(), p);
     auto ib = state_->renderImage(*b, other);
     if (!ib) return asParamError(ib.error(), other);
@@ -203,6 +249,7 @@ Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams
     out.contentType = "image/png";
     out.backend = state_->renderer->info().backend;
     out.changedPixels = changed;
+    out.camera = camera;
     return out;
 }
 

@@ -223,8 +223,10 @@ struct Service::State {
     /// The snapshot a frame with `p` shows: the current document or p.revision's, with
     /// p.patternsOff / p.only applied to the placements' `enabled`.
     Result<Snapshot> frameSnapshot(const std::string& id, const FrameParams& p) const;
-    /// Plans and renders one frame of `snap` with `p`'s overrides (not encoded).
-    Result<Image8> renderImage(const Snapshot& snap, const FrameParams& p);
+    /// Plans and renders one frame of `snap` with `p`'s overrides and outlines (not encoded);
+    /// `camera` (when given) receives the camera used: distance, target x, y, z.
+    Result<Image8> renderImage(const Snapshot& snap, const FrameParams& p,
+                               std::optional<std::array<double, 4>>* camera = nullptr);
     /// The frame plan of `snap` with `p`'s overrides (errors name the parameters).
     Result<FramePlan> plan(const Snapshot& snap, const FrameParams& p) const;
     /// Plans and renders one frame of `snap` with `p`'s overrides; encodes it.

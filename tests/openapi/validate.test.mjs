@@ -305,6 +305,12 @@ try {
   const sheet = await api("GET", "/scenes/{id}/sweep", { params: { id }, query: "placement=elbow_l&steps=4&size=48", expect: 200 });
   assert.ok(isPng(sheet.bytes));
   await api("GET", "/scenes/{id}/sweep", { params: { id }, query: "placement=elbow_l&steps=0", expect: 422 });
+  // the 3D view: focus (the editor's F) and the turntable (an animated WebP)
+  const focus = (await api("GET", "/scenes/{id}/focus", { params: { id }, query: "placement=elbow_l&time=0.5", expect: 200 })).json();
+  await api("GET", "/scenes/{id}/focus", { params: { id }, query: "placement=nope", expect: 404 });
+  const turntable = await api("GET", "/scenes/{id}/turntable", { params: { id }, query: `placement=elbow_l&frames=4&size=64&target=${focus.target.join(",")}&distance=${focus.distance}`, expect: 200 });
+  assert.equal(turntable.bytes.subarray(8, 12).toString(), "WEBP");
+  await api("GET", "/scenes/{id}/turntable", { params: { id }, query: "placement=elbow_l&frames=2", expect: 422 });
   const noTexture = await api("GET", "/models/{id}/texture", { params: { id: "builtin:default" }, expect: 404 });
   assert.equal(noTexture.json().error.code, "no_texture");
   const byUv = await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=0.29&v=0.737", expect: 200 });

@@ -1,15 +1,18 @@
-// 3D view: the server's frames of the scene. Drag orbits (yaw, pitch), the wheel zooms
-// (distance); click selects the placement under the pointer (pick → UV → footprint), and with the
-// place tool (P, or Alt+click) creates one there with the suggested driver. View modes shaded /
-// bump / displacement / normal; compare with a split slider, flicker, or the diff heat map against
-// "patterns off" or a chosen revision.
+// 3D view: the server's frames of the scene. The camera (orbit, pan, zoom to the cursor, frame
+// the selection, hover and brush outlines) is camera3d.js; click selects the placement under the
+// pointer (pick → UV → footprint), and with the place tool (P, or Alt+click) creates one there with
+// the suggested driver. The selection is outlined on the skin (frame `highlight`), the hovered
+// placement too (`hover`), and the place tool's brush (`brush`). View modes shaded / bump /
+// displacement / normal; compare with a split slider, flicker, or the diff heat map against
+// "patterns off" or a chosen revision (compare images carry no outlines). The bar's Turntable
+// button shows the selection's range of motion as an animated WebP (GET turntable).
 //
 // While a drag runs in the texture view, frames preview the dragged placement (the frame route's
 // `preview`: nothing stored) at each pointer move, with MSAA off; the edits go to the server at
 // their own pace. Frames are coalesced: one request in flight per image, the newest wanted URL wins when it ends,
 // and a frame never replaces a newer one; a frame slower than 500 ms shows a spinner.
 
-import { store, on, set, emit, shownTime, whenIdle } from "./store.js";
+import { store, on, set, emit, shownTime, whenIdle, placementById } from "./store.js";
 import { API, query } from "./api.js";
 import * as geo from "./geometry.js";
 import { notify } from "./notice.js";
@@ -17,6 +20,7 @@ import { addPlacement } from "./edits.js";
 import { placementFromPattern } from "./placing.js";
 import { trace } from "./trace.js";
 import { frameFormat } from "./frame_format.js";
+import { initCamera, noteFrameCamera, pointer, frameSelection } from "./camera3d.js";
 
 let api, stage, img, cmpImg, spinner, splitHandle, sizeSelect;
 let flickerTimer = null;
@@ -54,6 +58,7 @@ class FrameLoader {
     try {
       const r = await api.raw("GET", job.url);
       const changed = r.headers.get("X-Dermis-Changed-Pixels");
+      if (this.onCamera) this.onCamera(r.headers);
       const blob = await r.blob();
       if (job.seq > this.shownSeq) {
         const objectUrl = URL.createObjectURL(blob);
@@ -88,22 +93,26 @@ export function initFrameView(section, theApi) {
       <label><span class="lbl">View</span> <select id="viewMode" aria-label="view mode" title="View mode">
         <option value="shaded">shaded</option><option value="bump">bump</option>
         <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
-      <label><span class="lbl">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame">
+      <label><span class="lbl keep">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame: split, flicker, or a diff heat map">
         <option value="off">off</option><option value="split">split</option>
-        <option value="flicker">flicker</option><option value="diff">diff heat map</option></select></label>
-      <label id="compareAgainstLabel" hidden>against <select id="compareAgainst" aria-label="compare against"><option value="off">patterns off</option></select></label>
-      <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
+        <option value="flicker">flicker</option><option value="diff" title="diff heat map">diff</option></select></label>
+      <span class="comparebits">
+        <label id="compareAgainstLabel" hidden><span class="lbl">against</span> <select id="compareAgainst" aria-label="compare against" title="Compare against"><option value="off">patterns off</option></select></label>
+        <input id="split" type="range" min="0" max="1" step="0.01" value="0.5" aria-label="split position" hidden>
+        <span id="diffText" class="badge" title="pixels that differ" hidden></span>
+      </span>
       <button type="button" id="placeTool" aria-pressed="false" title="Place tool (P): click the model to add a placement there">Place</button>
       <div class="more" id="viewMoreWrap">
-        <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: frame size, reset camera">⋯</button>
+        <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: frame size, reset camera, frame the selection, turntable">⋯</button>
         <div class="moremenu" id="viewMoreMenu" role="group" aria-label="more 3D view settings">
           <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
-          <button type="button" id="resetCamera" title="Reset the camera">Reset</button>
+          <button type="button" id="resetCamera" title="Reset the camera (orbit about the whole character)">Reset</button>
+          <button type="button" id="frameSelection" title="Frame the selection (F): centre and zoom on the selected placement's skin" disabled>Frame</button>
+          <button type="button" id="turntable" title="Turntable: the selection's range of motion (θmin → θmax → θmin) while the camera turns, as an animated WebP" disabled>Turntable</button>
         </div>
       </div>
-      <span id="diffText" class="badge" hidden></span>
     </div>
-    <div class="stage" id="frameStage" tabindex="0" aria-label="3D view: drag to orbit, wheel to zoom, click to select">
+    <div class="stage" id="frameStage" tabindex="0" aria-label="3D view: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom at the pointer, F frames the selection, click to select">
       <img id="frame" alt="" draggable="false">
       <img id="compareFrame" alt="" draggable="false" hidden>
       <div class="split-handle" hidden></div>
@@ -126,6 +135,7 @@ export function initFrameView(section, theApi) {
     if (store.compare.mode === "diff") document.getElementById("diffText").textContent = `${img.dataset.changedPixels || "?"} px changed`;
     img.dataset.seq = String(job.seq);
   });
+  mainLoader.onCamera = noteFrameCamera;
   cmpLoader = new FrameLoader(cmpImg);
   const $ = (id) => section.querySelector("#" + id);
   $("viewMode").onchange = (e) => set({ view: e.target.value });
@@ -134,10 +144,21 @@ export function initFrameView(section, theApi) {
   $("split").oninput = (e) => { store.compare.split = +e.target.value; layoutCompare(); };
   sizeSelect.onchange = () => { frameSize = +sizeSelect.value; refresh(); };
   $("placeTool").onclick = () => setPlaceTool(!placeTool);
-  $("resetCamera").onclick = () => set({ camera: { yaw: 0, pitch: 10, distance: null } });
+  $("resetCamera").onclick = () => set({ camera: { yaw: 0, pitch: 10, distance: null, target: null } });
+  $("frameSelection").onclick = () => frameSelection(frameParams()).catch((e) => notify(`Frame: ${e.message}`, "error"));
+  $("turntable").onclick = () => openTurntable();
   initMoreMenu($("viewMoreWrap"));
-  orbit(stage);
-  on("doc revision camera view compare solo time pinnedRevision gestures drag", () => {
+  initCamera(stage, api, {
+    framePixel, displaySide, pick: pickAt, params: frameParams, placeTool: () => placeTool,
+    brushSize: () => (currentPattern() ? [0.08, 0.08] : null), // placementFromPattern's footprint
+    onClick: click, onChange: refresh, onError: (e) => notify(`Frame: ${e.message}`, "error"),
+  });
+  on("selection doc scene", () => {
+    const has = store.selection.some((id) => placementById(id));
+    $("frameSelection").disabled = !has;
+    $("turntable").disabled = !has;
+  });
+  on("doc revision camera view compare solo time pinnedRevision gestures drag selection", () => {
     $("viewMode").value = store.view;
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
@@ -157,7 +178,7 @@ function initMoreMenu(wrap) {
   const open = (yes, focusBack = false) => {
     wrap.classList.toggle("open", yes);
     button.setAttribute("aria-expanded", String(yes));
-    if (yes) wrap.querySelector(".moremenu select, .moremenu button")?.focus();
+    if (yes) wrap.querySelector(".moremenu select:not(:disabled), .moremenu button:not(:disabled)")?.focus();
     else if (focusBack) button.focus();
   };
   button.onclick = () => open(!wrap.classList.contains("open"));
@@ -183,6 +204,7 @@ export const placeToolOn = () => placeTool;
 
 export function setPlaceTool(onOff) {
   placeTool = onOff;
+  if (!onOff && pointer.brush) { pointer.brush = null; refresh(); }
   document.getElementById("placeTool").setAttribute("aria-pressed", String(onOff));
   stage.style.cursor = onOff ? "copy" : "";
   showPlaceHint();
@@ -199,31 +221,38 @@ function showPlaceHint() {
                        : "Place tool: choose a pattern in the library first · P or Esc to stop";
 }
 
-/// The frame parameters this view shows (shared by frame, compare, diff and pick).
-export function frameParams() {
+/// The frame parameters this view shows (shared by frame, compare, diff and pick); `outlines`
+/// false leaves out the selection, hover and brush outlines (compare images, diff, pick).
+export function frameParams(outlines = true) {
   const c = store.camera;
+  const selected = store.doc ? store.selection.filter((id) => placementById(id)).slice(0, 6) : [];
+  const hover = pointer.hover && placementById(pointer.hover) && !selected.includes(pointer.hover) ? pointer.hover : undefined;
   return {
     width: frameSize, height: frameSize,
     msaa: store.gestures > 0 ? 1 : undefined, // while dragging: quicker frames; the scene's MSAA after
     format: frameFormat(store.gestures > 0), // JPEG previews while dragging, lossless after (frame_format.js)
     yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined,
+    target: c.target ? c.target.join(",") : undefined,
     time: shownTime(),
     view: store.view === "shaded" ? undefined : store.view,
     only: store.solo.length ? store.solo.join(",") : undefined,
     revision: store.pinnedRevision ?? store.revision,
     preview: previewSource() ? JSON.stringify(previewSource()) : undefined,
+    highlight: outlines && selected.length ? selected.join(",") : undefined,
+    hover: outlines ? hover : undefined,
+    brush: outlines && placeTool && pointer.brush ? pointer.brush.join(",") : undefined,
   };
 }
 
 /// The URL (under /api/v1) of the frame this view shows now.
 export function frameUrl() {
-  return `/scenes/${store.sceneId}/frame${query(frameParams())}`;
+  return `/scenes/${store.sceneId}/frame${query(frameParams(store.compare.mode === "off"))}`;
 }
 
 export function refresh() {
   if (!store.sceneId || !store.doc) return;
-  const p = frameParams();
   const cmp = store.compare;
+  const p = frameParams(cmp.mode === "off");
   const against = cmp.against === "off" ? { patterns: "off" } : { revision: +cmp.against };
   if (cmp.mode === "diff") {
     mainLoader.load(`/scenes/${store.sceneId}/frame-diff${query({ ...p, against: cmp.against })}`);
@@ -278,45 +307,17 @@ function framePixel(e) {
   return [Math.floor(x), Math.floor(y)];
 }
 
-function orbit(el) {
-  let start = null;
-  el.addEventListener("pointerdown", (e) => {
-    if (e.button !== 0) return;
-    el.focus();
-    start = { x: e.clientX, y: e.clientY, yaw: store.camera.yaw, pitch: store.camera.pitch, moved: false };
-    el.setPointerCapture(e.pointerId);
-  });
-  el.addEventListener("pointermove", (e) => {
-    if (store.compare.mode === "split" && !start) {
-      const r = el.getBoundingClientRect();
-      if (e.buttons === 0 && e.shiftKey) { store.compare.split = (e.clientX - r.left) / r.width; layoutCompare(); }
-    }
-    if (!start) return;
-    const dx = e.clientX - start.x, dy = e.clientY - start.y;
-    if (!start.moved && Math.hypot(dx, dy) < 4) return;
-    start.moved = true;
-    const yaw = geo.wrapDegrees(start.yaw - dx * 0.5);
-    const pitch = Math.max(-85, Math.min(85, start.pitch + dy * 0.4));
-    set({ camera: { ...store.camera, yaw: Math.round(yaw * 10) / 10, pitch: Math.round(pitch * 10) / 10 } });
-  });
-  el.addEventListener("pointerup", (e) => {
-    const s = start;
-    start = null;
-    if (s && !s.moved) click(e);
-  });
-  el.addEventListener("wheel", (e) => {
-    e.preventDefault();
-    const d = store.camera.distance ?? (store.liveCamera && store.liveCamera.distance) ?? 3;
-    const next = Math.min(Math.max(d * Math.exp(e.deltaY * 0.001), 0.05), 1000);
-    set({ camera: { ...store.camera, distance: Math.round(next * 1000) / 1000 } });
-  }, { passive: false });
+/// The side of the frame on screen in CSS pixels (object-fit: contain, square frames).
+function displaySide() {
+  const r = img.getBoundingClientRect();
+  return Math.min(r.width, r.height) || frameSize;
 }
 
 /// The pick answer at a frame pixel of this view.
 export function pickAt(x, y) {
   const p = frameParams();
   return api.get(`/scenes/${store.sceneId}/pick${query({ x, y, width: p.width, height: p.height, yaw: p.yaw,
-                                                             pitch: p.pitch, distance: p.distance, time: p.time })}`);
+                                                             pitch: p.pitch, distance: p.distance, target: p.target, time: p.time })}`);
 }
 
 async function click(e) {
@@ -333,6 +334,34 @@ async function click(e) {
   const p = geo.hit(store.doc.placements, hit.uv);
   if (p) set({ selection: [p.id] });
   else notify(`No placement at UV (${hit.uv[0].toFixed(3)}, ${hit.uv[1].toFixed(3)}); skin of ${hit.joints.map((j) => j.name).join(", ")}. Use the place tool (P) to add one here.`, "info");
+}
+
+/// The turntable of the selected placement (GET turntable: an animated WebP of its driver swept
+/// θmin → θmax → θmin while the camera turns once about the current target) in a dialog, with a
+/// link that downloads it.
+export function openTurntable() {
+  const pid = store.selection.find((id) => placementById(id));
+  if (!pid) return notify("Select a placement first: the turntable shows its range of motion.", "warn");
+  const c = store.camera;
+  const url = `${API}/scenes/${store.sceneId}/turntable${query({ placement: pid, frames: 36, size: 320,
+    yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined, target: c.target ? c.target.join(",") : undefined,
+    time: shownTime(), revision: store.pinnedRevision ?? undefined, view: store.view === "shaded" ? undefined : store.view })}`;
+  let dlg = document.getElementById("turntableDialog");
+  if (!dlg) {
+    dlg = document.createElement("dialog");
+    dlg.id = "turntableDialog";
+    dlg.setAttribute("aria-label", "turntable");
+    document.body.appendChild(dlg);
+  }
+  const p = placementById(pid);
+  dlg.innerHTML = `<h2>Turntable of ${escapeHtml(pid)}: ${escapeHtml(p.joint)} ${escapeHtml(String(p.axis))} ${p.theta_min}° → ${p.theta_max}° → ${p.theta_min}°</h2>
+    <div class="turntable"><div class="spinner"></div><img alt="turntable of ${escapeHtml(pid)}" hidden></div>
+    <form method="dialog"><a id="turntableDownload" href="${url}" download="turntable-${escapeHtml(pid)}.webp" title="Download the animated WebP">Download .webp</a> <button>Close</button></form>`;
+  const image = dlg.querySelector("img");
+  image.onload = () => { image.hidden = false; dlg.querySelector(".spinner").remove(); };
+  image.onerror = () => { dlg.querySelector(".spinner")?.remove(); notify("The turntable could not be rendered.", "error"); };
+  image.src = url;
+  dlg.showModal();
 }
 
 let currentPattern = () => null;

@@ -26,6 +26,7 @@ export const SHORTCUTS = [
   ["H", "hide / show (enabled)"],
   ["S", "solo in the 3D view"],
   ["P", "place tool: click the model in 3D to add a placement there"],
+  ["F", "frame the selection in the 3D view (drag orbits about it; Shift+drag or middle drag pans; the wheel zooms at the pointer)"],
   ["Tab", "switch texture / 3D (in the views)"],
   ["T / V / L", "go to the texture view / the 3D view / the placements list"],
   ["Space", "play / pause the clip"],

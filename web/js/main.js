@@ -49,7 +49,7 @@ async function openScene(id, link = {}) {
   const layout = model.has_uvs ? await api.get(`/models/${encodeURIComponent(model.id)}/uv-layout`) : null;
   clearUndo();
   store.presence.clear();
-  const camera = { yaw: link.yaw ?? 0, pitch: link.pitch ?? 10, distance: link.distance ?? null };
+  const camera = { yaw: link.yaw ?? 0, pitch: link.pitch ?? 10, distance: link.distance ?? null, target: link.target ?? null };
   if (link.yaw === undefined && answer.scene.render && answer.scene.render.camera) {
     const c = answer.scene.render.camera;
     if (typeof c.yaw === "number") camera.yaw = c.yaw;

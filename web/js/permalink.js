@@ -1,5 +1,5 @@
 // Permalink: the address bar names the scene, revision, time, camera, view, frame size and
-// selection (?scene=…&revision=…&time=…&yaw=…&pitch=…&distance=…&view=…&size=…&sel=a,b).
+// selection (?scene=…&revision=…&time=…&yaw=…&pitch=…&distance=…&target=x,y,z&view=…&size=…&sel=a,b).
 // Opening such a link shows that revision's frame from that camera at that time — the same
 // frame request, so the same bytes on the same server — until the person edits or leaves it.
 
@@ -15,6 +15,8 @@ export function readLink() {
     revision: num("revision"),
     time: num("time"),
     yaw: num("yaw"), pitch: num("pitch"), distance: num("distance"),
+    target: q.get("target") && q.get("target").split(",").length === 3 && q.get("target").split(",").every((x) => x !== "" && Number.isFinite(+x))
+      ? q.get("target").split(",").map(Number) : undefined,
     view: q.get("view") || undefined,
     size: num("size"),
     selection: q.get("sel") ? q.get("sel").split(",").filter(Boolean) : undefined,
@@ -31,6 +33,7 @@ export function currentLink() {
   q.set("yaw", String(store.camera.yaw));
   q.set("pitch", String(store.camera.pitch));
   if (store.camera.distance !== null) q.set("distance", String(store.camera.distance));
+  if (store.camera.target) q.set("target", store.camera.target.join(","));
   if (store.view !== "shaded") q.set("view", store.view);
   q.set("size", String(frameSize));
   if (store.selection.length) q.set("sel", store.selection.join(","));

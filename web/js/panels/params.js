@@ -9,6 +9,7 @@ import { patchPlacement, patchPose, mirrorPlacement } from "../edits.js";
 import { height, normalizedT } from "../deform.js";
 import { escapeHtml } from "./library.js";
 import { query } from "../api.js";
+import { openSweep } from "../sweep_view.js";
 import { notify } from "../notice.js";
 
 let api, box, drivers = new Map(), driversKey = "";
@@ -204,12 +205,5 @@ function drawPlot(c, p, theta) {
   }
 }
 
-/// The sweep contact sheet of p's driver range in a dialog.
-export async function openSweep(p) {
-  const dlg = document.getElementById("sweepDialog");
-  const url = `/api/v1/scenes/${store.sceneId}/sweep${query({ placement: p.id, steps: 8, size: 192 })}`;
-  dlg.innerHTML = `<h2>Sweep of ${escapeHtml(p.id)}: ${escapeHtml(p.joint)} ${p.axis} from ${p.theta_min}° to ${p.theta_max}°</h2>
-    <img alt="sweep contact sheet of ${escapeHtml(p.id)}" src="${url}"><form method="dialog"><button>Close</button></form>`;
-  dlg.querySelector("img").onerror = () => notify("The sweep could not be rendered.", "error");
-  dlg.showModal();
-}
+/// The sweep contact sheet of p's driver range in a dialog (sweep_view.js: the 3D view's camera).
+export { openSweep };
