@@ -22,6 +22,59 @@ namespace {
 class RendersHttpTest : public SharedServerTest {};
 
 // ================================================================================================
+// Frames with their parameters in a POST body (issue #27, item 8)
+// ================================================================================================
+
+std::string percentEncoded(const std::string& s) {
+    std::string out;
+    char buf[4];
+    for (unsigned char c : s) {
+        if (std::isalnum(c) || c == '-' || c == '_' || c == '.') out += static_cast<char>(c);
+        else {
+            std::snprintf(buf, sizeof buf, "%%%02X", c);
+            out += buf;
+        }
+    }
+    return out;
+}
+
+TEST_F(RendersHttpTest, PostFrameTakesAPreviewTooLargeForTheRequestLine) {
+    Http h = http();
+    json doc = smallScene();
+    doc["placements"] = json::array();
+    for (int k = 0; k < 24; ++k) doc["placements"].push_back(placementOf("crease", "p" + std::to_string(k)));
+    const std::string id = createScene(doc);
+    // A small preview: GET and POST give the same bytes, and not the plain frame's.
+    const json small = {{"p3", {{"center", {0.35, 0.42}}}}};
+    Reply get = h.get("/scenes/" + id + "/frame?msaa=1&preview=" + percentEncoded(small.dump()));
+    Reply post = h.post("/scenes/" + id + "/frame", {{"msaa", 1}, {"preview", small}});
+    ASSERT_EQ(get.status, 200) << get;
+    ASSERT_EQ(post.status, 200) << post;
+    EXPECT_EQ(post.header("Content-Type"), "image/png");
+    EXPECT_EQ(get.body, post.body) << "one parser for both";
+    // Every placement disabled in the preview: the frame without patterns, byte for byte.
+    json off = json::object();
+    for (int k = 0; k < 24; ++k) off["p" + std::to_string(k)] = {{"enabled", false}};
+    Reply none = h.post("/scenes/" + id + "/frame", {{"msaa", 1}, {"preview", off}});
+    Reply patternsOff = h.get("/scenes/" + id + "/frame?msaa=1&patterns=off");
+    ASSERT_EQ(none.status, 200) << none;
+    EXPECT_EQ(none.body, patternsOff.body) << "the preview was applied";
+    // A 4 KB preview is over 8 KB percent-encoded: the GET is refused (414), the POST renders.
+    json large = json::object();
+    for (int k = 0; k < 24; ++k)
+        large["p" + std::to_string(k)] = {{"label", std::string(120, '/')}, {"center", {0.3 + 0.01 * k, 0.4}}};
+    ASSERT_GT(percentEncoded(large.dump()).size(), 8192u);
+    ASSERT_LT(large.dump().size(), 16384u);
+    EXPECT_EQ(h.get("/scenes/" + id + "/frame?preview=" + percentEncoded(large.dump())).status, 414);
+    Reply big = h.post("/scenes/" + id + "/frame", {{"preview", large}, {"format", "jpeg"}, {"target", {0, 1, 0}}});
+    ASSERT_EQ(big.status, 200) << big;
+    EXPECT_EQ(big.header("Content-Type"), "image/jpeg");
+    expectError(h.post("/scenes/" + id + "/frame", {{"bogus", 1}}), 422, "/bogus");
+    expectError(h.post("/scenes/" + id + "/frame", json::array()), 422);
+    EXPECT_EQ(h.get("/scenes/" + id).js()["revision"], 1) << "nothing stored";
+}
+
+// ================================================================================================
 // Stateless batch
 // ================================================================================================
 

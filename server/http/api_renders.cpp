@@ -5,6 +5,8 @@
 // the Service to the renderer's thread (a full queue answers 503 + Retry-After).
 #include "http/api_internal.hpp"
 
+#include <set>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -195,10 +197,62 @@ bool sweepParams(const Req& req, Res& res, SweepParams& s) {
 
 } // namespace
 
+namespace {
+
+/// The parameters of a POST frame: its JSON body's members, each as the query parameter of the
+/// same name would give it (strings as they are, numbers and objects as JSON, arrays of numbers
+/// comma-separated), so that one parser (frameParams) reads both. False (and 422 sent) for
+/// anything else than an object of known members.
+bool framePostParams(const Req& req, Res& res, Req& out) {
+    static const std::set<std::string> known = {"format", "width", "height", "msaa", "yaw", "pitch",
+                                                "distance", "time", "target", "highlight", "hover",
+                                                "brush", "view", "patterns", "only", "preview", "revision"};
+    json body;
+    if (!jsonBody(req, res, body)) return false;
+    if (!body.is_object()) {
+        sendError(res, 422, "invalid_argument", "dermis::Api: body: a JSON object of frame parameters", "");
+        return false;
+    }
+    out.params.clear();
+    for (auto it = body.begin(); it != body.end(); ++it) {
+        if (!known.count(it.key())) {
+            sendError(res, 422, "invalid_argument", "dermis::Api: /" + it.key() + ": not a frame parameter", "/" + it.key());
+            return false;
+        }
+        const json& v = it.value();
+        std::string text;
+        if (v.is_string()) text = v.get<std::string>();
+        else if (v.is_array()) {
+            for (const json& x : v) {
+                if (!x.is_number() && !x.is_string()) {
+                    sendError(res, 422, "invalid_argument", "dermis::Api: /" + it.key() + ": numbers or ids", "/" + it.key());
+                    return false;
+                }
+                text += (text.empty() ? "" : ",") + (x.is_string() ? x.get<std::string>() : x.dump());
+            }
+        } else text = v.dump();
+        out.params.emplace(it.key(), std::move(text));
+    }
+    return true;
+}
+
+} // namespace
+
 void installRenderRoutes(RouteTable& t) {
     t.add("GET", "/scenes/{id}/frame", [](Api::Impl& a, const Req& req, Res& res) {
         FrameParams p;
         if (!frameParams(req, res, p)) return;
+        auto r = a.svc.frame(req.matches[1], p);
+        if (!r) return sendError(res, r.error());
+        sendFrame(res, std::move(*r));
+    });
+    // The same frame with its parameters in a JSON body: a preview (up to 16 KB) need not fit the
+    // 8 KB request line. Nothing is stored.
+    t.add("POST", "/scenes/{id}/frame", [](Api::Impl& a, const Req& req, Res& res) {
+        Req q;
+        if (!framePostParams(req, res, q)) return;
+        FrameParams p;
+        if (!frameParams(q, res, p)) return;
         auto r = a.svc.frame(req.matches[1], p);
         if (!r) return sendError(res, r.error());
         sendFrame(res, std::move(*r));

@@ -56,7 +56,7 @@ class FrameLoader {
     clearTimeout(this.slowTimer);
     this.slowTimer = setTimeout(() => { spinner.hidden = false; }, 500);
     try {
-      const r = await api.raw("GET", job.url);
+      const r = await fetchFrame(job.url);
       const changed = r.headers.get("X-Dermis-Changed-Pixels");
       if (this.onCamera) this.onCamera(r.headers);
       const blob = await r.blob();
@@ -245,6 +245,16 @@ export function frameParams(outlines = true) {
 }
 
 /// The URL (under /api/v1) of the frame this view shows now.
+/// GETs a frame URL; a /frame URL too long for the server's 8 KB request line (a large preview)
+/// goes as POST /frame with the same parameters in a JSON body — the same bytes come back.
+function fetchFrame(url) {
+  if (url.length <= 6000 || !/\/frame\?/.test(url)) return api.raw("GET", url);
+  const [path, q] = url.split("?");
+  const body = {};
+  for (const [k, v] of new URLSearchParams(q)) body[k] = k === "preview" ? JSON.parse(v) : v;
+  return api.raw("POST", path, { body });
+}
+
 export function frameUrl() {
   return `/scenes/${store.sceneId}/frame${query(frameParams(store.compare.mode === "off"))}`;
 }
