@@ -136,9 +136,12 @@ private:
 
 /// Who makes an edit and which revision it was based on (SPEC §6 Concurrency).
 struct EditContext {
-    /// The revision the client read (If-Match: "r<N>"); when set and not the scene's current
-    /// revision, the edit fails with ErrorCode::StaleRevision (Error::currentRevision set) and
-    /// nothing changes. Unset: the edit applies to whatever is current.
+    /// The revision the client read (If-Match: "r<N>"). When set and older than the scene's
+    /// current revision, an edit of one placement, of the pose or of the order applies only when
+    /// that is the same in N as now (and a new placement unless its given id came or went since
+    /// N): the server rebases it; otherwise, and always for whole-document edits (PUT, revert,
+    /// delete), it fails with ErrorCode::StaleRevision (Error::currentRevision set) and nothing
+    /// changes. Unset: the edit applies to whatever is current.
     std::optional<std::uint64_t> ifMatch;
     /// X-Dermis-Client: recorded in the history and carried by events. ≤ 64 printable ASCII
     /// characters ("" = not named); checked by the HTTP layer (checkClientName).
@@ -318,8 +321,14 @@ public:
 
     // --- renders
     /// A frame of scene `id` with `params`' overrides; `patternsOff`, `only` (unknown ids fail,
-    /// field "only") and `revision` (NotFound, field "revision") choose what it shows.
+    /// field "only") and `revision` (NotFound, field "revision") choose what it shows. The
+    /// current revision and the 15 before it render from the scene validated
+    /// when they were committed; an older revision's document is read and validated again
+    /// (Conflict when it no longer renders: a pattern or model it names was deleted since).
     Result<EncodedImage> frame(const std::string& id, const FrameParams& params);
+    /// How many frames, sweeps and driver answers so far parsed and validated their scene again
+    /// from a document (an older revision, a preview) instead of taking the cached one. For tests.
+    std::uint64_t framesPrepared() const;
     /// PNG heat map of the per-pixel difference between the frame `params` describe and the same
     /// frame `against` "off" (no dynamic patterns) or a revision number (SPEC §6 Compare): black
     /// where equal, red → yellow → white as the largest channel difference grows;
