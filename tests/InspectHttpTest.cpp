@@ -61,6 +61,16 @@ TEST_F(InspectHttpTest, ProbeAndActivation) {
 
 TEST_F(InspectHttpTest, LintFindsOverlapsAndUnusedUploads) {
     Http h = http();
+    // The shipped default scene has no warnings (unused uploads of other tests are info only).
+    Reply defaults = h.post("/scenes", {{"default_patterns", true}});
+    ASSERT_EQ(defaults.status, 201) << defaults;
+    const std::string ds = "/scenes/" + defaults.js()["id"].get<std::string>();
+    Reply defaultLint = h.get(ds + "/lint");
+    ASSERT_EQ(defaultLint.status, 200) << defaultLint;
+    for (const json findings = defaultLint.js(); const json& f : findings)
+        EXPECT_NE(f["severity"], "warning") << f;
+    ASSERT_EQ(h.del(ds).status, 204);
+
     const std::string id = createScene(smallScene());
     const std::string s = "/scenes/" + id;
     Reply clean = h.get(s + "/lint");
