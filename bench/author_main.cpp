@@ -14,7 +14,8 @@
 //    renders), a 256² JPEG frame without and with ?revision= (the current one, as the editor
 //    sends it), drivers with ?revision=, mirror of the left elbow crease (its twin deleted,
 //    untimed, before each);
-//  * edit_if_match_5_behind: the same PATCH with an If-Match five revisions old (rebased);
+//  * edit_if_match_rebased: the same PATCH with an If-Match one revision old, another client
+//    having changed the pose meanwhile (rebased);
 //  * reopen_ms: Service::open of the data folder with that history.
 #include "http/api.hpp"
 #include "service/service.hpp"
@@ -195,16 +196,25 @@ int main(int argc, char** argv) {
         ++current;
         return ok(res);
     });
-    // If-Match five revisions behind, on a placement nobody else changed: rebased (the base
-    // document from the recent revisions in memory).
-    measure("edit_if_match_5_behind", [&](int r) {
-        httplib::Headers h{{"If-Match", "\"r" + std::to_string(current - 5) + "\""},
-                           {"X-Dermis-Client", "bench"}};
-        auto res = c.Patch(base + "/placements/elbow", h, json{{"h", 1.0 + r * 0.001}}.dump(),
-                           "application/json");
-        ++current;
-        return ok(res);
-    });
+    // Two clients: before each timed PATCH of the elbow (If-Match: the revision of this client's
+    // own last answer), another client changes the pose (untimed), so every If-Match is one
+    // revision behind and is rebased (the base document from the recent revisions in memory).
+    std::uint64_t mine = current;
+    measure(
+        "edit_if_match_rebased",
+        [&](int r) {
+            httplib::Headers h{{"If-Match", "\"r" + std::to_string(mine) + "\""},
+                               {"X-Dermis-Client", "bench"}};
+            auto res = c.Patch(base + "/placements/elbow", h, json{{"h", 1.0 + r * 0.001}}.dump(),
+                               "application/json");
+            if (!ok(res)) return false;
+            mine = current = json::parse(res->body)["revision"].get<std::uint64_t>();
+            return true;
+        },
+        [&](int r) {
+            c.Patch(base + "/pose", json{{"time", 0.01 * (r % 100)}}.dump(), "application/json");
+            ++current;
+        });
     measure("revert", [&](int r) {
         auto res = c.Post(base + "/revert", json{{"revision", 1 + (r * 13) % revisions}}.dump(), "application/json");
         ++current;
