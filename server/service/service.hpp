@@ -238,9 +238,12 @@ public:
                                           const nlohmann::json& patch, const EditContext& ctx = {});
     Result<nlohmann::json> deletePlacement(const std::string& id, const std::string& pid,
                                            const EditContext& ctx = {});
-    /// Adds the mirror twin of placement `pid` (SPEC §6 Mirror; core mirrorPlacement): id with its
-    /// side swapped (elbow_l → elbow_r) or "<pid>_mirror", made unique. Fails (InvalidArgument)
-    /// when the footprint centre is on no chart or the joint has no twin by name or position.
+    /// Adds the mirror twin of placement `pid` (SPEC §6 Mirror; core mirrorPlacement): id from
+    /// core mirrorPlacementId (elbow_l → elbow_r, else the twin joint's side or "_twin"), made
+    /// unique ("_2"…), label from mirrorLabel. Computed under the writer lock from the current
+    /// document. Fails: InvalidArgument when the footprint centre is on no chart or the joint
+    /// has no twin by name or position; Conflict (field "placement", the message naming it) when
+    /// the twin is in the scene already (core findMirrorTwin) or `pid` is its own twin.
     Result<nlohmann::json> mirrorPlacement(const std::string& id, const std::string& pid,
                                            const EditContext& ctx = {});
     /// `order`: every placement id once, in the new order.
