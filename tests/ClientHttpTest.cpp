@@ -264,7 +264,8 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
                       "axis=x", "theta_max=120"})
                   .out,
               sid + " r4\n");
-    ClientRun mirror = dermis({"placement", "mirror", sid, "elbow_l"});
+    // (elbow_l's twin is in the default set already: mirroring it would be a 409.)
+    ClientRun mirror = dermis({"placement", "mirror", sid, "extra"});
     EXPECT_EQ(mirror.code, 0) << mirror;
     EXPECT_EQ(dermis({"placement", "rm", sid, "extra"}).out, sid + " r6\n");
     doc = dermis({"scene", "get", sid}).js();
@@ -273,13 +274,15 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
         if (p["id"] == "elbow_l") elbow = p;
     EXPECT_EQ(elbow["h"], 1.5);
     EXPECT_EQ(elbow["label"], "left elbow");
-    EXPECT_EQ(doc["placements"].size(), 19u) << "18 + elbow_l's mirror twin";
+    EXPECT_EQ(doc["placements"].size(), 19u) << "18 + extra's mirror twin";
+    EXPECT_EQ(doc["placements"].back()["id"], "extra_r") << "named after its joint's side";
+    EXPECT_EQ(doc["placements"].back()["joint"], "forearm.r");
 
     ClientRun history = dermis({"--json", "scene", "history", sid});
     ASSERT_EQ(history.code, 0) << history;
     EXPECT_EQ(history.js()["revision"], 6);
     EXPECT_EQ(history.js()["revisions"][0]["op"], "delete placement extra");
-    EXPECT_NE(dermis({"scene", "history", sid}).out.find("mirror placement elbow_l"), std::string::npos);
+    EXPECT_NE(dermis({"scene", "history", sid}).out.find("mirror placement extra"), std::string::npos);
     EXPECT_EQ(dermis({"scene", "revert", sid, "1"}).out, sid + " r7\n");
     EXPECT_EQ(dermis({"scene", "get", sid}).js()["placements"].size(), 18u);
 

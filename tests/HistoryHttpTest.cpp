@@ -52,7 +52,14 @@ TEST_F(HistoryHttpTest, EtagsAndIfMatchGuardEveryEditRoute) {
     fresh("PUT", s, doc, 200);
     ASSERT_EQ(rev, 9u);
 
-    // The same routes with a stale ETag: 412, the current revision, nothing changed.
+    // Someone changes everything an edit can touch (r10: elbow, the pose, a new placement, the
+    // order); the same routes based on r9 conflict with it: 412, the current revision, nothing
+    // changed. (An edit of something that did not change since is rebased: EditRebaseHttpTest.)
+    json changed = doc;
+    changed["placements"] = json::array({doc["placements"][1], doc["placements"][0], placementOf("crease", "c")});
+    changed["placements"][1]["h"] = 2.5;
+    changed["pose"]["time"] = 0.75;
+    ASSERT_EQ(h.put(s, changed).status, 200);
     const json before = h.get(s).js();
     const std::vector<std::tuple<std::string, std::string, json>> edits = {
         {"POST", s + "/placements", placementOf("crease", "c")},
@@ -66,15 +73,15 @@ TEST_F(HistoryHttpTest, EtagsAndIfMatchGuardEveryEditRoute) {
         {"DELETE", s, json()},
     };
     for (const auto& [method, path, body] : edits) {
-        Reply r = send(method, path, body, ifMatch("\"r3\"", "bob"));
+        Reply r = send(method, path, body, ifMatch("\"r9\"", "bob"));
         expectError(r, 412, "If-Match");
         EXPECT_EQ(r.js()["error"]["code"], "stale_revision") << method << " " << path;
-        EXPECT_EQ(r.js()["revision"], 9) << method << " " << path;
+        EXPECT_EQ(r.js()["revision"], 10) << method << " " << path;
     }
     EXPECT_EQ(h.get(s).js(), before);
 
     // Weak, malformed and multiple ETags are refused before anything else happens: 400.
-    for (const std::string bad : {"W/\"r9\"", "r9", "\"9\"", "\"r\"", "\"r0\"", "\"r9\", \"r8\"",
+    for (const std::string bad : {"W/\"r10\"", "r10", "\"10\"", "\"r\"", "\"r0\"", "\"r10\", \"r9\"",
                                   "\"r99999999999999999999999\"", "\"r9x\""}) {
         Reply r = send("PATCH", s + "/placements/elbow", json{{"h", 3.0}}, ifMatch(bad));
         expectError(r, 400, "If-Match");
@@ -84,7 +91,7 @@ TEST_F(HistoryHttpTest, EtagsAndIfMatchGuardEveryEditRoute) {
     EXPECT_EQ(star.status, 200) << star;
     Reply plain = h.patch(s + "/pose", {{"time", 0.1}});
     EXPECT_EQ(plain.status, 200) << plain;
-    EXPECT_EQ(plain.js()["revision"], 11);
+    EXPECT_EQ(plain.js()["revision"], 12);
     // A client name longer than 64 characters or with control characters: 400.
     Reply longName = send("PATCH", s + "/pose", json{{"time", 0.0}},
                           {{"X-Dermis-Client", std::string(65, 'x')}});

@@ -61,6 +61,16 @@ TEST_F(InspectHttpTest, ProbeAndActivation) {
 
 TEST_F(InspectHttpTest, LintFindsOverlapsAndUnusedUploads) {
     Http h = http();
+    // The shipped default scene has no warnings (unused uploads of other tests are info only).
+    Reply defaults = h.post("/scenes", {{"default_patterns", true}});
+    ASSERT_EQ(defaults.status, 201) << defaults;
+    const std::string ds = "/scenes/" + defaults.js()["id"].get<std::string>();
+    Reply defaultLint = h.get(ds + "/lint");
+    ASSERT_EQ(defaultLint.status, 200) << defaultLint;
+    for (const json findings = defaultLint.js(); const json& f : findings)
+        EXPECT_NE(f["severity"], "warning") << f;
+    ASSERT_EQ(h.del(ds).status, 204);
+
     const std::string id = createScene(smallScene());
     const std::string s = "/scenes/" + id;
     Reply clean = h.get(s + "/lint");
@@ -137,11 +147,13 @@ TEST_F(InspectHttpTest, MirrorAddsTheTwinOnTheOtherSide) {
     ASSERT_TRUE(right.is_object());
     ASSERT_EQ(h.del(s + "/placements/elbow_r").status, 200);
 
-    httplib::Headers stale{{"If-Match", "\"r1\""}};
+    ASSERT_EQ(h.patch(s + "/placements/elbow_l", {{"label", "left elbow (L)"}}).status, 200); // r3
+    // Based on r2, from before that label: a conflict on the placement mirrored.
+    httplib::Headers stale{{"If-Match", "\"r2\""}};
     expectError(h.call("POST", s + "/placements/elbow_l/mirror", "", "", stale), 412, "If-Match");
     Reply m = h.call("POST", s + "/placements/elbow_l/mirror", "", "", {{"X-Dermis-Client", "ana"}});
     ASSERT_EQ(m.status, 201) << m;
-    EXPECT_EQ(m.header("ETag"), "\"r3\"");
+    EXPECT_EQ(m.header("ETag"), "\"r4\"");
     json twin;
     const json mirrored = m.js();
     for (const json& p : mirrored["scene"]["placements"])
@@ -149,13 +161,25 @@ TEST_F(InspectHttpTest, MirrorAddsTheTwinOnTheOtherSide) {
     ASSERT_TRUE(twin.is_object()) << m;
     EXPECT_EQ(twin["joint"], "forearm.r");
     EXPECT_EQ(twin["pattern"], "crease");
+    EXPECT_EQ(twin["label"], "right elbow (R)");
     const double du = (twin["center"][0].get<double>() - right["center"][0].get<double>()) * 1024;
     const double dv = (twin["center"][1].get<double>() - right["center"][1].get<double>()) * 1024;
     EXPECT_LE(std::hypot(du, dv), 2.0) << twin;
+    // Mirroring again stacks no second twin: 409 naming the one there (and the twin's own twin
+    // is the source).
     Reply again = h.call("POST", s + "/placements/elbow_l/mirror", "", "", {});
-    ASSERT_EQ(again.status, 201) << again;
-    EXPECT_EQ(again.js()["scene"]["placements"].back()["id"], "elbow_r_2");
+    expectError(again, 409, "placement");
+    EXPECT_NE(again.js()["error"]["message"].get<std::string>().find("\"elbow_r\""), std::string::npos) << again;
+    Reply back = h.call("POST", s + "/placements/elbow_r/mirror", "", "", {});
+    expectError(back, 409, "placement");
+    EXPECT_NE(back.js()["error"]["message"].get<std::string>().find("\"elbow_l\""), std::string::npos) << back;
+    EXPECT_EQ(h.get(s).header("ETag"), "\"r4\"");
     EXPECT_EQ(h.get(s + "/revisions?limit=1").js()["revisions"][0]["op"], "mirror placement elbow_l");
+    // Moved away from where the twin would be, the old one is no twin: a new one, its id unique.
+    ASSERT_EQ(h.patch(s + "/placements/elbow_r", {{"center", {0.9, 0.9}}}).status, 200);
+    Reply third = h.call("POST", s + "/placements/elbow_l/mirror", "", "", {});
+    ASSERT_EQ(third.status, 201) << third;
+    EXPECT_EQ(third.js()["scene"]["placements"].back()["id"], "elbow_r_2");
 
     // A footprint centre on no UV chart cannot be mirrored; an unknown placement is 404.
     ASSERT_EQ(h.patch(s + "/placements/stomach", {{"center", {0.995, 0.995}}, {"scale", {0.005, 0.005}}}).status, 200);

@@ -157,6 +157,14 @@ TEST_F(LintTest, TheDefaultMirrorPairsAreSymmetric) {
     for (const LintFinding& x : mirrorFindings(f)) ADD_FAILURE() << x.message;
 }
 
+TEST_F(LintTest, TheDefaultSceneLintsClean) {
+    // What a fresh server's scene shows in the editor's lint panel: nothing.
+    const auto f = lint(loaded_->scene.placements);
+    for (const LintFinding& x : f)
+        ADD_FAILURE() << x.code << " on " << loaded_->scene.placements[static_cast<std::size_t>(x.placement)].id
+                      << ": " << x.message;
+}
+
 TEST_F(LintTest, FindsAsymmetricMirrorPairs) {
     const std::vector<Placement> all = loaded_->scene.placements;
     const int left = indexOf(all, "elbow_l"), right = indexOf(all, "elbow_r");

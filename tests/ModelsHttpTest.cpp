@@ -38,7 +38,11 @@ TEST_F(ModelsHttpTest, BuiltinModelIsListedWithItsDetails) {
     ASSERT_EQ(list.status, 200) << list;
     bool found = false;
     for (const json all = list.js(); const json& m : all["models"])
-        found = found || m["id"] == "builtin:default";
+        if (m["id"] == "builtin:default") {
+            found = true;
+            EXPECT_EQ(m["joint_count"], 51) << m;
+            EXPECT_EQ(m["has_texture"], false) << m; // GET …/texture answers 404 no_texture
+        }
     EXPECT_TRUE(found) << list;
 
     Reply r = h.get("/models/builtin:default");
@@ -86,12 +90,17 @@ TEST_F(ModelsHttpTest, CesiumManUploadsInspectsAndDeletes) {
     const std::string id = created["id"];
     EXPECT_EQ(id.rfind("m_", 0), 0u) << id;
     EXPECT_EQ(created["joints"], 19);
+    // The upload answer carries what the editor needs without a second request.
+    EXPECT_EQ(created["joint_count"], 19) << created;
+    EXPECT_EQ(created["has_texture"], true) << created;
     EXPECT_EQ(created["name"].get<std::string>().find('/'), std::string::npos) << created;
 
     Reply got = h.get("/models/" + id);
     ASSERT_EQ(got.status, 200) << got;
     const json m = got.js();
     EXPECT_EQ(m["joints"].size(), 19u);
+    EXPECT_EQ(m["joint_count"], 19);
+    EXPECT_EQ(m["has_texture"], true);
     EXPECT_TRUE(m["has_uvs"].get<bool>());
     EXPECT_EQ(m["triangles"], 4672);
     EXPECT_GE(m["clips"].size(), 1u);
@@ -294,6 +303,8 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
     Reply barb = h.upload("/models", readBytes(kBarbarian), "model/gltf-binary");
     ASSERT_EQ(barb.status, 201) << barb;
     const std::string barbId = barb.js()["id"];
+    EXPECT_EQ(barb.js()["joint_count"], 41) << barb;
+    EXPECT_EQ(barb.js()["has_texture"], true) << barb;
     Reply bm = h.get("/models/" + barbId);
     ASSERT_EQ(bm.status, 200);
     EXPECT_EQ(bm.js()["joints"].size(), 41u);
@@ -318,6 +329,8 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
     ASSERT_EQ(fig.status, 201) << fig;
     const std::string figId = fig.js()["id"];
     EXPECT_FALSE(fig.js()["has_uvs"].get<bool>());
+    EXPECT_FALSE(fig.js()["has_texture"].get<bool>());
+    EXPECT_EQ(fig.js()["joint_count"], 19);
     expectError(h.get("/models/" + figId + "/uv-layout"), 422, "id");
     expectError(h.get("/models/" + figId + "/uv-layout?format=png"), 422, "id");
     json withPlacement = {{"format", "dermis.scene/1"},

@@ -3,6 +3,7 @@
 // and redo), history across a reopen and after an interrupted commit, If-Match (stale edits change
 // nothing), events carrying client/op/placement, presence broadcast and lapse.
 #include "ServiceFixture.hpp"
+#include "TwoClientEdits.hpp"
 
 #include "io/atomic_file.hpp"
 
@@ -10,6 +11,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <iostream>
 #include <fstream>
 #include <thread>
 
@@ -160,10 +162,13 @@ TEST_F(ServiceHistoryTest, HistorySurvivesReopeningAndInterruptedCommits) {
 TEST_F(ServiceHistoryTest, StaleEditsAreRefusedAndChangeNothing) {
     const std::string id = (*svc_->createScene(kEmpty))["id"];
     ASSERT_TRUE(svc_->addPlacement(id, placement("a", 0.3), EditContext{1, "alice"})); // 1 → 2
+    ASSERT_TRUE(svc_->patchPose(id, {{"time", 0.25}}, EditContext{2, "alice"}));       // 2 → 3
     auto sub = svc_->subscribe(id);
     ASSERT_TRUE(sub);
     (*sub)->next(1000); // hello
     const json before = (*svc_->getScene(id))["scene"];
+    // Based on revision 1, every edit conflicts with what changed since: placement a came, the
+    // pose changed, and whole-document edits are never rebased.
     const EditContext stale{1, "bob"};
     std::vector<Error> errors;
     auto collect = [&](auto r) {
@@ -171,32 +176,39 @@ TEST_F(ServiceHistoryTest, StaleEditsAreRefusedAndChangeNothing) {
         errors.push_back(r.error());
     };
     collect(svc_->replaceScene(id, before, stale));
-    collect(svc_->addPlacement(id, placement("b", 0.5), stale));
+    collect(svc_->addPlacement(id, placement("a", 0.5), stale)); // a was added since 1
     collect(svc_->patchPlacement(id, "a", {{"h", 3}}, stale));
     collect(svc_->deletePlacement(id, "a", stale));
+    collect(svc_->mirrorPlacement(id, "a", stale));
     collect(svc_->reorderPlacements(id, json::array({"a"}), stale));
     collect(svc_->putPose(id, {{"time", 1}}, stale));
     collect(svc_->patchPose(id, {{"time", 1}}, stale));
     collect(svc_->revert(id, 1, stale));
     collect(svc_->deleteScene(id, stale));
-    ASSERT_EQ(errors.size(), 9u);
+    // A revision the scene has not reached yet is stale for every edit.
+    collect(svc_->addPlacement(id, placement("c", 0.5), EditContext{4, "bob"}));
+    ASSERT_EQ(errors.size(), 11u);
     for (const Error& e : errors) {
         EXPECT_EQ(e.code, ErrorCode::StaleRevision) << e.message;
         EXPECT_EQ(e.field, "If-Match");
         ASSERT_TRUE(e.currentRevision);
-        EXPECT_EQ(*e.currentRevision, 2u);
+        EXPECT_EQ(*e.currentRevision, 3u);
         EXPECT_STREQ(errorCodeName(e.code), "stale_revision");
     }
-    EXPECT_EQ(revisionOf(id), 2u);
+    EXPECT_NE(errors[2].message.find("placement \"a\" was added since revision 1"), std::string::npos)
+        << errors[2].message;
+    EXPECT_NE(errors[6].message.find("the pose changed since revision 1"), std::string::npos)
+        << errors[6].message;
+    EXPECT_EQ(revisionOf(id), 3u);
     EXPECT_EQ((*svc_->getScene(id))["scene"], before);
-    EXPECT_EQ((*svc_->listRevisions(id, 10, std::nullopt))["revisions"].size(), 2u);
+    EXPECT_EQ((*svc_->listRevisions(id, 10, std::nullopt))["revisions"].size(), 3u);
     EXPECT_FALSE((*sub)->next(50)) << "a refused edit must not be announced";
     // The current revision passes.
-    auto fresh = svc_->patchPlacement(id, "a", {{"h", 3}}, EditContext{2, "bob"});
+    auto fresh = svc_->patchPlacement(id, "a", {{"h", 3}}, EditContext{3, "bob"});
     ASSERT_TRUE(fresh) << fresh.error().message;
     const json event = dataOf(*(*sub)->next(1000));
     EXPECT_EQ(event["type"], "placement_updated");
-    EXPECT_EQ(event["revision"], 3);
+    EXPECT_EQ(event["revision"], 4);
     EXPECT_EQ(event["client"], "bob");
     EXPECT_EQ(event["op"], "patch placement a");
     EXPECT_EQ(event["placement"], "a");
@@ -205,6 +217,164 @@ TEST_F(ServiceHistoryTest, StaleEditsAreRefusedAndChangeNothing) {
     EXPECT_TRUE(poseEvent["placement"].is_null());
     EXPECT_EQ(poseEvent["client"], "");
     svc_->unsubscribe(id, *sub);
+}
+
+TEST_F(ServiceHistoryTest, IfMatchOnAnOlderRevisionRebasesEditsOfWhatDidNotChange) {
+    const std::string id = (*svc_->createScene(kEmpty))["id"];
+    ASSERT_TRUE(svc_->addPlacement(id, placement("a", 0.3)));                          // 2
+    ASSERT_TRUE(svc_->addPlacement(id, placement("b", 0.5)));                          // 3
+    auto h = [&](const std::string& pid) {
+        const json doc = (*svc_->getScene(id))["scene"];
+        for (const json& p : doc["placements"])
+            if (p["id"] == pid) return p.value("h", 1.0);
+        return -1.0;
+    };
+    auto expectStale = [&](auto r, const std::string& why) {
+        ASSERT_FALSE(r) << why;
+        EXPECT_EQ(r.error().code, ErrorCode::StaleRevision) << r.error().message;
+        EXPECT_NE(r.error().message.find(why), std::string::npos) << r.error().message;
+    };
+    // Alice and Bob both read revision 3; Alice edits a, Bob then edits b: no conflict.
+    auto alice = svc_->patchPlacement(id, "a", {{"h", 2.0}}, EditContext{3, "alice"}); // 4
+    ASSERT_TRUE(alice) << alice.error().message;
+    auto bob = svc_->patchPlacement(id, "b", {{"h", 3.0}}, EditContext{3, "bob"}); // 5, rebased
+    ASSERT_TRUE(bob) << bob.error().message;
+    EXPECT_EQ((*bob)["revision"], 5);
+    EXPECT_EQ(h("a"), 2.0) << "Alice's edit is kept";
+    EXPECT_EQ(h("b"), 3.0);
+    // Bob, still on 3, edits a: Alice changed it since — refused, nothing changes.
+    expectStale(svc_->patchPlacement(id, "a", {{"h", 9.0}}, EditContext{3, "bob"}),
+                "placement \"a\" changed since revision 3");
+    expectStale(svc_->deletePlacement(id, "a", EditContext{3, "bob"}), "placement \"a\" changed");
+    EXPECT_EQ(h("a"), 2.0);
+    // The pose: unchanged since 3, so a pose edit based on 3 applies; a second one on 3 does not.
+    ASSERT_TRUE(svc_->patchPose(id, {{"time", 0.5}}, EditContext{3, "alice"})); // 6
+    expectStale(svc_->putPose(id, {{"time", 0.7}}, EditContext{5, "bob"}), "the pose changed since revision 5");
+    // Adding: an append by someone else is no conflict; the same id added since is.
+    ASSERT_TRUE(svc_->addPlacement(id, placement("c", 0.6), EditContext{3, "bob"})); // 7
+    auto generated = svc_->addPlacement(id, {{"pattern", "crease"}, {"joint", "forearm.l"}},
+                                        EditContext{4, "alice"}); // 8
+    ASSERT_TRUE(generated) << generated.error().message;
+    expectStale(svc_->addPlacement(id, placement("c", 0.7), EditContext{6, "alice"}),
+                "placement \"c\" was added since revision 6");
+    // Order: rebased while the list of ids is the same; refused after an add or a delete.
+    const json order = json::array({"b", "a", "c", "p3"});
+    expectStale(svc_->reorderPlacements(id, order, EditContext{7, "bob"}), "the placements were added");
+    ASSERT_TRUE(svc_->patchPlacement(id, "c", {{"h", 4.0}}, EditContext{8, "alice"})); // 9
+    ASSERT_TRUE(svc_->reorderPlacements(id, order, EditContext{8, "bob"}));            // 10
+    // A deleted placement: an edit of it based on before the delete is refused (not a 404).
+    ASSERT_TRUE(svc_->deletePlacement(id, "c", EditContext{10, "alice"})); // 11
+    expectStale(svc_->patchPlacement(id, "c", {{"h", 5.0}}, EditContext{10, "bob"}),
+                "placement \"c\" was deleted since revision 10");
+    // Whole-document edits are never rebased.
+    expectStale(svc_->replaceScene(id, (*svc_->getScene(id))["scene"], EditContext{10, "bob"}), "not 10");
+    expectStale(svc_->revert(id, 2, EditContext{10, "bob"}), "not 10");
+    EXPECT_EQ(revisionOf(id), 11u);
+
+    // Beyond the recent revisions kept in memory, the base document comes from the history.
+    for (int k = 0; k < 40; ++k) ASSERT_TRUE(svc_->patchPlacement(id, "b", {{"h", 1.0 + k}})); // → 51
+    auto old = svc_->patchPlacement(id, "a", {{"h", 7.0}}, EditContext{11, "alice"});
+    ASSERT_TRUE(old) << old.error().message;
+    EXPECT_EQ(h("a"), 7.0);
+    expectStale(svc_->patchPlacement(id, "b", {{"h", 7.0}}, EditContext{11, "alice"}),
+                "placement \"b\" changed since revision 11");
+    // Reading a revision: the same document from memory as from the history, and the time of each.
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    for (int k = 0; k < 200; ++k) ASSERT_TRUE(svc_->getSceneRevision(id, 50));
+    const auto t1 = Clock::now();
+    for (int k = 0; k < 200; ++k) ASSERT_TRUE(svc_->getSceneRevision(id, 12));
+    const auto t2 = Clock::now();
+    std::cout << "[ figures  ] reading an old revision of a 5-placement scene: "
+              << std::chrono::duration<double, std::micro>(t1 - t0).count() / 200
+              << " us from the recent ones in memory, "
+              << std::chrono::duration<double, std::micro>(t2 - t1).count() / 200
+              << " us from the history on disk\n";
+    open(); // after a restart the recent window holds the current revision only: the same answers
+    const json at50 = (*svc_->getSceneRevision(id, 50))["scene"];
+    EXPECT_EQ(at50["placements"][0]["id"], "b");
+    EXPECT_EQ(at50["placements"][0]["h"], 39.0);
+    auto afterRestart = svc_->patchPlacement(id, "b", {{"h", 8.0}}, EditContext{51, "bob"});
+    ASSERT_TRUE(afterRestart) << afterRestart.error().message;
+    expectStale(svc_->patchPlacement(id, "a", {{"h", 8.0}}, EditContext{51, "bob"}), "placement \"a\" changed");
+}
+
+TEST_F(ServiceHistoryTest, TwoClientsOnDifferentPlacementsLoseNothingAndAreNeverRefused) {
+    const std::string id = (*svc_->createScene(kEmpty))["id"];
+    ASSERT_TRUE(svc_->addPlacement(id, placement("a", 0.3)));
+    ASSERT_TRUE(svc_->addPlacement(id, placement("b", 0.5)));
+    const EditCall edit = [&](int c, const std::string& pid, double value, std::uint64_t base) {
+        auto r = svc_->patchPlacement(id, pid, {{"h", value}}, EditContext{base, c ? "bob" : "alice"});
+        if (r) return EditAnswer{200, (*r)["revision"].get<std::uint64_t>()};
+        if (r.error().code == ErrorCode::StaleRevision) return EditAnswer{412, *r.error().currentRevision};
+        ADD_FAILURE() << r.error().message;
+        return EditAnswer{500, base};
+    };
+    const auto doc = [&] { return (*svc_->getScene(id))["scene"]; };
+    const std::string different[2] = {"a", "b"}, same[2] = {"a", "a"};
+    const TwoClientRun apart = runTwoClients(edit, doc, different, 3, 3.0, 10.0);
+    std::cout << "[ figures  ] service, two clients on different placements, 10 edits/s each for 3 s: "
+              << apart << "\n";
+    EXPECT_GE(apart.totalEdits(), 40);
+    EXPECT_EQ(apart.totalRefusals(), 0);
+    EXPECT_EQ(apart.lost, 0);
+    EXPECT_EQ(apart.errors, 0);
+    const TwoClientRun together = runTwoClients(edit, doc, same, revisionOf(id), 3.0, 10.0);
+    std::cout << "[ figures  ] service, two clients on the same placement, 10 edits/s each for 3 s: "
+              << together << "\n";
+    EXPECT_GT(together.totalRefusals(), 0);
+    EXPECT_EQ(together.lost, 0);
+    EXPECT_EQ(together.errors, 0);
+}
+
+TEST_F(ServiceHistoryTest, FramesOfRecentRevisionsComeFromTheCachedScene) {
+    const std::string id = defaultScene(); // r1
+    FrameParams p;
+    p.width = p.height = 64;
+    auto frame = [&](std::optional<std::uint64_t> revision) {
+        FrameParams q = p;
+        q.revision = revision;
+        auto f = svc_->frame(id, q);
+        EXPECT_TRUE(f) << f.error().message;
+        return f ? f->bytes : std::vector<std::uint8_t>{};
+    };
+    const std::uint64_t n0 = svc_->framesPrepared();
+    const auto plain = frame(std::nullopt);
+    const auto r1 = frame(1); // what the editor sends: the current revision, named
+    EXPECT_EQ(r1, plain);
+    EXPECT_EQ(svc_->framesPrepared(), n0) << "the current revision is not parsed again";
+    ASSERT_TRUE(svc_->patchPlacement(id, "elbow_l", {{"h", 2.5}})); // r2
+    EXPECT_NE(frame(std::nullopt), plain);
+    EXPECT_EQ(frame(1), r1) << "a recent revision: from its cached scene";
+    EXPECT_EQ(svc_->framesPrepared(), n0);
+    // A preview changes the document: parsed and checked.
+    FrameParams preview = p;
+    preview.preview = {{"elbow_l", {{"h", 3.0}}}};
+    ASSERT_TRUE(svc_->frame(id, preview));
+    EXPECT_EQ(svc_->framesPrepared(), n0 + 1);
+    // Beyond the recent revisions the document is read and parsed again: the same bytes.
+    for (int k = 0; k < 20; ++k) ASSERT_TRUE(svc_->patchPose(id, {{"time", 0.05 * k}}));
+    EXPECT_EQ(frame(1), r1);
+    EXPECT_EQ(svc_->framesPrepared(), n0 + 2);
+    EXPECT_EQ(frame(revisionOf(id)), frame(std::nullopt));
+    EXPECT_EQ(svc_->framesPrepared(), n0 + 2);
+
+    // A recent revision that names a pattern deleted since is not rendered from its cache: it
+    // no longer renders (409), as before.
+    auto added = svc_->addPattern(patternPng(8, 8), "bumps");
+    ASSERT_TRUE(added) << added.error().message;
+    const std::string pat = (*added)["id"];
+    json pl = {{"id", "up"}, {"pattern", pat}, {"joint", "forearm.l"}, {"center", {0.3, 0.4}}};
+    auto withUpload = svc_->addPlacement(id, pl);
+    ASSERT_TRUE(withUpload) << withUpload.error().message;
+    const std::uint64_t used = (*withUpload)["revision"];
+    ASSERT_TRUE(svc_->deletePlacement(id, "up"));
+    ASSERT_TRUE(svc_->deletePattern(pat));
+    FrameParams old = p;
+    old.revision = used;
+    auto gone = svc_->frame(id, old);
+    ASSERT_FALSE(gone);
+    EXPECT_EQ(gone.error().code, ErrorCode::Conflict) << gone.error().message;
 }
 
 TEST_F(ServiceHistoryTest, PresenceIsBroadcastListedAndChecked) {

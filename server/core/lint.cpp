@@ -195,6 +195,10 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
         std::set<int> charts;
         float influence = 0.0f;
         const int joint = findPosable(model, p.joint);
+        // A joint's angle bends the skin of its own bone and of the bone it turns against (its
+        // parent joint's): a crease across the joint, or a muscle on the parent bone bulging as
+        // the joint bends (the biceps on upper_arm, driven by the elbow, forearm).
+        const int parent = joint >= 0 ? model.parentJoint(joint) : -1;
         for (glm::dvec2 uv : points[i]) {
             const auto hit = lookup.find(uv);
             if (!hit) {
@@ -203,6 +207,7 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
             }
             charts.insert(hit->chart);
             if (joint >= 0) influence = std::max(influence, lookup.weightOf(*hit, joint));
+            if (parent >= 0) influence = std::max(influence, lookup.weightOf(*hit, parent));
         }
         const std::size_t n = points[i].size();
         if (off > 0)
@@ -220,8 +225,8 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
                                "] degrees about its axis: the pattern never shows in a clip"});
         if (joint >= 0 && n > off && influence < 0.01f)
             out.push_back({"no_influence", LintSeverity::Warning, idx,
-                           "joint '" + p.joint + "' has no skin weight under the footprint: "
-                           "the skin it wrinkles does not follow that joint"});
+                           "neither joint '" + p.joint + "' nor its parent has skin weight under "
+                           "the footprint: the skin there does not bend with that joint"});
         for (std::size_t j = i + 1; j < scene.placements.size(); ++j) {
             const Placement& q = scene.placements[j];
             if (!q.enabled || q.target != p.target) continue;

@@ -23,6 +23,7 @@
 #pragma once
 
 #include "bake.hpp"
+#include "mirror.hpp" // kMirrorCenterTexels: centre distance, height-map texels
 #include "model_derived.hpp"
 #include "uv_lookup.hpp"
 
@@ -35,7 +36,6 @@ enum class LintSeverity { Info, Warning };
 std::string_view toString(LintSeverity s);
 
 /// Tolerances of a mirror pair (see above).
-inline constexpr double kMirrorCenterTexels = 4.0;     ///< centre distance, height-map texels
 inline constexpr double kMirrorScaleFraction = 0.15;   ///< |scale / mirrored scale − 1| per axis
 inline constexpr double kMirrorRotationDegrees = 10.0; ///< footprint rotation, modulo 180°
 inline constexpr double kMirrorAxisDegrees = 5.0;      ///< angle between the axes

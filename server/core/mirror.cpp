@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 namespace dermis {
 
@@ -177,6 +178,119 @@ std::string mirrorJointName(const Model& model, const std::string& joint) {
 
 namespace {
 
+bool isUpper(char c) { return std::isupper(static_cast<unsigned char>(c)) != 0; }
+bool isLower(char c) { return std::islower(static_cast<unsigned char>(c)) != 0; }
+bool isLetter(char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0; }
+
+/// What may stand beside a one-letter side token ("elbow_l", "(L)", "leg_L_1"): not a letter or
+/// digit, and none of the characters that join a letter to a word ("l'", "R&D").
+bool separates(char c) {
+    return std::strchr(" _.-()[]:/,", c) != nullptr && c != '\0';
+}
+
+struct SideToken {
+    std::size_t at = 0, len = 0;
+    bool left = false;
+};
+
+/// The side tokens of `s`, in order (see swapSides).
+std::vector<SideToken> sideTokens(const std::string& s) {
+    std::vector<SideToken> out;
+    const std::string ls = lower(s);
+    for (std::size_t i = 0; i < s.size();) {
+        bool word = false;
+        for (auto [w, left] : {std::pair{"left", true}, std::pair{"right", false}}) {
+            const std::size_t n = std::strlen(w);
+            if (ls.compare(i, n, w) != 0) continue;
+            const char prev = i > 0 ? s[i - 1] : ' ', next = i + n < s.size() ? s[i + n] : ' ';
+            bool allUpper = true;
+            for (std::size_t k = i; k < i + n; ++k) allUpper = allUpper && isUpper(s[k]);
+            const bool starts = !isLetter(prev) || (isUpper(s[i]) && isLower(prev));
+            const bool ends = !isLetter(next) || (isUpper(next) && !allUpper);
+            if (starts && ends) {
+                out.push_back({i, n, left});
+                i += n;
+                word = true;
+                break;
+            }
+        }
+        if (word) continue;
+        if ((ls[i] == 'l' || ls[i] == 'r') && (i == 0 || separates(s[i - 1])) &&
+            (i + 1 == s.size() || separates(s[i + 1])))
+            out.push_back({i, 1, ls[i] == 'l'});
+        ++i;
+    }
+    return out;
+}
+
+/// `to` in the case of `from` (ALL CAPS, Capitalised or small).
+std::string inCaseOf(const std::string& from, const char* to) {
+    std::string out = to;
+    bool allUpper = true;
+    for (char c : from) allUpper = allUpper && isUpper(c);
+    for (std::size_t k = 0; k < out.size(); ++k)
+        if (allUpper || (k == 0 && isUpper(from[0])))
+            out[k] = static_cast<char>(std::toupper(static_cast<unsigned char>(out[k])));
+    return out;
+}
+
+/// At most `max` bytes of `s`, cut before a UTF-8 continuation byte never.
+std::string cutUtf8(std::string s, std::size_t max) {
+    if (s.size() <= max) return s;
+    std::size_t n = max;
+    while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
+    s.resize(n);
+    return s;
+}
+
+} // namespace
+
+std::optional<std::string> swapSides(const std::string& s) {
+    const std::vector<SideToken> tokens = sideTokens(s);
+    if (tokens.empty()) return std::nullopt;
+    std::string out;
+    std::size_t from = 0;
+    for (const SideToken& t : tokens) {
+        out += s.substr(from, t.at - from);
+        const std::string token = s.substr(t.at, t.len);
+        out += inCaseOf(token, t.len == 1 ? (t.left ? "r" : "l") : (t.left ? "right" : "left"));
+        from = t.at + t.len;
+    }
+    return out + s.substr(from);
+}
+
+char sideOf(const std::string& name) {
+    const std::vector<SideToken> tokens = sideTokens(name);
+    return tokens.empty() ? 0 : tokens.front().left ? 'l' : 'r';
+}
+
+std::string mirrorPlacementId(const std::string& id, const std::string& twinJoint) {
+    if (auto swapped = swapSides(id)) return *swapped;
+    if (const char side = sideOf(twinJoint)) return id + "_" + side;
+    return id + "_twin";
+}
+
+std::string mirrorLabel(const std::string& label) {
+    if (label.empty()) return label;
+    if (auto swapped = swapSides(label)) return cutUtf8(*swapped, kMaxLabelLength);
+    const std::string suffix = " (mirror)";
+    return cutUtf8(label, kMaxLabelLength - suffix.size()) + suffix;
+}
+
+int findMirrorTwin(const Scene& scene, const Placement& twin) {
+    const double w = scene.heightmapSize[0], h = scene.heightmapSize[1];
+    for (std::size_t k = 0; k < scene.placements.size(); ++k) {
+        const Placement& q = scene.placements[k];
+        if (q.joint != twin.joint || q.pattern != twin.pattern || q.target != twin.target) continue;
+        if (std::hypot((q.center[0] - twin.center[0]) * w, (q.center[1] - twin.center[1]) * h) <=
+            kMirrorCenterTexels)
+            return static_cast<int>(k);
+    }
+    return -1;
+}
+
+namespace {
+
 glm::dmat3 reflectionD(int axis) {
     glm::dmat3 r(1.0);
     r[axis][axis] = -1.0;
@@ -247,6 +361,7 @@ Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const 
     if (!centre) return makeError(ErrorCode::NotFound, where, "center", "the footprint centre lies on no UV chart");
     Placement out = p;
     out.id.clear();
+    out.label = mirrorLabel(p.label);
     out.center = {centre->x, centre->y};
     // The footprint's axes through the same map: steps of a fifth of the footprint.
     const glm::dvec2 su = fp.toUV({0.7, 0.5}), sv = fp.toUV({0.5, 0.7});
@@ -291,7 +406,11 @@ Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const 
     const glm::dvec3 in(p.axis[0], p.axis[1], p.axis[2]);
     if (!(glm::length(in) > 0.0)) return makeError(ErrorCode::InvalidArgument, where, "axis", "zero axis");
     const glm::vec3 a = mirrorAxisOf(world, j, t, glm::vec3(glm::normalize(in)), plane.axis);
-    out.axis = {a.x, a.y, a.z};
+    // Written rounded: no -1.777e-7 for a component that is 0 up to float noise.
+    const auto rounded = [](double x) {
+        return std::abs(x) < 1e-6 ? 0.0 : std::round(x * 1e6) / 1e6;
+    };
+    out.axis = {rounded(a.x), rounded(a.y), rounded(a.z)};
     out.axisName.clear();
     for (int k = 0; k < 3; ++k) // a named axis stays named when it maps onto one
         if (std::abs(std::abs(a[k]) - 1.0f) < 1e-4f && a[k] > 0) {

@@ -17,7 +17,9 @@
 //   axis:           an axial vector: world a_w = Q_j·a, mirrored a_w' = −R·a_w (R the
 //                   reflection), twin-local a' = Q_t⁻¹·a_w' (Q the joints' rest world rotations),
 //                   so a pose and its mirror image give both twins the same θ, hence the same t;
-//                   θ range, h, model, target and response are kept.
+//                   written rounded (components within 1e-6 of 0 are 0, the others rounded to
+//                   6 decimals); θ range, h, model, target and response are kept;
+//   label:          mirrorLabel (side words swapped, else " (mirror)" appended).
 //
 // Pure; O(vertices) per mirror for the nearest-point search (no index yet). What depends only on
 // the model (the rest-pose skinning, RestSkin) can be computed once and passed in; the overloads
@@ -31,6 +33,7 @@
 
 #include <glm/glm.hpp>
 
+#include <optional>
 #include <string>
 
 namespace dermis {
@@ -62,6 +65,36 @@ SymmetryPlane symmetryPlane(const RestSkin& rest);
 /// The twin joint's name for `joint` by the naming conventions above ("" when none applies or
 /// the model has no such joint).
 std::string mirrorJointName(const Model& model, const std::string& joint);
+
+/// `s` with every side token swapped, left for right and right for left, each keeping its case:
+/// the words "left"/"right" (any case, at a word start: after a non-letter, or a capital after a
+/// small letter as in "ArmLeft"; and not followed by a small letter, so "cleft" and "Leftover"
+/// have none) and the letters "l"/"r" standing alone between non-alphanumerics or the ends
+/// ("elbow_l", "forearm.L", "L_arm", "leg_L_1", "elbow L", "(L)"). nullopt when `s` has none.
+std::optional<std::string> swapSides(const std::string& s);
+
+/// The side of `name` by its first side token: 'l', 'r', or 0 when it has none (see swapSides).
+char sideOf(const std::string& name);
+
+/// The id a mirror twin of placement `id` gets before it is made unique: `id` with its sides
+/// swapped (swapSides: elbow_l → elbow_r, Left → Right, .L → .R); else, when the twin joint has
+/// a side, `id` + "_l" or "_r" (that side); else `id` + "_twin".
+std::string mirrorPlacementId(const std::string& id, const std::string& twinJoint);
+
+/// The label of a mirror twin: `label` with its side words swapped (swapSides: "elbow L" →
+/// "elbow R", "left" → "right", "(L)" → "(R)"), else `label` + " (mirror)"; "" stays "". Cut
+/// to kMaxLabelLength bytes at a UTF-8 character boundary.
+std::string mirrorLabel(const std::string& label);
+
+/// How far (height-map texels of the scene) a placement may be from where another mirrors to
+/// and still be its twin: the mirror route's duplicate check and lint's mirror pairs.
+inline constexpr double kMirrorCenterTexels = 4.0;
+
+/// The index in `scene.placements` of a placement that already is `twin` — the mirror image
+/// mirrorPlacement made of some placement: the same joint, pattern and target and a centre
+/// within kMirrorCenterTexels of the scene's height map (`heightmapSize`) of twin's — or −1.
+/// Compares the patterns as named (resolve aliases in both first). The first such, in order.
+int findMirrorTwin(const Scene& scene, const Placement& twin);
 
 /// The mirror twin of `p` (id left empty for the caller). Fails: Unsupported ("/uvs") without
 /// UVs; NotFound ("center") when the footprint centre is on no UV chart; NotFound ("joint") when

@@ -203,7 +203,7 @@ Result<Service::State::Snapshot> Service::State::snapshot(const std::string& id)
     std::shared_lock<std::shared_mutex> lock(mutex);
     auto it = scenes.find(id);
     if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    return snapshotOf(it->second.scene, models.at(it->second.scene.model).model);
+    return snapshotOf(*it->second.scene, models.at(it->second.scene->model).model);
 }
 
 // --- open -----------------------------------------------------------------------------------
@@ -294,8 +294,10 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
             warnings.push_back("scene " + r.id + ": " + history.error().message);
             continue;
         }
-        scenes[r.id] = SceneEntry{prepared->canonical, std::move(prepared->scene), r.revision,
-                                  std::move(*history)};
+        SceneEntry& e = scenes[r.id];
+        e.history = std::move(*history);
+        e.setCurrent({r.revision, std::make_shared<const json>(std::move(prepared->canonical)),
+                      std::make_shared<const Scene>(std::move(prepared->scene))});
     }
 }
 

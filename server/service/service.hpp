@@ -166,9 +166,12 @@ private:
 
 /// Who makes an edit and which revision it was based on (SPEC §6 Concurrency).
 struct EditContext {
-    /// The revision the client read (If-Match: "r<N>"); when set and not the scene's current
-    /// revision, the edit fails with ErrorCode::StaleRevision (Error::currentRevision set) and
-    /// nothing changes. Unset: the edit applies to whatever is current.
+    /// The revision the client read (If-Match: "r<N>"). When set and older than the scene's
+    /// current revision, an edit of one placement, of the pose or of the order applies only when
+    /// that is the same in N as now (and a new placement unless its given id came or went since
+    /// N): the server rebases it; otherwise, and always for whole-document edits (PUT, revert,
+    /// delete), it fails with ErrorCode::StaleRevision (Error::currentRevision set) and nothing
+    /// changes. Unset: the edit applies to whatever is current.
     std::optional<std::uint64_t> ifMatch;
     /// X-Dermis-Client: recorded in the history and carried by events. ≤ 64 printable ASCII
     /// characters ("" = not named); checked by the HTTP layer (checkClientName).
@@ -265,9 +268,12 @@ public:
                                           const nlohmann::json& patch, const EditContext& ctx = {});
     Result<nlohmann::json> deletePlacement(const std::string& id, const std::string& pid,
                                            const EditContext& ctx = {});
-    /// Adds the mirror twin of placement `pid` (SPEC §6 Mirror; core mirrorPlacement): id with its
-    /// side swapped (elbow_l → elbow_r) or "<pid>_mirror", made unique. Fails (InvalidArgument)
-    /// when the footprint centre is on no chart or the joint has no twin by name or position.
+    /// Adds the mirror twin of placement `pid` (SPEC §6 Mirror; core mirrorPlacement): id from
+    /// core mirrorPlacementId (elbow_l → elbow_r, else the twin joint's side or "_twin"), made
+    /// unique ("_2"…), label from mirrorLabel. Computed under the writer lock from the current
+    /// document. Fails: InvalidArgument when the footprint centre is on no chart or the joint
+    /// has no twin by name or position; Conflict (field "placement", the message naming it) when
+    /// the twin is in the scene already (core findMirrorTwin) or `pid` is its own twin.
     Result<nlohmann::json> mirrorPlacement(const std::string& id, const std::string& pid,
                                            const EditContext& ctx = {});
     /// `order`: every placement id once, in the new order.
@@ -363,8 +369,14 @@ public:
 
     // --- renders
     /// A frame of scene `id` with `params`' overrides; `patternsOff`, `only` (unknown ids fail,
-    /// field "only") and `revision` (NotFound, field "revision") choose what it shows.
+    /// field "only") and `revision` (NotFound, field "revision") choose what it shows. The
+    /// current revision and the 15 before it render from the scene validated
+    /// when they were committed; an older revision's document is read and validated again
+    /// (Conflict when it no longer renders: a pattern or model it names was deleted since).
     Result<EncodedImage> frame(const std::string& id, const FrameParams& params);
+    /// How many frames, sweeps and driver answers so far parsed and validated their scene again
+    /// from a document (an older revision, a preview) instead of taking the cached one. For tests.
+    std::uint64_t framesPrepared() const;
     /// PNG heat map of the per-pixel difference between the frame `params` describe and the same
     /// frame `against` "off" (no dynamic patterns) or a revision number (SPEC §6 Compare): black
     /// where equal, red → yellow → white as the largest channel difference grows;

@@ -68,13 +68,13 @@ Result<json> Service::getSceneRevision(const std::string& id, std::uint64_t revi
         auto it = state_->scenes.find(id);
         if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
         current = it->second.revision;
-        if (revision == current)
-            return json{{"id", id}, {"revision", revision}, {"current_revision", current},
-                        {"scene", it->second.doc}};
         if (revision == 0 || revision > current)
             return notFound("revision", "scene " + id + " has no revision " +
                                             std::to_string(revision) + " (current: " +
                                             std::to_string(current) + ")");
+        if (const SceneVersion* v = it->second.recentVersion(revision))
+            return json{{"id", id}, {"revision", revision}, {"current_revision", current},
+                        {"scene", *v->doc}};
     }
     // Older revisions are read from disk, outside the lock (files are never rewritten).
     auto doc = state_->store->readRevision(id, revision);
@@ -84,15 +84,21 @@ Result<json> Service::getSceneRevision(const std::string& id, std::uint64_t revi
 
 Result<json> Service::revert(const std::string& id, std::uint64_t revision, const EditContext& ctx) {
     std::lock_guard<std::mutex> write(state_->writeMutex);
+    if (auto s = state_->checkIfMatch(id, ctx, EditScope{}); !s) return s.error();
+    std::shared_ptr<const json> recent;
     {
         std::shared_lock<std::shared_mutex> lock(state_->mutex);
         auto it = state_->scenes.find(id);
         if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-        if (auto s = State::checkIfMatch(id, ctx, it->second.revision); !s) return s.error();
         if (revision == 0 || revision > it->second.revision)
             return notFound("/revision", "scene " + id + " has no revision " +
                                              std::to_string(revision));
+        if (const SceneVersion* v = it->second.recentVersion(revision)) recent = v->doc;
     }
+    if (recent) // undo and redo of a recent edit: no file to read
+        return state_->commit(id, *recent,
+                              EditInfo{"reverted", "revert to " + std::to_string(revision), ""},
+                              ctx, false);
     auto doc = state_->store->readRevision(id, revision);
     if (!doc) {
         Error e = doc.error();

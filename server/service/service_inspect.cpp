@@ -121,9 +121,9 @@ Result<json> Service::lint(const std::string& id) {
         std::shared_lock<std::shared_mutex> lock(state_->mutex);
         std::set<std::string> used;
         for (const auto& [sid, e] : state_->scenes) {
-            for (const Placement& p : state_->resolved(e.scene).placements) used.insert(p.pattern);
-            if (e.scene.heightmapBase) used.insert(*e.scene.heightmapBase);
-            for (const auto& [alias, target] : e.scene.patterns) used.insert(target);
+            for (const Placement& p : state_->resolved(*e.scene).placements) used.insert(p.pattern);
+            if (e.scene->heightmapBase) used.insert(*e.scene->heightmapBase);
+            for (const auto& [alias, target] : e.scene->patterns) used.insert(target);
         }
         for (const auto& [pid, e] : state_->patterns)
             if (!e.builtin && !used.count(pid)) unused.push_back(pid);

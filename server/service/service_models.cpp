@@ -54,7 +54,9 @@ json modelSummary(const ModelEntry& e) {
             {"triangles", e.model->triangleCount()},
             {"joints", e.model->joints.size()},
             {"clips", e.model->clips.size()},
+            {"joint_count", e.model->joints.size()},
             {"has_uvs", e.model->hasUVs()},
+            {"has_texture", e.model->dominantBaseColorImage() >= 0},
             {"bytes", e.bytes}};
 }
 
@@ -196,7 +198,6 @@ Result<json> Service::getModel(const std::string& id) const {
     for (const MeshPart& p : m.parts)
         vertices += p.positions.size();
     out["joints"] = std::move(joints);
-    out["joint_count"] = m.joints.size();
     out["clips"] = std::move(clips);
     out["vertices"] = vertices;
     return out;
@@ -211,7 +212,7 @@ Status Service::deleteModel(const std::string& id) {
         if (it->second.builtin)
             return makeError(ErrorCode::Conflict, "dermis::Service", "id", "built-in models cannot be deleted");
         for (const auto& [sid, s] : state_->scenes)
-            if (s.scene.model == id)
+            if (s.scene->model == id)
                 return makeError(ErrorCode::Conflict, "dermis::Service", "id",
                                  "model \"" + id + "\" is used by scene " + sid);
     }

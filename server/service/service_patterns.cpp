@@ -146,8 +146,8 @@ Status Service::deletePattern(const std::string& id) {
         if (it->second.builtin)
             return makeError(ErrorCode::Conflict, "dermis::Service", "id", "built-in patterns cannot be deleted");
         for (const auto& [sid, s] : state_->scenes) {
-            bool used = s.scene.heightmapBase && *s.scene.heightmapBase == id;
-            for (const auto& [alias, target] : s.scene.patterns)
+            bool used = s.scene->heightmapBase && *s.scene->heightmapBase == id;
+            for (const auto& [alias, target] : s.scene->patterns)
                 used = used || target == id;
             if (used)
                 return makeError(ErrorCode::Conflict, "dermis::Service", "id",

@@ -90,11 +90,21 @@ Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string
             std::shared_lock<std::shared_mutex> lock(mutex);
             auto it = scenes.find(id);
             if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-            current = it->second.revision;
-            if (!p.revision || *p.revision == current) doc = it->second.doc;
+            const SceneEntry& e = it->second;
+            current = e.revision;
+            if (p.revision && (*p.revision == 0 || *p.revision > current))
+                return notFound("revision",
+                                "scene " + id + " has no revision " + std::to_string(*p.revision));
+            const SceneVersion* v = e.recentVersion(p.revision ? *p.revision : current);
+            // The current revision, or a recent one whose model and patterns are all still here,
+            // renders from the scene validated at its commit: nothing to parse or check again.
+            if (v && !preview && cachedRenders(*v->scene)) {
+                snap = snapshotOf(*v->scene, models.at(v->scene->model).model);
+            } else if (v) {
+                doc = *v->doc;
+            }
         }
-        if (p.revision && (*p.revision == 0 || *p.revision > current))
-            return notFound("revision", "scene " + id + " has no revision " + std::to_string(*p.revision));
+        if (snap) return withCompare(std::move(*snap), id, p);
         if (doc.is_null()) {
             auto old = store->readRevision(id, *p.revision);
             if (!old) return old.error();
@@ -115,6 +125,7 @@ Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string
             }
         }
         std::shared_lock<std::shared_mutex> lock(mutex);
+        framesPrepared.fetch_add(1, std::memory_order_relaxed);
         auto prepared = prepare(doc, false);
         if (!prepared) {
             if (preview)
@@ -128,12 +139,28 @@ Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string
         snap = snapshot(id);
     }
     if (!snap) return snap;
+    return withCompare(std::move(*snap), id, p);
+}
+
+bool Service::State::cachedRenders(const Scene& scene) const {
+    if (!models.count(scene.model)) return false;
+    const auto present = [&](const std::string& pattern) {
+        auto alias = scene.patterns.find(pattern);
+        return images.count(alias == scene.patterns.end() ? pattern : alias->second) > 0;
+    };
+    for (const Placement& pl : scene.placements)
+        if (!present(pl.pattern)) return false;
+    return !scene.heightmapBase || present(*scene.heightmapBase);
+}
+
+Result<Service::State::Snapshot> Service::State::withCompare(Snapshot snap, const std::string& id,
+                                                             const FrameParams& p) const {
     for (const std::string& pid : p.only) {
         bool known = false;
-        for (const Placement& pl : snap->scene.placements) known = known || pl.id == pid;
+        for (const Placement& pl : snap.scene.placements) known = known || pl.id == pid;
         if (!known) return bad("only", "no placement \"" + pid + "\" in scene " + id);
     }
-    for (Placement& pl : snap->scene.placements) {
+    for (Placement& pl : snap.scene.placements) {
         if (p.patternsOff) pl.enabled = false;
         if (!p.only.empty() && std::find(p.only.begin(), p.only.end(), pl.id) == p.only.end())
             pl.enabled = false;
@@ -183,6 +210,10 @@ Error asParamError(Error e, const FrameParams& p) {
 }
 
 } // namespace detail
+
+std::uint64_t Service::framesPrepared() const {
+    return state_->framesPrepared.load(std::memory_order_relaxed);
+}
 
 Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p) {
     if (!isFrameFormat(p.format)) return bad("format", "must be png, jpeg or webp");

@@ -9,13 +9,104 @@ namespace dermis {
 
 using namespace detail;
 
+void SceneEntry::setCurrent(SceneVersion v) {
+    doc = v.doc;
+    scene = v.scene;
+    revision = v.revision;
+    recent.push_back(std::move(v));
+    while (recent.size() > kRecentRevisions) recent.pop_front();
+}
+
+const SceneVersion* SceneEntry::recentVersion(std::uint64_t r) const {
+    for (const SceneVersion& v : recent)
+        if (v.revision == r) return &v;
+    return nullptr;
+}
+
+namespace {
+
+/// Index of placement `pid` in doc["placements"], or −1.
+int placementIndex(const json& doc, const std::string& pid) {
+    const auto pl = doc.find("placements");
+    if (pl == doc.end() || !pl->is_array()) return -1;
+    for (std::size_t i = 0; i < pl->size(); ++i)
+        if ((*pl)[i].is_object() && (*pl)[i].value("id", "") == pid) return static_cast<int>(i);
+    return -1;
+}
+
+/// Placement `pid` of `doc`, or null when it has none.
+json placementOf(const json& doc, const std::string& pid) {
+    const int k = placementIndex(doc, pid);
+    return k < 0 ? json() : doc["placements"][static_cast<std::size_t>(k)];
+}
+
+/// The placement ids of `doc`, in order.
+std::vector<std::string> placementIds(const json& doc) {
+    std::vector<std::string> ids;
+    if (auto pl = doc.find("placements"); pl != doc.end() && pl->is_array())
+        for (const json& p : *pl) ids.push_back(p.is_object() ? p.value("id", "") : "");
+    return ids;
+}
+
+/// Why an edit of `scope` based on document `then` conflicts with document `now` ("" = it
+/// does not: the edit may apply to `now`). See Service::State::checkIfMatch.
+std::string conflictOf(const json& then, const json& now, const EditScope& scope) {
+    if (then.value("model", "") != now.value("model", "")) return "the scene's model changed";
+    switch (scope.kind) {
+    case EditScope::Kind::Whole: return "the document changed";
+    case EditScope::Kind::Add:
+        if (scope.placement.empty()) return "";
+        [[fallthrough]];
+    case EditScope::Kind::Placement: {
+        const json a = placementOf(then, scope.placement), b = placementOf(now, scope.placement);
+        if (a == b) return "";
+        const std::string p = "placement \"" + scope.placement + "\" ";
+        return a.is_null() ? p + "was added" : b.is_null() ? p + "was deleted" : p + "changed";
+    }
+    case EditScope::Kind::Order:
+        if (placementIds(then) == placementIds(now)) return "";
+        return "the placements were added, deleted or reordered";
+    case EditScope::Kind::Pose: {
+        const auto a = then.find("pose"), b = now.find("pose");
+        const bool same = (a == then.end() && b == now.end()) ||
+                          (a != then.end() && b != now.end() && *a == *b);
+        return same ? "" : "the pose changed";
+    }
+    }
+    return "the document changed";
+}
+
+} // namespace
+
 Status Service::State::checkIfMatch(const std::string& id, const EditContext& ctx,
-                                    std::uint64_t current) {
-    if (!ctx.ifMatch || *ctx.ifMatch == current) return Ok{};
+                                    const EditScope& scope) {
+    std::uint64_t current = 0;
+    std::shared_ptr<const json> now, then;
+    {
+        std::shared_lock<std::shared_mutex> lock(mutex);
+        auto it = scenes.find(id);
+        if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
+        current = it->second.revision;
+        if (!ctx.ifMatch || *ctx.ifMatch == current) return Ok{};
+        now = it->second.doc;
+        if (const SceneVersion* v = it->second.recentVersion(*ctx.ifMatch)) then = v->doc;
+    }
+    const std::uint64_t base = *ctx.ifMatch;
+    std::string why;
+    if (scope.kind != EditScope::Kind::Whole && base < current) {
+        if (!then) { // older than the recent ones: from the history (files are never rewritten)
+            auto old = store->readRevision(id, base);
+            if (old) then = std::make_shared<const json>(std::move(*old));
+        }
+        if (then) {
+            why = conflictOf(*then, *now, scope);
+            if (why.empty()) return Ok{}; // rebased: what the edit touches is as the client saw it
+            why = ", and " + why + " since revision " + std::to_string(base);
+        }
+    }
     Error e = makeError(ErrorCode::StaleRevision, "dermis::Service", "If-Match",
-                        "scene " + id + " is at revision " + std::to_string(current) +
-                            ", not " + std::to_string(*ctx.ifMatch) +
-                            ": read it again and redo the edit");
+                        "scene " + id + " is at revision " + std::to_string(current) + ", not " +
+                            std::to_string(base) + why + ": read it again and redo the edit");
     e.currentRevision = current;
     return e;
 }
@@ -36,12 +127,12 @@ Result<json> Service::State::commit(const std::string& id, const json& newDoc, c
     const Store::RevisionInfo kept{revision, nowSeconds(), info.op, ctx.client};
     if (auto s = store->putScene(id, kept, prepared.canonical); !s) return s.error();
     json answer = {{"id", id}, {"revision", revision}, {"scene", prepared.canonical}};
+    SceneVersion version{revision, std::make_shared<const json>(std::move(prepared.canonical)),
+                         std::make_shared<const Scene>(std::move(prepared.scene))};
     {
         std::unique_lock<std::shared_mutex> lock(mutex);
         SceneEntry& e = scenes[id];
-        e.doc = std::move(prepared.canonical);
-        e.scene = std::move(prepared.scene);
-        e.revision = revision;
+        e.setCurrent(std::move(version));
         e.history.push_back(kept);
     }
     json event = {{"type", info.type}, {"scene", id},      {"revision", revision},
@@ -52,15 +143,16 @@ Result<json> Service::State::commit(const std::string& id, const json& newDoc, c
 }
 
 Result<json> Service::State::edit(const std::string& id, const EditContext& ctx, EditInfo& info,
+                                  const EditScope& scope,
                                   const std::function<Status(json&)>& change) {
     std::lock_guard<std::mutex> write(writeMutex);
+    if (auto s = checkIfMatch(id, ctx, scope); !s) return s.error();
     json doc;
     {
         std::shared_lock<std::shared_mutex> lock(mutex);
         auto it = scenes.find(id);
         if (it == scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-        if (auto s = checkIfMatch(id, ctx, it->second.revision); !s) return s.error();
-        doc = it->second.doc;
+        doc = *it->second.doc;
     }
     if (auto s = change(doc); !s) return s.error();
     return commit(id, doc, info, ctx, false);
@@ -70,8 +162,8 @@ json Service::listScenes() const {
     std::shared_lock<std::shared_mutex> lock(state_->mutex);
     json out = json::array();
     for (const auto& [id, e] : state_->scenes)
-        out.push_back({{"id", id}, {"revision", e.revision}, {"model", e.scene.model},
-                       {"placements", e.scene.placements.size()}});
+        out.push_back({{"id", id}, {"revision", e.revision}, {"model", e.scene->model},
+                       {"placements", e.scene->placements.size()}});
     return {{"scenes", out}};
 }
 
@@ -102,12 +194,12 @@ Result<json> Service::getScene(const std::string& id) const {
     std::shared_lock<std::shared_mutex> lock(state_->mutex);
     auto it = state_->scenes.find(id);
     if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-    return json{{"id", id}, {"revision", it->second.revision}, {"scene", it->second.doc}};
+    return json{{"id", id}, {"revision", it->second.revision}, {"scene", *it->second.doc}};
 }
 
 Result<json> Service::replaceScene(const std::string& id, const json& doc, const EditContext& ctx) {
     EditInfo info{"replaced", "replace scene", ""};
-    return state_->edit(id, ctx, info, [&](json& d) -> Status {
+    return state_->edit(id, ctx, info, EditScope{}, [&](json& d) -> Status {
         d = doc;
         return Ok{};
     });
@@ -115,12 +207,7 @@ Result<json> Service::replaceScene(const std::string& id, const json& doc, const
 
 Status Service::deleteScene(const std::string& id, const EditContext& ctx) {
     std::lock_guard<std::mutex> write(state_->writeMutex);
-    {
-        std::shared_lock<std::shared_mutex> lock(state_->mutex);
-        auto it = state_->scenes.find(id);
-        if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
-        if (auto s = State::checkIfMatch(id, ctx, it->second.revision); !s) return s;
-    }
+    if (auto s = state_->checkIfMatch(id, ctx, EditScope{}); !s) return s;
     if (auto s = state_->store->removeScene(id); !s) return s;
     {
         std::unique_lock<std::shared_mutex> lock(state_->mutex);
@@ -139,23 +226,14 @@ Status Service::deleteScene(const std::string& id, const EditContext& ctx) {
     return Ok{};
 }
 
-namespace {
-
-/// Index of placement `pid` in doc["placements"], or −1.
-int placementIndex(const json& doc, const std::string& pid) {
-    const json& pl = doc["placements"];
-    for (std::size_t i = 0; i < pl.size(); ++i)
-        if (pl[i].value("id", "") == pid) return static_cast<int>(i);
-    return -1;
-}
-
-} // namespace
-
 Result<json> Service::addPlacement(const std::string& id, const json& placement,
                                    const EditContext& ctx) {
     if (!placement.is_object()) return bad("", "a placement must be a JSON object");
     EditInfo info{"placement_added", "", ""};
-    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+    EditScope scope{EditScope::Kind::Add, ""};
+    if (auto given = placement.find("id"); given != placement.end() && given->is_string())
+        scope.placement = given->get<std::string>();
+    return state_->edit(id, ctx, info, scope, [&](json& doc) -> Status {
         json p = placement;
         if (!p.contains("id")) { // a fresh id that no other placement has
             std::string pid;
@@ -178,7 +256,8 @@ Result<json> Service::patchPlacement(const std::string& id, const std::string& p
     if (auto i = patch.find("id"); i != patch.end() && (!i->is_string() || i->get<std::string>() != pid))
         return bad("/id", "a placement's id cannot be changed");
     EditInfo info{"placement_updated", "patch placement " + pid, pid};
-    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+    const EditScope scope{EditScope::Kind::Placement, pid};
+    return state_->edit(id, ctx, info, scope, [&](json& doc) -> Status {
         const int k = placementIndex(doc, pid);
         if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
         doc["placements"][static_cast<std::size_t>(k)].merge_patch(patch);
@@ -189,7 +268,8 @@ Result<json> Service::patchPlacement(const std::string& id, const std::string& p
 Result<json> Service::deletePlacement(const std::string& id, const std::string& pid,
                                       const EditContext& ctx) {
     EditInfo info{"placement_deleted", "delete placement " + pid, pid};
-    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+    const EditScope scope{EditScope::Kind::Placement, pid};
+    return state_->edit(id, ctx, info, scope, [&](json& doc) -> Status {
         const int k = placementIndex(doc, pid);
         if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
         doc["placements"].erase(static_cast<std::size_t>(k));
@@ -199,27 +279,50 @@ Result<json> Service::deletePlacement(const std::string& id, const std::string& 
 
 Result<json> Service::mirrorPlacement(const std::string& id, const std::string& pid,
                                       const EditContext& ctx) {
-    auto snap = state_->snapshot(id);
-    if (!snap) return snap.error();
-    const Placement* source = nullptr;
-    for (const Placement& p : snap->scene.placements)
-        if (p.id == pid) source = &p;
-    if (!source) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
-    const auto derived = state_->derivedOf(*snap); // UV index, plane and rest skin, built once
-    auto twin = dermis::mirrorPlacement(*source, derived->model(), derived->uvLookup(),
-                                        derived->symmetryPlane(), derived->restSkin());
-    if (!twin) {
-        Error e = twin.error();
-        e.code = ErrorCode::InvalidArgument; // the placement cannot be mirrored: 422
-        return e;
+    // The model's derived data (UV index, rest skin, symmetry plane) is built here, before the
+    // writer lock, so that a first mirror on a large model holds no other edit back meanwhile.
+    if (auto warm = state_->snapshot(id)) {
+        const auto derived = state_->derivedOf(*warm);
+        if (derived->model().hasUVs()) {
+            derived->uvLookup();
+            derived->symmetryPlane();
+        }
     }
-    // The twin's id: the source's with its side swapped (elbow_l → elbow_r), else "<pid>_mirror".
-    std::string base = pid + "_mirror";
-    for (auto [from, to] : {std::pair{"_l", "_r"}, std::pair{"_r", "_l"}, std::pair{"_L", "_R"},
-                            std::pair{"_R", "_L"}, std::pair{".l", ".r"}, std::pair{".r", ".l"}})
-        if (pid.size() > 2 && pid.compare(pid.size() - 2, 2, from) == 0) base = pid.substr(0, pid.size() - 2) + to;
     EditInfo info{"placement_added", "mirror placement " + pid, ""};
-    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+    const EditScope scope{EditScope::Kind::Placement, pid};
+    return state_->edit(id, ctx, info, scope, [&](json& doc) -> Status {
+        // Under writeMutex: the snapshot is the document being edited.
+        auto snap = state_->snapshot(id);
+        if (!snap) return snap.error();
+        const Placement* source = nullptr;
+        for (const Placement& p : snap->scene.placements)
+            if (p.id == pid) source = &p;
+        const int at = placementIndex(doc, pid);
+        if (!source || at < 0)
+            return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
+        const auto derived = state_->derivedOf(*snap); // UV index, plane and rest skin, built once
+        auto twin = dermis::mirrorPlacement(*source, derived->model(), derived->uvLookup(),
+                                            derived->symmetryPlane(), derived->restSkin());
+        if (!twin) {
+            Error e = twin.error();
+            e.code = ErrorCode::InvalidArgument; // the placement cannot be mirrored: 422
+            return e;
+        }
+        // Mirroring twice stacks nothing: a placement that already is the twin answers 409.
+        if (const int k = findMirrorTwin(snap->scene, *twin); k >= 0) {
+            const std::string& existing = snap->scene.placements[static_cast<std::size_t>(k)].id;
+            const std::string why =
+                existing == pid ? "placement \"" + pid + "\" is its own mirror twin (it lies on "
+                                  "the model's symmetry plane)"
+                                : "placement \"" + existing + "\" already is the mirror twin of \"" +
+                                      pid + "\" (same joint, pattern and target, centre within " +
+                                      std::to_string(static_cast<int>(kMirrorCenterTexels)) +
+                                      " texels of where it mirrors to)";
+            return makeError(ErrorCode::Conflict, "dermis::Service::mirrorPlacement", "placement", why);
+        }
+        // The twin's id: the source's with its side swapped (elbow_l → elbow_r), else from the
+        // twin joint's side or "<pid>_twin"; "_2", "_3"… only when that is taken.
+        const std::string base = mirrorPlacementId(pid, twin->joint);
         std::string newId = base;
         for (int k = 2; placementIndex(doc, newId) >= 0; ++k) newId = base + "_" + std::to_string(k);
         info.placement = newId;
@@ -227,7 +330,7 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
         Scene one;
         one.placements.push_back(*twin);
         one.placements[0].id = newId;
-        one.placements[0].pattern = doc["placements"][static_cast<std::size_t>(placementIndex(doc, pid))]["pattern"];
+        one.placements[0].pattern = doc["placements"][static_cast<std::size_t>(at)]["pattern"];
         doc["placements"].push_back(dermis::toJson(one)["placements"][0]);
         return Ok{};
     });
@@ -237,7 +340,7 @@ Result<json> Service::reorderPlacements(const std::string& id, const json& order
                                         const EditContext& ctx) {
     if (!order.is_array()) return bad("", "the order must be an array of placement ids");
     EditInfo info{"placements_reordered", "reorder placements", ""};
-    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+    return state_->edit(id, ctx, info, EditScope{EditScope::Kind::Order, ""}, [&](json& doc) -> Status {
         const json& old = doc["placements"];
         if (order.size() != old.size())
             return bad("", "the order must list each of the " + std::to_string(old.size()) + " placements once");
@@ -260,7 +363,7 @@ Result<json> Service::reorderPlacements(const std::string& id, const json& order
 Result<json> Service::putPose(const std::string& id, const json& pose, const EditContext& ctx) {
     if (!pose.is_object()) return bad("/pose", "a pose must be a JSON object");
     EditInfo info{"pose", "set pose", ""};
-    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+    return state_->edit(id, ctx, info, EditScope{EditScope::Kind::Pose, ""}, [&](json& doc) -> Status {
         doc["pose"] = pose;
         return Ok{};
     });
@@ -269,7 +372,7 @@ Result<json> Service::putPose(const std::string& id, const json& pose, const Edi
 Result<json> Service::patchPose(const std::string& id, const json& patch, const EditContext& ctx) {
     if (!patch.is_object()) return bad("/pose", "a pose patch must be a JSON object");
     EditInfo info{"pose", "patch pose", ""};
-    return state_->edit(id, ctx, info, [&](json& doc) -> Status {
+    return state_->edit(id, ctx, info, EditScope{EditScope::Kind::Pose, ""}, [&](json& doc) -> Status {
         json& pose = doc["pose"];
         if (!pose.is_object()) pose = json::object();
         for (auto e = patch.begin(); e != patch.end(); ++e) {

@@ -19,6 +19,7 @@
 #include "service/content_cache.hpp"
 
 #include <atomic>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -75,11 +76,46 @@ Result<Model> decodeModelBytes(const std::vector<std::uint8_t>& bytes, const Ser
 Result<HeightImage> decodePatternBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
                                        const char* where, const std::string& field);
 
+/// One revision of a scene as it was validated: its canonical document and its scene (shared,
+/// immutable: readers keep them after the lock is released).
+struct SceneVersion {
+    std::uint64_t revision = 0;
+    std::shared_ptr<const json> doc;    ///< canonical document (toJson of scene)
+    std::shared_ptr<const Scene> scene; ///< unresolved (aliases kept), as parsed
+};
+
+/// How many recent revisions of a scene stay in memory (SceneEntry::recent): what an If-Match
+/// a few edits behind is rebased against, and what a frame of a recent revision renders without
+/// parsing its document again. Older revisions are read from the store's history.
+inline constexpr std::size_t kRecentRevisions = 16;
+
 struct SceneEntry {
-    json doc; ///< canonical document (toJson of scene)
-    Scene scene;
+    std::shared_ptr<const json> doc;    ///< canonical document of the current revision
+    std::shared_ptr<const Scene> scene; ///< the current revision's scene
     std::uint64_t revision = 1;
     std::vector<Store::RevisionInfo> history; ///< kept revisions, oldest first (last = current)
+    /// The last kRecentRevisions revisions, oldest first; back() is the current one (the same
+    /// pointers as doc and scene). Revisions loaded from the data folder start with the current.
+    std::deque<SceneVersion> recent;
+
+    /// Makes `v` current and keeps it among the recent ones (the oldest beyond the window go).
+    void setCurrent(SceneVersion v);
+    /// Revision `revision` if it is among the recent ones, else nullptr.
+    const SceneVersion* recentVersion(std::uint64_t revision) const;
+};
+
+/// What an edit touches, for rebasing an If-Match on an older revision (SPEC §6 Concurrency; see
+/// Service::State::checkIfMatch).
+struct EditScope {
+    enum class Kind {
+        Whole,     ///< the whole document (PUT scene, revert, delete scene): never rebased
+        Placement, ///< one placement (PATCH, DELETE, mirror of `placement`)
+        Add,       ///< a new placement; `placement` its given id ("" = one will be generated)
+        Order,     ///< the order of the placements
+        Pose,      ///< the pose (PUT, PATCH)
+    };
+    Kind kind = Kind::Whole;
+    std::string placement;
 };
 
 /// What an edit is, for the history and the events.
@@ -205,12 +241,24 @@ struct Service::State {
     /// and announces it. Caller holds `writeMutex` (and not `mutex`).
     Result<json> commit(const std::string& id, const json& newDoc, const detail::EditInfo& info,
                         const EditContext& ctx, bool create);
-    /// Takes `writeMutex`, checks ctx.ifMatch, copies scene `id`'s document, lets `change`
-    /// modify the copy (it may also complete `info`), commits.
+    /// Takes `writeMutex`, checks ctx.ifMatch against `scope` (checkIfMatch), copies scene `id`'s
+    /// document, lets `change` modify the copy (it may also complete `info`), commits. `change`
+    /// runs under `writeMutex` (not `mutex`): the scene stays as it read it until the commit.
     Result<json> edit(const std::string& id, const EditContext& ctx, detail::EditInfo& info,
-                      const std::function<Status(json&)>& change);
-    /// StaleRevision when `ctx.ifMatch` is set and is not `current`.
-    static Status checkIfMatch(const std::string& id, const EditContext& ctx, std::uint64_t current);
+                      const detail::EditScope& scope, const std::function<Status(json&)>& change);
+    /// Whether an edit of `scope` based on revision ctx.ifMatch may apply to scene `id` now, at
+    /// revision `current` with document `now` (SPEC §6 Concurrency): always without If-Match or
+    /// when it names `current`; for an older revision N (rebase), when what the edit touches is
+    /// the same in N as now and the model is the same — the placement (its JSON, or its absence)
+    /// for Placement and for Add with a given id, the list of placement ids for Order, the pose
+    /// for Pose; an Add without id always rebases; Whole never. N's document comes from the
+    /// recent revisions or else the store. Caller holds `writeMutex`, not `mutex`. Fails:
+    /// StaleRevision (Error::currentRevision set, the message saying what changed); NotFound
+    /// when the scene does not exist.
+    Status checkIfMatch(const std::string& id, const EditContext& ctx, const detail::EditScope& scope);
+    /// Counts frames whose scene was parsed and validated again from a document (a revision not
+    /// among the recent ones, a preview), as opposed to taken from a cached scene. For tests.
+    mutable std::atomic<std::uint64_t> framesPrepared{0};
     /// Sends `event` to the scene's subscribers as an SSE message named `name`.
     void publish(const std::string& sceneId, const json& event, const char* name = "change");
 
@@ -223,6 +271,12 @@ struct Service::State {
     /// The snapshot a frame with `p` shows: the current document or p.revision's, with
     /// p.patternsOff / p.only applied to the placements' `enabled`.
     Result<Snapshot> frameSnapshot(const std::string& id, const FrameParams& p) const;
+    /// Whether a scene validated earlier still renders as it did: its model and every pattern it
+    /// names (through its aliases) are still here. Caller holds `mutex` (shared is enough).
+    bool cachedRenders(const Scene& scene) const;
+    /// `snap` with p.patternsOff / p.only applied to its placements' `enabled` (an unknown id in
+    /// p.only: InvalidArgument, field "only").
+    Result<Snapshot> withCompare(Snapshot snap, const std::string& id, const FrameParams& p) const;
     /// Plans and renders one frame of `snap` with `p`'s overrides and outlines (not encoded);
     /// `camera` (when given) receives the camera used: distance, target x, y, z.
     Result<Image8> renderImage(const Snapshot& snap, const FrameParams& p,

@@ -290,7 +290,10 @@ try {
   await api("GET", "/scenes/{id}", { params: S, query: "revision=1", expect: 200 });
   await api("GET", "/scenes/{id}/revisions", { params: S, query: "limit=3", expect: 200 });
   await api("POST", "/scenes/{id}/revert", { params: S, body: { revision: 2 }, expect: 200 });
-  await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { id, pid: "elbow_l" }, expect: 201 });
+  // The default set has elbow_l's twin already: 409 naming it; the small scene gets one (201).
+  await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { id, pid: "elbow_l" }, expect: 409 });
+  await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { ...S, pid: "elbow_l" }, expect: 201 });
+  await api("PATCH", "/scenes/{id}/pose", { params: { id }, body: { time: 0.25 }, expect: 200 });
   await api("POST", "/scenes/{id}/presence", { params: S, body: { client: "ben", selection: ["elbow_l"], color: "#0af" }, expect: 200 });
   await api("GET", "/scenes/{id}/presence", { params: S, expect: 200 });
 
@@ -384,6 +387,7 @@ try {
   await api("POST", "/scenes/{id}/placements", { params: { id }, body: { center: [0.5, 0.5] }, invalidRequest: true, expect: 422 });
   await api("PATCH", "/scenes/{id}/pose", { params: { id }, body: { time: -1 }, invalidRequest: true, expect: 422 });
   await api("POST", "/scenes/{id}/presence", { params: { id }, body: { client: "ana", shape: "circle" }, invalidRequest: true, expect: 422 });
+  // Based on r1, from before that pose edit: a conflict (an edit of something unchanged since would be rebased).
   const stale = (await api("PATCH", "/scenes/{id}/pose", { params: { id }, headers: { "If-Match": '"r1"' }, body: {}, expect: 412 })).json();
   assert.equal(stale.revision, 2);
   await api("DELETE", "/scenes/{id}", { params: { id }, headers: { "If-Match": "r2" }, expect: 400 });

@@ -284,6 +284,9 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       await until(async () => (await state(page)).solo.length === 0, "solo off");
     }],
     ["M mirrors: the twin appears with the mirrored joint", async () => {
+      // The default set has the twin already (a second mirror would be 409): remove it first.
+      await api("DELETE", `/scenes/${sceneId}/placements/elbow_r`);
+      await until(async () => !(await state(page)).doc.placements.some((q) => q.id === "elbow_r"), "the editor heard of the delete");
       await settle();
       await select("elbow_l");
       const n0 = (await api("GET", `/scenes/${sceneId}`)).body.scene.placements.length;
