@@ -260,7 +260,7 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
     EXPECT_EQ(doc["pose"]["joints"]["hand.l"]["rotation"], json({0.0, 0.0, 0.0, 1.0})) << doc["pose"];
 
     EXPECT_EQ(dermis({"placement", "set", sid, "elbow_l", "h=1.5", "label=left elbow"}).out, sid + " r3\n");
-    EXPECT_EQ(dermis({"placement", "add", sid, "id=extra", "pattern=crease", "center=0.3,0.5", "scale=0.05,0.05", "joint=forearm.l",
+    EXPECT_EQ(dermis({"placement", "add", sid, "id=extra", "pattern=crease", "center=0.289,0.70", "scale=0.05,0.05", "joint=forearm.l",
                       "axis=x", "theta_max=120"})
                   .out,
               sid + " r4\n");
@@ -331,8 +331,13 @@ TEST_F(ClientHttpTest, FramesMapsLintAndWatch) {
     ASSERT_EQ(dermis({"maps", sid, "displacement", "-o", *dir_ / "frames/disp.f32"}).code, 0);
     EXPECT_EQ(fs::file_size(*dir_ / "frames/disp.f32") % 4, 0u);
 
+    ClientRun clean = dermis({"lint", sid});
+    EXPECT_EQ(clean.out, "no findings\n") << clean; // the shipped default scene lints clean
+    // A knee crease driven by the elbow: no_influence, shown as a table.
+    ASSERT_EQ(dermis({"placement", "set", sid, "knee_l", "joint=forearm.l"}).code, 0);
     ClientRun lint = dermis({"lint", sid});
     EXPECT_EQ(lint.code, 0) << lint;
+    EXPECT_NE(lint.out.find("no_influence"), std::string::npos) << lint;
     EXPECT_NE(lint.out.find("SEVERITY"), std::string::npos) << lint;
     ClientRun lintJson = dermis({"--json", "lint", sid});
     EXPECT_TRUE(lintJson.js().is_array()) << lintJson;
@@ -350,7 +355,7 @@ TEST_F(ClientHttpTest, FramesMapsLintAndWatch) {
     while (std::getline(lines, line)) events.push_back(json::parse(line, nullptr, false));
     ASSERT_EQ(events.size(), 2u) << slurp(out);
     EXPECT_EQ(events[0]["type"], "hello");
-    EXPECT_EQ(events[1]["revision"], 2);
+    EXPECT_EQ(events[1]["revision"], 3); // after the knee edit above
 }
 
 TEST_F(ClientHttpTest, BadArgumentsServerErrorsAndNoServer) {

@@ -416,7 +416,7 @@ try {
   const errorValidator = componentSchema("Error");
   wrong(errorValidator, { error: { message: "no code", field: "" } }, "an error without its code");
   wrong(errorValidator, { error: { code: "oops", message: "", field: "" } }, "an error with an unknown code");
-  const summary = { builtin: false, bytes: 50116, clips: 1, has_uvs: false, id: "m_825650b7acc9d69d", joints: 19, name: "RiggedFigure", triangles: 256 };
+  const summary = { builtin: false, bytes: 50116, clips: 1, has_texture: false, has_uvs: false, id: "m_825650b7acc9d69d", joint_count: 19, joints: 19, name: "RiggedFigure", triangles: 256 };
   assert.ok(componentSchema("ModelSummary")(summary));
   wrong(schemaOf("GET /models", "200"), { models: [{ ...summary, triangles: "256" }] }, "a model summary with a string triangle count");
   wrong(schemaOf("POST /models", "201"), { ...summary, uvs: true }, "a model summary with an unknown field");
