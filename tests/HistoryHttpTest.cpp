@@ -81,11 +81,16 @@ TEST_F(HistoryHttpTest, EtagsAndIfMatchGuardEveryEditRoute) {
     EXPECT_EQ(h.get(s).js(), before);
 
     // Weak, malformed and multiple ETags are refused before anything else happens: 400.
-    for (const std::string bad : {"W/\"r10\"", "r10", "\"10\"", "\"r\"", "\"r0\"", "\"r10\", \"r9\"",
+    for (const std::string bad : {"W/\"r10\"", "r10", "\"10\"", "\"r\"", "\"r10\", \"r9\"",
                                   "\"r99999999999999999999999\"", "\"r9x\""}) {
         Reply r = send("PATCH", s + "/placements/elbow", json{{"h", 3.0}}, ifMatch(bad));
         expectError(r, 400, "If-Match");
     }
+    // "r0" is a well-formed ETag of a revision no scene has: stale (412 with the current one).
+    Reply r0 = send("PATCH", s + "/placements/elbow", json{{"h", 3.0}}, ifMatch("\"r0\""));
+    expectError(r0, 412, "If-Match");
+    EXPECT_EQ(r0.js()["revision"], 10);
+    EXPECT_EQ(h.get(s).js(), before);
     // `*` matches any current revision; no If-Match applies as before.
     Reply star = send("PATCH", s + "/pose", json{{"time", 0.0}}, ifMatch("*"));
     EXPECT_EQ(star.status, 200) << star;

@@ -329,6 +329,10 @@ try {
   assert.ok(isJpeg(jpeg.bytes));
   assert.ok(jpeg.headers.get("x-dermis-backend"));
   await api("GET", "/scenes/{id}/frame", { params: S, query: "format=gif", expect: 422 });
+  // The same frame with its parameters in a JSON body (a preview too large for the request line).
+  const posted = await api("POST", "/scenes/{id}/frame", { params: S, body: { format: "jpeg", width: 48, height: 32, time: 0.3 }, expect: 200 });
+  assert.ok(posted.bytes.equals(jpeg.bytes), "POST frame = GET frame");
+  await api("POST", "/scenes/{id}/frame", { params: S, body: { bogus: 1 }, invalidRequest: true, expect: 422 });
   const diff = await api("GET", "/scenes/{id}/frame-diff", { params: S, query: "against=off", expect: 200 });
   assert.match(diff.headers.get("x-dermis-changed-pixels") || "", /^[0-9]+$/);
   for (const [map, format, media] of [["bump", "", "image/png"], ["displacement", "format=f32", "application/octet-stream"],
