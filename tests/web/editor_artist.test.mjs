@@ -9,7 +9,8 @@
 // of arrow keys is one revision per placement, each one undo step named by what it did; undo
 // after redo names the edit, not "revert"; the scene menu names models, a long name keeps the
 // toolbar one row at 1600 px, a new scene's notice counts joints; labels stay inside the view;
-// the activation strip names lanes as the list does; M on a placement whose twin exists adds none.
+// the activation strip names lanes as the list does; M on a placement whose twin exists adds none,
+// and without its twin makes one with the side swapped in id and label; the default scene lints clean.
 // Screenshots: editor-artist-labels-edge.png, editor-artist-1600.png.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
@@ -47,6 +48,8 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       assert.equal(typeof model.has_texture, "boolean", "the model answer says whether it has a texture");
       assert.deepEqual(bad, [], "no request answered 4xx/5xx");
       assert.deepEqual(consoleErrors, [], "no console error");
+      // The shipped default scene lints clean: no warning badge in the placements list.
+      assert.equal(await p.$$eval("#placementList .lintbadge", (b) => b.length), 0, "no lint badge on the default scene");
       await p.close();
     }],
     ["a click anywhere in the workspace keeps the texture view's zoom", async () => {
@@ -210,6 +213,18 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       await settled(page, api);
       assert.equal((await doc(sceneId)).scene.placements.length, n0, "no placement added");
       assert.ok(!(await notices(page)).some((t) => /dermis::/.test(t)));
+      // Without its twin, M makes one: the side swapped in id and label, the axis written round.
+      const rightId = left.id.replace(/_l$/, "_r");
+      assert.equal((await api("DELETE", `/scenes/${sceneId}/placements/${rightId}`)).status, 200);
+      assert.equal((await api("PATCH", `/scenes/${sceneId}/placements/${left.id}`, { label: "Elbow L crease" })).status, 200);
+      await settled(page, api);
+      await page.focus("#uv");
+      await page.keyboard.press("m");
+      const twin = await until(async () => (await doc(sceneId)).scene.placements.find((p) => p.id === rightId), "the twin");
+      assert.equal(twin.label, "Elbow R crease");
+      const axis = Array.isArray(twin.axis) ? twin.axis : [];
+      for (const c of axis) assert.ok(c === 0 || (Math.abs(c) >= 1e-6 && Math.abs(c * 1e6 - Math.round(c * 1e6)) < 1e-6), `axis ${JSON.stringify(twin.axis)} written round`);
+      assert.ok(!(await doc(sceneId)).scene.placements.some((p) => /_mirror$/.test(p.id)), "no _mirror ids");
     }],
     ["1600 px: the scene menu names models, a long name keeps the toolbar one row, a new scene's notice counts joints", async () => {
       const glb = readFileSync(new URL("../../../shared/models/CesiumMan/CesiumMan.glb", import.meta.url));
