@@ -4,6 +4,10 @@ ASAN_BUILD ?= build-asan
 FUZZ_BUILD ?= build-fuzz
 FUZZ_SECONDS ?= 60
 JOBS ?= 2
+# ccache (when installed, see DERMIS_CCACHE): paths relative to the clone, so that another clone
+# of the same sources (CI's) hits the same cache entries.
+export CCACHE_BASEDIR ?= $(CURDIR)
+export CCACHE_NOHASHDIR ?= 1
 CMAKE_FLAGS ?=
 
 .PHONY: all deps build test test-asan fuzz run offline bench loadbench authorbench patterns character clean format

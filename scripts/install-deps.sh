@@ -4,7 +4,7 @@
 # package is missing, and npm when the lock file changed.
 set -euo pipefail
 PKGS=(
-  cmake g++ make ninja-build pkg-config
+  cmake g++ make ninja-build pkg-config ccache
   libglm-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
   libopenimageio-dev
   libpng-dev zlib1g-dev libturbojpeg0-dev libwebp-dev
