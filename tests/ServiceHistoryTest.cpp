@@ -419,6 +419,28 @@ TEST_F(ServiceHistoryTest, PresenceIsBroadcastListedAndChecked) {
     svc_->unsubscribe(id, *sub);
 }
 
+TEST_F(ServiceHistoryTest, PresenceIsBoundedPerAddressAndPerScene) {
+    const std::string id = (*svc_->createScene(kEmpty))["id"];
+    // One address cycling names keeps at most its share; its oldest entries make room.
+    for (int k = 0; k < 40; ++k)
+        ASSERT_TRUE(svc_->postPresence(id, {{"client", "bot" + std::to_string(k)}}, "10.0.0.1"));
+    json live = (*svc_->listPresence(id))["presence"];
+    ASSERT_EQ(live.size(), Service::kMaxPresencePerAddress);
+    EXPECT_EQ(live.back()["client"], "bot39");
+    for (const json& e : live) EXPECT_NE(e["client"], "bot0") << "the oldest names were dropped";
+    // Other addresses fill the scene up to its cap; then a new name is refused, a known one not.
+    const std::size_t others = Service::kMaxPresencePerScene - Service::kMaxPresencePerAddress;
+    for (std::size_t k = 0; k < others; ++k)
+        ASSERT_TRUE(svc_->postPresence(id, {{"client", "p" + std::to_string(k)}}, "10.0.1." + std::to_string(k)));
+    EXPECT_EQ((*svc_->listPresence(id))["presence"].size(), Service::kMaxPresencePerScene);
+    auto full = svc_->postPresence(id, {{"client", "late"}}, "10.0.2.1");
+    ASSERT_FALSE(full);
+    EXPECT_EQ(full.error().code, ErrorCode::Unavailable);
+    EXPECT_TRUE(svc_->postPresence(id, {{"client", "p0"}, {"selection", {"a"}}}, "10.0.1.0")) << "a refresh";
+    EXPECT_TRUE(svc_->postPresence(id, {{"client", "bot99"}}, "10.0.0.1")) << "within its own share";
+    EXPECT_EQ((*svc_->listPresence(id))["presence"].size(), Service::kMaxPresencePerScene);
+}
+
 TEST_F(ServiceHistoryTest, PresenceLapsesAfterItsTime) {
     ServerLimits limits;
     limits.presenceSeconds = 0.3;

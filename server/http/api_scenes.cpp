@@ -150,7 +150,7 @@ void installHistoryRoutes(RouteTable& t) {
     t.add("POST", "/scenes/{id}/presence", [](Api::Impl& a, const Req& req, Res& res) {
         json body;
         if (!jsonBody(req, res, body)) return;
-        auto r = a.svc.postPresence(req.matches[1], body);
+        auto r = a.svc.postPresence(req.matches[1], body, req.remote_addr);
         if (!r) return sendError(res, r.error());
         sendJson(res, 200, *r);
     });

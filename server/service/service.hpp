@@ -302,7 +302,14 @@ public:
     /// after the last refresh; the next presence call on the scene after that announces
     /// {"type": "presence", "client", "selection": [], "left": true}.
     /// Answers {"scene", "presence": [{client, selection, color, expires_in}]}.
-    Result<nlohmann::json> postPresence(const std::string& id, const nlohmann::json& body);
+    /// Bounded (issue #27): at most kMaxPresencePerAddress live entries per scene from one peer
+    /// `address` (a new name from an address at its cap replaces that address's entry nearest to
+    /// lapsing) and kMaxPresencePerScene per scene (past it a new name is refused: Unavailable),
+    /// so a scene's presence answer stays under ~1 MB.
+    Result<nlohmann::json> postPresence(const std::string& id, const nlohmann::json& body,
+                                        const std::string& address = "");
+    static constexpr std::size_t kMaxPresencePerScene = 64;
+    static constexpr std::size_t kMaxPresencePerAddress = 16;
     Result<nlohmann::json> listPresence(const std::string& id);
 
     // --- inspection (CPU only; service_inspect.cpp)

@@ -131,7 +131,7 @@ json Service::State::livePresence(const std::string& sceneId) {
     return live;
 }
 
-Result<json> Service::postPresence(const std::string& id, const json& body) {
+Result<json> Service::postPresence(const std::string& id, const json& body, const std::string& address) {
     if (!body.is_object()) return bad("", "presence must be a JSON object");
     for (auto it = body.begin(); it != body.end(); ++it)
         if (it.key() != "client" && it.key() != "selection" && it.key() != "color")
@@ -162,7 +162,31 @@ Result<json> Service::postPresence(const std::string& id, const json& body) {
     }
     std::lock_guard<std::mutex> pl(state_->presenceMutex);
     const std::string name = client->get<std::string>();
-    PresenceEntry& e = state_->presence[id][name];
+    state_->livePresence(id); // lapsed entries go first (and are announced)
+    auto& entries = state_->presence[id];
+    if (!entries.count(name)) {
+        // A new name: within its address's share (its entry nearest to lapsing makes room), and
+        // within the scene's.
+        std::vector<decltype(entries.begin())> mine;
+        for (auto it = entries.begin(); it != entries.end(); ++it)
+            if (it->second.address == address) mine.push_back(it);
+        if (mine.size() >= kMaxPresencePerAddress) {
+            auto oldest = *std::min_element(mine.begin(), mine.end(), [](const auto& a, const auto& b) {
+                return a->second.expires < b->second.expires;
+            });
+            state_->publish(id,
+                            {{"type", "presence"}, {"scene", id}, {"client", oldest->first},
+                             {"selection", json::array()}, {"color", oldest->second.color}, {"left", true}},
+                            "presence");
+            entries.erase(oldest);
+        } else if (entries.size() >= kMaxPresencePerScene) {
+            return makeError(ErrorCode::Unavailable, "dermis::Service::postPresence", "/client",
+                             std::to_string(kMaxPresencePerScene) +
+                                 " people are on this scene, the most its presence lists; retry later");
+        }
+    }
+    PresenceEntry& e = entries[name];
+    e.address = address;
     e.selection = selection;
     e.color = color;
     e.expires = nowSeconds() + limits_.presenceSeconds;

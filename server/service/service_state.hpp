@@ -130,6 +130,7 @@ struct PresenceEntry {
     json selection = json::array();
     std::string color;
     double expires = 0.0; ///< nowSeconds() at which it lapses
+    std::string address;  ///< the peer address that posted it ("" when not known)
 };
 
 /// The glTF loader's limits (checked from declared sizes, before allocating) for a server's
