@@ -132,6 +132,32 @@ TEST_F(LintTest, FindsEachPurposeBuiltProblem) {
     for (const LintFinding& x : overlap)
         if (x.code == "overlap") EXPECT_EQ(x.message.find("other"), std::string::npos) << x.message;
 
+    // Forty footprints on one spot: one finding per placement, each naming at most five others
+    // (before: one per pair, 780 findings; the answer grew with the square of the count).
+    std::vector<Placement> crowd;
+    for (int k = 0; k < 40; ++k) {
+        Placement c = elbow();
+        c.id = "c" + std::to_string(k);
+        c.center[0] += 0.0005 * k;
+        crowd.push_back(c);
+    }
+    const auto crowded = lint(crowd);
+    std::size_t overlapFindings = 0, bytes = 0;
+    for (const LintFinding& x : crowded)
+        if (x.code == "overlap") {
+            ++overlapFindings;
+            bytes += x.message.size();
+            EXPECT_LT(x.message.size(), 400u) << x.message;
+        }
+    EXPECT_EQ(overlapFindings, 39u) << "one per placement that overlaps a later one";
+    EXPECT_LT(bytes, 39u * 400u);
+    ASSERT_TRUE(has(crowded, "overlap", 0));
+    for (const LintFinding& x : crowded)
+        if (x.code == "overlap" && x.placement == 0) {
+            EXPECT_NE(x.message.find("overlaps 39 placements"), std::string::npos) << x.message;
+            EXPECT_NE(x.message.find("and 34 more"), std::string::npos) << x.message;
+        }
+
     // A θ range no clip reaches.
     Placement far = elbow();
     far.id = "far";

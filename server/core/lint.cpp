@@ -20,6 +20,9 @@ std::string_view toString(LintSeverity s) {
 
 namespace {
 
+/// The most other placements one overlap finding names (the rest are counted).
+constexpr std::size_t kOverlapNames = 5;
+
 constexpr int kGrid = 12;
 constexpr float kFlat = 0.02f;
 
@@ -227,18 +230,31 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
             out.push_back({"no_influence", LintSeverity::Warning, idx,
                            "neither joint '" + p.joint + "' nor its parent has skin weight under "
                            "the footprint: the skin there does not bend with that joint"});
+        // Each pair once (on the earlier placement), all of a placement's pairs in one finding
+        // naming at most kOverlapNames of them: the answer grows with the placements, not with
+        // their square (issue #27: 82 MB at 1,000 placements before).
+        std::size_t overlaps = 0;
+        std::string named;
         for (std::size_t j = i + 1; j < scene.placements.size(); ++j) {
             const Placement& q = scene.placements[j];
             if (!q.enabled || q.target != p.target) continue;
             std::size_t shared = 0;
             for (glm::dvec2 uv : points[i])
                 if (covers(q, images, uv)) ++shared;
-            if (shared > 0)
-                out.push_back({"overlap", LintSeverity::Warning, idx,
-                               "overlaps placement '" + q.id + "' on the " +
-                                   std::string(toString(p.target)) + " map (" +
-                                   percent(shared, n) + " of this footprint): heights add up"});
+            if (shared == 0) continue;
+            if (++overlaps <= kOverlapNames)
+                named += std::string(named.empty() ? "" : ", ") + "'" + q.id + "' (" + percent(shared, n) + ")";
         }
+        if (overlaps == 1)
+            out.push_back({"overlap", LintSeverity::Warning, idx,
+                           "overlaps placement " + named + " of this footprint on the " +
+                               std::string(toString(p.target)) + " map: heights add up"});
+        else if (overlaps > 1)
+            out.push_back({"overlap", LintSeverity::Warning, idx,
+                           "overlaps " + std::to_string(overlaps) + " placements on the " +
+                               std::string(toString(p.target)) + " map (share of this footprint): " + named +
+                               (overlaps > kOverlapNames ? " and " + std::to_string(overlaps - kOverlapNames) + " more" : "") +
+                               ": heights add up"});
     }
     lintMirrorPairs(scene, model, lookup, derived, out);
     std::stable_sort(out.begin(), out.end(),
