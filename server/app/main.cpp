@@ -127,6 +127,7 @@ struct ServeArgs {
     double maxUploadMb = 64;
     double gpuCacheMb = static_cast<double>(dermis::kDefaultGpuCacheBytes >> 20);
     double contentCacheMb = static_cast<double>(dermis::ServerLimits{}.contentCacheBytes >> 20);
+    double decodeBudgetMb = static_cast<double>(dermis::ServerLimits{}.decodeBudgetBytes >> 20);
     dermis::ApiOptions api; ///< connection limits (head deadline, per-address and total caps)
 };
 
@@ -140,6 +141,7 @@ int runServe(ServeArgs a) {
                   << " characters; use at least 16 random ones (e.g. `openssl rand -hex 16`)\n";
     a.limits.maxUploadBytes = static_cast<std::size_t>(a.maxUploadMb * 1024.0 * 1024.0);
     a.limits.contentCacheBytes = static_cast<std::size_t>(a.contentCacheMb * 1024.0 * 1024.0);
+    a.limits.decodeBudgetBytes = static_cast<std::size_t>(a.decodeBudgetMb * 1024.0 * 1024.0);
     // SIGINT/SIGTERM are taken by a waiting thread (blocked here, before any thread starts).
     sigset_t signals;
     sigemptyset(&signals);
@@ -239,6 +241,10 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
                    "Connections open at once in all (one thread each); past it the oldest connection "
                    "that never finished a request head is closed for the new one, else 503, closed")
         ->check(CLI::Range(1, 65536));
+    app.add_option("--decode-budget-mb", s.decodeBudgetMb,
+                   "Memory of pattern decodes in flight (uploads, batch parts); a decode that does not "
+                   "fit waits up to 2 s, then 503")
+        ->check(CLI::Range(16.0, 65536.0));
     app.add_option("--max-streams-per-address", s.api.maxStreamsPerAddress,
                    "Event streams one peer address may hold (default: half of the server's 16); "
                    "raise it behind a reverse proxy, where every stream comes from its address")

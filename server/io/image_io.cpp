@@ -55,12 +55,12 @@ bool looksLikePngOrJpeg(const std::string& path) {
 
 /// A pattern read by the OpenImageIO module (loaded on first use) from a file or from bytes.
 Result<HeightImage> readHeightThroughModule(const char* where, const std::string* path,
-                                            const std::vector<std::uint8_t>* bytes) {
+                                            const std::vector<std::uint8_t>* bytes, int maxSide = kMaxPatternSize) {
     auto api = oiio::oiioApi();
     if (!api) return api.error();
     HeightImage img;
     oiio::OiioFailure f;
-    if (!(*api)->readHeight(path, bytes, kMaxPatternSize, img, f)) return moduleError(where, f);
+    if (!(*api)->readHeight(path, bytes, maxSide, img, f)) return moduleError(where, f);
     return img;
 }
 
@@ -85,14 +85,15 @@ Result<HeightImage> readHeightImage(const std::string& path) {
     return readHeightThroughModule(where, &path, nullptr);
 }
 
-Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes) {
+Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes, int maxSide) {
     const char* where = "dermis::readHeightImageFromMemory";
+    maxSide = std::clamp(maxSide, 1, kMaxPatternSize);
     if (bytes.empty()) return makeError(ErrorCode::Parse, where, "", "empty image data");
-    if (auto direct = decodeDirect(bytes.data(), bytes.size(), kMaxPatternSize, where, "")) {
+    if (auto direct = decodeDirect(bytes.data(), bytes.size(), maxSide, where, "")) {
         if (!*direct) return direct->error();
         return heightOf(**direct);
     }
-    return readHeightThroughModule(where, nullptr, &bytes);
+    return readHeightThroughModule(where, nullptr, &bytes, maxSide);
 }
 
 Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes) {

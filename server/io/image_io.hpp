@@ -32,7 +32,9 @@ Result<HeightImage> readHeightImage(const std::string& path);
 /// Same, from encoded bytes in memory (PNG, JPEG, TIFF, EXR, BMP, HDR, WebP, GIF, TGA, by
 /// content), decoded in memory: no file is written, not even a temporary one. Parse for empty,
 /// unrecognised or corrupt data; Unsupported for a format that cannot be read from memory.
-Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes);
+/// Sides over `maxSide` are refused (TooLarge) from the header or the decoder's spec, before any
+/// pixel is decoded, whatever the format.
+Result<HeightImage> readHeightImageFromMemory(const std::vector<std::uint8_t>& bytes, int maxSide = kMaxPatternSize);
 
 /// Encodes a height map in memory as a single-channel ("Y") 32-bit float OpenEXR, row 0 first,
 /// values as they are, through the OpenImageIO module with its default compression.

@@ -55,8 +55,8 @@ bool checkSpec(const std::string& name, const ImageSpec& spec, int maxSide, Oiio
         return failWith(f, ErrorCode::Parse, name, "image has no pixels");
     if (spec.depth > 1)
         return failWith(f, ErrorCode::Unsupported, name, "volume images are not supported");
-    if (spec.width > maxSide || spec.height > maxSide)
-        return failWith(f, ErrorCode::InvalidArgument, name,
+    if (spec.width > maxSide || spec.height > maxSide) // from the spec: no pixel decoded yet
+        return failWith(f, ErrorCode::TooLarge, name,
                         "image is " + std::to_string(spec.width) + "x" +
                             std::to_string(spec.height) + ", larger than the limit of " +
                             std::to_string(maxSide) + " per side");

@@ -313,6 +313,7 @@ Result<std::unique_ptr<Service>> Service::open(const ServiceConfig& config,
     st.contentDir = config.contentDir.empty() ? dermisContentDir() : config.contentDir;
     st.renderer = std::move(renderer);
     st.content = std::make_unique<ContentCache>(config.limits.contentCacheBytes);
+    st.decodeBudget = std::make_unique<DecodeBudget>(config.limits.decodeBudgetBytes);
     keepLargeBuffersMapped();
     auto store = Store::open(config.dataDir);
     if (!store) return store.error();

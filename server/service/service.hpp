@@ -61,6 +61,9 @@ struct ServerLimits {
     std::size_t maxBatchFrames = 512;
     /// Decoded models and patterns that batches sent inline, kept by content address (LRU).
     std::size_t contentCacheBytes = 256u << 20;
+    /// Memory of pattern decodes in flight (uploads and batch parts), estimated before each
+    /// decode (DecodeBudget): a decode that does not fit waits up to 2 s, then Unavailable.
+    std::size_t decodeBudgetBytes = 512u << 20;
     double presenceSeconds = 30.0; ///< a presence entry lapses this long after its last refresh
     nlohmann::json toJson() const;
 };

@@ -121,7 +121,7 @@ Result<ContentOverlay> Service::State::resolveContent(
             cost = ContentCache::approxBytes(*model);
             item.model = std::make_shared<const Model>(std::move(*model));
         } else {
-            auto img = decodePatternBytes(bytes, limits, kWhere, address);
+            auto img = decodePatternBytes(bytes, limits, kWhere, address, decodeBudget.get());
             if (!img) {
                 Error e = img.error();
                 e.message = std::string(kWhere) + ": " + address + " (" + use->second->field + "): " + e.message;

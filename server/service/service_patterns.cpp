@@ -51,7 +51,7 @@ std::string sniffExtension(const std::vector<std::uint8_t>& b) {
 } // namespace
 
 Result<HeightImage> detail::decodePatternBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
-                                               const char* where, const std::string& field) {
+                                               const char* where, const std::string& field, DecodeBudget* budget) {
     if (bytes.size() > limits.maxUploadBytes)
         return makeError(ErrorCode::TooLarge, where, field, "larger than " + std::to_string(limits.maxUploadBytes) + " bytes");
     // PNG and JPEG sides from their headers before anything is decoded: a small file declaring
@@ -65,8 +65,23 @@ Result<HeightImage> detail::decodePatternBytes(const std::vector<std::uint8_t>& 
         declared && (declared->width > static_cast<std::uint32_t>(limits.maxImageSide) ||
                      declared->height > static_cast<std::uint32_t>(limits.maxImageSide)))
         return tooLarge(declared->width, declared->height);
-    auto img = readHeightImageFromMemory(bytes);
-    if (!img) return img.error();
+    // The decode's memory, reserved before it starts: pixels as decoded (up to 4 bytes) plus the
+    // float map (4 bytes), from the declared size, else the worst case the side limit allows.
+    std::optional<DecodeBudget::Lease> lease;
+    if (budget) {
+        const auto side = static_cast<std::uint64_t>(std::max(limits.maxImageSide, 1));
+        const auto declared = encodedImageSize(bytes.data(), bytes.size());
+        const std::uint64_t pixels = declared ? std::uint64_t(declared->width) * declared->height : side * side;
+        auto reserved = budget->reserve(static_cast<std::size_t>(pixels * 8), std::chrono::seconds(2), field);
+        if (!reserved) return reserved.error();
+        lease.emplace(std::move(*reserved));
+    }
+    auto img = readHeightImageFromMemory(bytes, limits.maxImageSide);
+    if (!img) {
+        Error e = img.error();
+        if (e.field.empty()) e.field = field; // the image as a whole: the upload's body, the batch's part
+        return e;
+    }
     if (img->width > limits.maxImageSide || img->height > limits.maxImageSide)
         return tooLarge(static_cast<std::uint64_t>(img->width), static_cast<std::uint64_t>(img->height));
     return img;
@@ -102,7 +117,7 @@ Result<json> Service::addPattern(const std::vector<std::uint8_t>& bytes, const s
             return patternSummary(known->second, img == state_->images.end() ? nullptr : &img->second->pixels);
         }
     }
-    auto img = decodePatternBytes(bytes, limits_, where, "body");
+    auto img = decodePatternBytes(bytes, limits_, where, "body", state_->decodeBudget.get());
     if (!img) return img.error();
     PatternEntry e;
     e.id = id;

@@ -11,6 +11,7 @@
 // alive after the lock is released, so deleting a pattern never waits for a render.
 #pragma once
 
+#include "service/decode_budget.hpp"
 #include "service/service.hpp"
 
 #include "core/frame_plan.hpp"
@@ -73,8 +74,12 @@ Result<Model> decodeModelBytes(const std::vector<std::uint8_t>& bytes, const Ser
                                const char* where, const std::string& field);
 /// An uploaded pattern image decoded and checked against `limits` (sides from the header of a
 /// PNG or JPEG before anything is decoded).
+/// The decode's memory is reserved in `budget` first (when given): the declared w·h·8 bytes for
+/// PNG and JPEG, the worst case maxImageSide²·8 for other formats (whose sides the decoder
+/// checks from its spec before any pixel); Unavailable when the budget has no room within 2 s.
 Result<HeightImage> decodePatternBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
-                                       const char* where, const std::string& field);
+                                       const char* where, const std::string& field,
+                                       DecodeBudget* budget = nullptr);
 
 /// One revision of a scene as it was validated: its canonical document and its scene (shared,
 /// immutable: readers keep them after the lock is released).
@@ -177,6 +182,7 @@ private:
 
 struct Service::State {
     std::optional<Store> store;
+    std::unique_ptr<DecodeBudget> decodeBudget; ///< pattern decodes in flight (limits.decodeBudgetBytes)
     std::unique_ptr<FrameRenderer> renderer;
     std::string contentDir;
     PatternManifest manifest;
