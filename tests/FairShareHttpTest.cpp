@@ -8,6 +8,7 @@
 //     the normal client is still answered (the oldest unfinished head is shed; before: 503 for as
 //     long as the attack lasted).
 #include "HttpTestFixture.hpp"
+#include "LoopbackSocket.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -22,25 +23,7 @@ using namespace dermis::test::http;
 namespace {
 
 /// A connection to 127.0.0.1:port from source address `from` (e.g. "127.0.0.2"); -1 on failure.
-int connectFrom(int port, const char* from) {
-    const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in src{};
-    src.sin_family = AF_INET;
-    ::inet_pton(AF_INET, from, &src.sin_addr);
-    if (::bind(s, reinterpret_cast<sockaddr*>(&src), sizeof src) != 0) {
-        ::close(s);
-        return -1;
-    }
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(static_cast<std::uint16_t>(port));
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-        ::close(s);
-        return -1;
-    }
-    return s;
-}
+int connectFrom(int port, const char* from) { return connectLoopback(port, from); }
 
 /// Sends `request` and reads until the answer's head is complete (or 5 s); the status, 0 if none.
 int statusOf(int s, const std::string& request) {

@@ -8,6 +8,7 @@
 // Each: exactly one answer comes back, the connection is closed after it, and the scene is still
 // there. Before the fix the DELETE ran (the scene was gone) and a second answer came back.
 #include "HttpTestFixture.hpp"
+#include "LoopbackSocket.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -28,15 +29,8 @@ using Clock = std::chrono::steady_clock;
 /// Sends `bytes` on a fresh connection to 127.0.0.1:port (as much as the server takes within
 /// 5 s) and reads until the server closes or 5 s pass. {everything read, closed by the server}.
 std::pair<std::string, bool> exchange(int port, const std::string& bytes) {
-    const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(static_cast<std::uint16_t>(port));
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-        ::close(s);
-        return {"", false};
-    }
+    const int s = connectLoopback(port);
+    if (s < 0) return {"", false};
     const auto until = Clock::now() + std::chrono::seconds(5);
     std::size_t sent = 0;
     std::string got;
