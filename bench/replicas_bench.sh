@@ -5,7 +5,11 @@
 # rendered by `dermis render --scene-file … --parallel N --batch 10` through nginx, at 512² and
 # 1024², PNG. Each configuration runs once untimed first (content sent by address, GL warm), then
 # timed: frames/s = frames / the client's wall time. Prints JSON on stdout:
-#   {"frames", "backend", "cores", "runs": [{"size", "replicas", "seconds", "fps", "speedup"}, …]}
+#   {"frames", "backend", "cores", "runs": [{"size", "replicas", "seconds", "fps", "speedup",
+#    "first_run_content_misses", "first_run_files_sent"}, …]} — the last two from the untimed first
+#    run, which sends the content: replicas' content-cache misses (one 409 counts 4: both files
+#    looked up for the request and for its resend) and the files the client sent along after 409s
+#    (2 per 409: one 409 per replica a batch went to).
 # Usage: bench/replicas_bench.sh [BUILD_DIR] [GL_BACKEND] [FRAMES]   (build, egl-surfaceless, 60)
 set -euo pipefail
 build="${1:-build}"
@@ -58,20 +62,28 @@ for size in 512 1024; do
     pids+=($!)
     for _ in $(seq 100); do curl -s -o /dev/null "http://127.0.0.1:$port/api/v1/health" && break; sleep 0.05; done
     run() {
-      "$client" --server "http://127.0.0.1:$port" render --scene-file "$work/shot/shot.scene.json" --frames "$range" \
-        --size "${size}x${size}" --batch 10 --parallel "$n" -o "$1/frame_%04d.png" >/dev/null
+      "$client" --server "http://127.0.0.1:$port" --json render --scene-file "$work/shot/shot.scene.json" --frames "$range" \
+        --size "${size}x${size}" --batch 10 --parallel "$n" -o "$1/frame_%04d.png" >"$1.json"
     }
     run "$work/warm"
+    # The first run sends the content: how often replicas asked for it (409 missing_content) and
+    # how many files the client sent along.
+    misses=0
+    for p in "${ports[@]}"; do
+      m=$(curl -s "http://127.0.0.1:$p/api/v1/info" | python3 -c 'import json,sys; print(json.load(sys.stdin)["content_cache"]["misses"])')
+      misses=$((misses + m))
+    done
+    sent=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["content_sent"])' "$work/warm.json")
     t0=$(now)
     run "$work/timed"
     t1=$(now)
     [ "$(ls "$work/timed" | wc -l)" -eq "$frames" ] || { echo "replicas_bench: $size² with $n replicas is incomplete" >&2; exit 1; }
     stop_all
-    rm -rf "$work/warm" "$work/timed" "$work"/data_*
+    rm -rf "$work/warm" "$work/timed" "$work/warm.json" "$work/timed.json" "$work"/data_*
     secs=$(python3 -c "print(round($t1 - $t0, 3))")
     fps=$(python3 -c "print(round($frames / ($t1 - $t0), 2))")
     [ -n "$base" ] || base=$fps
-    rows+=("{\"size\": $size, \"replicas\": $n, \"seconds\": $secs, \"fps\": $fps, \"speedup\": $(python3 -c "print(round($fps / $base, 2))")}")
+    rows+=("{\"size\": $size, \"replicas\": $n, \"seconds\": $secs, \"fps\": $fps, \"speedup\": $(python3 -c "print(round($fps / $base, 2))"), \"first_run_content_misses\": $misses, \"first_run_files_sent\": $sent}")
   done
 done
 printf '{"frames": %d, "backend": "%s", "cores": %d, "runs": [\n  %s\n]}\n' "$frames" "$gl" "$(nproc)" \

@@ -259,6 +259,7 @@ bool Http::stream(const std::string& method, const std::string& path, const std:
     req.method = method;
     req.path = url(path);
     if (!contentType.empty()) req.headers.emplace("Content-Type", contentType);
+    if (!contentKey_.empty()) req.headers.emplace("X-Dermis-Content-Key", contentKey_);
     req.body = body;
     bool stopped = false, tooLarge = false;
     int status = 0;

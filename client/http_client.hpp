@@ -84,6 +84,11 @@ public:
     /// --deadline → exit 3. Not retried. Returns the answer's status, headers and byte count.
     Reply download(const std::string& path, const std::string& out, FileKind kind);
 
+    /// Sent as `X-Dermis-Content-Key` with every streamed request (batches) from now on: a proxy
+    /// in front of replicas routes the same key to the same replica (docker/nginx-replicas.conf),
+    /// so content sent after a 409 missing_content lands where it was asked for. "" sends none.
+    void setContentKey(std::string key) { contentKey_ = std::move(key); }
+
     /// The full path for a route: prefix + "/api/v1" + `path`.
     std::string url(const std::string& path) const { return prefix_ + path; }
     const std::string& server() const { return server_; }
@@ -99,6 +104,7 @@ private:
     GlobalOptions options_;
     std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
     std::string server_, prefix_;
+    std::string contentKey_;
     std::unique_ptr<httplib::Client> client_;
 };
 

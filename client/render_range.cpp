@@ -4,8 +4,10 @@
 #include "batch.hpp"
 #include "frames.hpp"
 #include "http_client.hpp"
+#include "io/sha256.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <deque>
 #include <mutex>
@@ -24,9 +26,20 @@ RangeOutcome renderRange(const GlobalOptions& options, const RangeJob& job, Prog
     std::optional<CliError> fatal;
     std::size_t left = job.pending.size(); // frames not yet written or failed
 
+    // One content key per worker: the scene's content (its addresses, or the document) plus the
+    // worker's slot, so that behind nginx each worker's batches stay on one replica (content sent
+    // once there) while --parallel workers still spread over replicas.
+    std::string contentOf;
+    if (job.content && !job.content->empty())
+        for (const auto& [address, path] : job.content->paths) contentOf += address + "\n";
+    else
+        contentOf = job.scene.dump();
+    const std::string contentKey = toHex(sha256(std::string_view(contentOf))).substr(0, 16);
+    std::atomic<int> slots{0};
     const auto worker = [&] {
         try {
             Http http(options);
+            http.setContentKey(contentKey + "-" + std::to_string(slots++));
             int stalls = 0; // broken answers in a row without a frame
             for (;;) {
                 std::vector<std::size_t> chunk;
@@ -65,8 +78,10 @@ RangeOutcome renderRange(const GlobalOptions& options, const RangeJob& job, Prog
                         return;
                     }
                     ++out.retries;
+                    progress.note("retrying the batch of frames " + std::to_string(chunk.front()) + "–" +
+                                  std::to_string(chunk.back()) + " (" + std::to_string(rest.size()) + " not received) after: " +
+                                  r.brokenWhy);
                     queue.push_front(std::move(rest));
-                    progress.note("retrying " + std::to_string(left) + " frames after: " + r.brokenWhy);
                     lock.unlock();
                     std::this_thread::sleep_for(std::chrono::duration<double>(0.25 * double(1 << std::min(stalls, 5))));
                     continue;
