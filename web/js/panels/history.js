@@ -17,6 +17,8 @@ export function initHistory(section, theApi) {
   list = section.querySelector("#historyList");
   list.addEventListener("keydown", onListKey);
   on("revision", () => whenIdle("history", load));
+  // Another scene: its history at once (not the last scene's until things are quiet).
+  on("scene", () => { list.innerHTML = ""; load(); });
 }
 
 async function load() {
