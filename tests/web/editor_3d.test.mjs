@@ -156,7 +156,12 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       assert.ok(on, "a pixel on the skin");
       const [x, y] = await client(on.px);
       await page.mouse.move(x, y);
-      await until(async () => page.evaluate(async () => { const m = await import("/js/camera3d.js"); return !!(m.pointer.last && m.pointer.last.hit); }), "the hover pick landed");
+      // The hover pick of this very pixel (not an earlier one still landing: slow under ASan).
+      await until(async () => page.evaluate(async (px) => {
+        const m = await import("/js/camera3d.js");
+        const last = m.pointer.last;
+        return !!(last && last.hit && Math.hypot(last.px[0] - px[0], last.px[1] - px[1]) <= 3);
+      }, on.px), "the hover pick of the pixel under the pointer landed");
       const c0 = await camera();
       await page.mouse.wheel(0, -200);
       const c1 = await until(async () => { const c = await camera(); return c.distance < c0.distance && c; }, "zoomed in");
