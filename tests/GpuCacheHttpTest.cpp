@@ -107,7 +107,15 @@ TEST_F(GpuCacheHttpTest, DeletedPatternsGiveTheirTexturesBack) {
     const double after = rssMb();
     std::cout << "[ rss ] before " << before << " MB, after 19 more cycles " << after
               << " MB, peak " << peak << " MB\n";
-    EXPECT_LT(after - before, 100.0) << "resident memory grew by " << after - before << " MB";
+    // Under AddressSanitizer freed memory stays resident in its quarantine (up to 256 MB), which
+    // adds ~100 MB of noise here: the bound doubles there (a leaked 64 MB texture per cycle would
+    // still be over 1 GB after 19 cycles).
+#if defined(__SANITIZE_ADDRESS__)
+    constexpr double kGrowthMb = 200.0;
+#else
+    constexpr double kGrowthMb = 100.0;
+#endif
+    EXPECT_LT(after - before, kGrowthMb) << "resident memory grew by " << after - before << " MB";
 
     // The deletes reached the renderer: a frame after them (the render queue runs in order)
     // finds no texture of a deleted pattern left in the cache.
