@@ -79,11 +79,13 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       const s = await state(a);
       assert.notEqual(s.camera.yaw, 0);
       const hashA = await settledFrameHash(a);
+      const urlA = await a.evaluate(() => window.dermisEditor.frameUrl());
       // Someone edits after the link was made: the link still shows its revision.
       await api("PATCH", `/scenes/${sceneId}/placements/elbow_l`, { h: 0.3 });
       const fresh = await browser.newContext();
       const c = await openEditor(fresh, link);
       const hashC = await settledFrameHash(c);
+      assert.equal(await c.evaluate(() => window.dermisEditor.frameUrl()), urlA, "the same frame parameters");
       assert.equal(hashC, hashA);
       const sc = await state(c);
       assert.deepEqual(sc.selection, ["elbow_l"]);

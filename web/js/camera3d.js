@@ -165,6 +165,8 @@ export function initCamera(stage, theApi, ctx) {
   stage.addEventListener("pointercancel", end);
   stage.addEventListener("pointerleave", () => {
     if (drag) return;
+    leaveGeneration++; // a pick still in flight is for a pointer that has gone
+    wantedPick = null;
     pointer.last = null;
     setHover(null, null, ctx);
   });
@@ -193,8 +195,9 @@ async function orbitPivot(ctx) {
   try { return (await focusOf(pid, ctx.params())).target; } catch { return null; }
 }
 
-// Picks for hover: one in flight, the newest pointer position next.
-let picking = false, wantedPick = null;
+// Picks for hover: one in flight, the newest pointer position next. A pick that lands after the
+// pointer left the stage is dropped (it would outline a placement nobody points at).
+let picking = false, wantedPick = null, leaveGeneration = 0;
 
 function hoverAt(e, ctx) {
   const px = ctx.framePixel(e);
@@ -208,8 +211,10 @@ async function pumpPick(ctx) {
   const job = wantedPick;
   wantedPick = null;
   picking = true;
+  const generation = leaveGeneration;
   try {
     const hit = await ctx.pick(job.px[0], job.px[1]);
+    if (generation !== leaveGeneration) return;
     pointer.last = { px: job.px, hit: hit.hit ? hit : null };
     if (!hit.hit) setHover(null, null, ctx);
     else {
