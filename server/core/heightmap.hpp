@@ -75,10 +75,22 @@ struct BakePlacement {
     double h = 1.0;
     double t = 0.0; ///< normalised angle from normalizedT
     int source = -1; ///< index of the scene placement it comes from (−1: not from a scene)
+    // Surface placements (SPEC §8): the footprint is unused; the pattern coordinate of a texel
+    // comes from its rest-surface point (RestSurfaceMap) and these, in bind space.
+    bool surface = false;
+    glm::dvec3 anchorPosition{0.0}, anchorNormal{0, 0, 1}, anchorTangent{1, 0, 0}; ///< orthonormal
+    glm::dvec2 size{0.1, 0.1}; ///< > 0, model units
+    double depth = 0.05;       ///< > 0, model units
 };
 
 /// The contribution of one placement at a UV point (0 outside its footprint).
 float placementHeight(const BakePlacement& p, glm::dvec2 uv);
+/// The contribution of one surface placement at a rest-surface point p with unit normal n
+/// (SPEC §8: pattern at (((p−c)·t)/w + ½, ((p−c)·b)/h + ½), 0 where |(p−c)·n| > depth or
+/// n_p·n ≤ 0 or outside the pattern square).
+float surfacePlacementHeight(const BakePlacement& p, glm::dvec3 position, glm::dvec3 normal);
+
+struct RestSurfaceMap; // texture_layout.hpp
 
 struct HeightMaps {
     HeightImage bump, displacement;
@@ -88,6 +100,8 @@ struct BakeSettings {
     int width = 1024, height = 1024;
     const HeightImage* base = nullptr; ///< static bump map; sampled bilinearly if sizes differ
     int threads = 0;                   ///< 0 = hardware concurrency
+    /// Rest-surface map of the layout at width×height; required when a placement is `surface`.
+    const RestSurfaceMap* rest = nullptr;
 };
 
 /// Bakes both maps: every texel centre sums its placements' L_out into the target map, plus the

@@ -26,6 +26,14 @@ std::optional<DisplacementMode> displacementModeFromString(std::string_view s) {
     return std::nullopt;
 }
 
+std::string_view toString(Projection p) { return p == Projection::Surface ? "surface" : "uv"; }
+
+std::optional<Projection> projectionFromString(std::string_view s) {
+    if (s == "uv") return Projection::Uv;
+    if (s == "surface") return Projection::Surface;
+    return std::nullopt;
+}
+
 json toJson(const Scene& scene) {
     json doc = json::object();
     doc["format"] = kSceneFormat;

@@ -11,6 +11,7 @@
 #include "deform.hpp"
 #include "heightmap.hpp"
 #include "result.hpp"
+#include "texture_layout.hpp"
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -45,6 +46,19 @@ struct PatternManifest {
 Result<PatternManifest> parsePatternManifest(const nlohmann::json& doc);
 nlohmann::json toJson(const PatternManifest& manifest);
 
+/// A placement's `projection` (SPEC §8): "uv" (the paper's: a footprint in texture space) or
+/// "surface" (a decal anchored on the rest surface, projected into the layout in use).
+enum class Projection { Uv, Surface };
+std::string_view toString(Projection p);
+std::optional<Projection> projectionFromString(std::string_view s);
+
+/// Where a surface placement sits, in bind (rest-pose model) space: MeshPart positions' space.
+struct SurfaceAnchor {
+    std::array<double, 3> position{0, 0, 0};
+    std::array<double, 3> normal{0, 0, 1};  ///< unit (normalised on parse)
+    std::array<double, 3> tangent{1, 0, 0}; ///< the pattern's u direction; made ⟂ normal on parse
+};
+
 struct Placement {
     std::string id;                      ///< unique within the scene
     std::string pattern;                 ///< key of Scene::patterns, or a built-in pattern id
@@ -60,6 +74,12 @@ struct Placement {
     Response response = Response::Log2;
     bool enabled = true; ///< false: kept in the document, contributes nothing (SPEC §6)
     std::string label;   ///< free text for people, ≤ kMaxLabelLength bytes of UTF-8
+    // SPEC §8: center/scale/rotation are used by projection Uv; anchor/size/depth by Surface
+    // (rotation turns the pattern about the anchor normal there too).
+    Projection projection = Projection::Uv;
+    SurfaceAnchor anchor;
+    std::array<double, 2> size{0.1, 0.1}; ///< model units (w along tangent, h along normal × tangent)
+    std::optional<double> depth;          ///< model units; absent = max(w, h) / 2
 };
 
 /// Longest placement label, in bytes.
@@ -119,6 +139,7 @@ struct RenderSettings {
 
 struct Scene {
     std::string model = "builtin:default";
+    UvLayoutMode uvLayout = UvLayoutMode::Auto; ///< SPEC §8 "Height-map layout"
     std::array<int, 2> heightmapSize{1024, 1024}; ///< each in [1, kMaxHeightmapSize]
     std::optional<std::string> heightmapBase;      ///< static height map path
     std::map<std::string, std::string> patterns;   ///< custom pattern id → path

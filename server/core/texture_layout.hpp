@@ -1,0 +1,70 @@
+// Dermis core — the texture space the height maps live in (SPEC §8 "Height-map layout"): a
+// layout is, per mesh part, its own vertex list (a layout vertex names the part vertex it copies;
+// seams of the layout duplicate vertices) with one UV each and the part's triangles re-indexed in
+// the same order. The model's own TEXCOORD_0 is one layout (`modelTextureLayout`); the generated,
+// non-overlapping chart layout (layout_gen.hpp) is another. The renderer samples the bump and
+// displacement maps with the layout's UVs (a second UV attribute) while the base colour keeps the
+// model's own.
+//
+// Also here: the rest-surface map of a layout, the bind-space position and normal of the surface
+// under every texel centre, which surface placements are projected through (SPEC §8 "Surface
+// placements"); the CPU reference and the GPU height pass read the same map.
+//
+// Pure (no GL, no I/O). Nothing here throws but std::bad_alloc.
+#pragma once
+
+#include "model.hpp"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace dermis {
+
+/// The scene member `uv_layout`: "auto" (the model's UVs when present and unique — overlap below
+/// 0.5 % of used texels — else generated), "model", "generated".
+enum class UvLayoutMode { Auto, Model, Generated };
+std::string_view toString(UvLayoutMode m);
+std::optional<UvLayoutMode> uvLayoutModeFromString(std::string_view s);
+
+/// One part's layout. `indices` has the part's triangle count · 3 entries, triangle k of the
+/// layout being triangle k of the part.
+struct PartLayout {
+    std::vector<std::uint32_t> source; ///< layout vertex → part vertex
+    std::vector<glm::vec2> uvs;        ///< per layout vertex, glTF convention (v down), [0,1]²
+    std::vector<std::uint32_t> indices;
+};
+
+struct TextureLayout {
+    std::string kind; ///< "model" or "generated"
+    std::vector<PartLayout> parts; ///< one per Model::parts entry; empty parts where there are no UVs
+    bool empty() const;            ///< no part has a triangle with UVs
+};
+
+/// The model's own TEXCOORD_0 as a layout: source = identity, uvs = part.uvs, indices = part's.
+/// A part without UVs (or with fewer UVs than positions) gets an empty PartLayout.
+TextureLayout modelTextureLayout(const Model& model);
+
+/// Per texel centre ((i+0.5)/W, (j+0.5)/H) of a W×H map: the bind-space position and unit normal
+/// of the layout's triangle covering it (barycentric interpolation of MeshPart positions and
+/// normals), or — within `dilate` texels of a covered texel — those of the nearest covered texel
+/// (gutters, so bilinear sampling across a chart edge reads continuous heights). coverage: 0 none,
+/// 1 covered, 2 dilated. Where triangles overlap, the later triangle (part, then index order) wins.
+struct RestSurfaceMap {
+    int width = 0, height = 0;
+    std::vector<glm::vec3> position; ///< width·height, row 0 first
+    std::vector<glm::vec3> normal;   ///< unit where coverage > 0, else 0
+    std::vector<std::uint8_t> coverage;
+    std::uint64_t contentId = 0;     ///< process-unique (a GPU cache key), > 0 once baked
+};
+
+/// Bakes the rest-surface map. Deterministic (bit-identical for the same inputs and any thread
+/// count). Preconditions: width, height in [1, kMaxHeightmapSize].
+RestSurfaceMap bakeRestSurface(const Model& model, const TextureLayout& layout, int width,
+                               int height, int dilate = 4);
+
+} // namespace dermis
