@@ -63,6 +63,16 @@ std::string imageFormatOf(const std::string& path) {
 
 std::string partialPathOf(const std::string& path) { return path + ".dermis-part"; }
 
+bool writeAll(int fd, const char* data, std::size_t n) {
+    for (std::size_t done = 0; done < n;) {
+        const ssize_t w = ::write(fd, data + done, n - done);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return false;
+        done += static_cast<std::size_t>(w);
+    }
+    return true;
+}
+
 void writeFileAtomically(const std::string& path, const std::string& bytes) {
     namespace fs = std::filesystem;
     std::error_code ec;
@@ -71,16 +81,10 @@ void writeFileAtomically(const std::string& path, const std::string& bytes) {
     const std::string tmp = partialPathOf(path);
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0) throw usageError("cannot write " + tmp, path);
-    std::size_t written = 0;
-    while (written < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            throw usageError("cannot write " + tmp, path);
-        }
-        written += static_cast<std::size_t>(n);
+    if (!writeAll(fd, bytes.data(), bytes.size())) {
+        ::close(fd);
+        ::unlink(tmp.c_str());
+        throw usageError("cannot write " + tmp, path);
     }
     if (::close(fd) != 0 || ::rename(tmp.c_str(), path.c_str()) != 0) {
         ::unlink(tmp.c_str());

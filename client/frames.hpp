@@ -28,6 +28,10 @@ std::string extensionOf(const std::string& path);
 /// is removed on failure.
 void writeFileAtomically(const std::string& path, const std::string& bytes);
 
+/// Writes all `n` bytes to the open descriptor `fd` (retrying short writes and EINTR). False on a
+/// write error (errno says which); the descriptor stays open either way.
+bool writeAll(int fd, const char* data, std::size_t n);
+
 /// The temporary name writeFileAtomically uses for `path`.
 std::string partialPathOf(const std::string& path);
 

@@ -349,14 +349,9 @@ Reply Http::download(const std::string& path, const std::string& out, FileKind k
         },
         [&](const char* data, std::size_t n) {
             if (head.size() < 8) head.append(data, std::min(n, 8 - head.size()));
-            for (std::size_t done = 0; done < n;) {
-                const ssize_t w = ::write(fd, data + done, n - done);
-                if (w < 0 && errno == EINTR) continue;
-                if (w <= 0) {
-                    writeFailed = true;
-                    return false;
-                }
-                done += static_cast<std::size_t>(w);
+            if (!writeAll(fd, data, n)) {
+                writeFailed = true;
+                return false;
             }
             bytes += n;
             return true;
