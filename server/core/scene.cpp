@@ -1,6 +1,6 @@
 // Dermis core — serialisation of the scene document `dermis.scene/1` (SPEC §2b): toJson(Scene)
 // writes every field explicitly ("auto" where optional values are absent), so that parse →
-// serialise → parse → serialise is byte-stable; and the names of DisplacementMode.
+// serialise → parse → serialise is byte-stable; and the names of DisplacementMode and Projection.
 // Parsing is in scene_parse.cpp, the pattern manifest in scene_manifest.cpp, the shared JSON
 // reader and predicates in scene_json.hpp.
 #include "scene.hpp"
