@@ -2,13 +2,20 @@
 // #defines by the renderer (server/gl/programs.cpp). Each uniform block here has a C++ mirror in
 // server/gl/uniform_blocks.hpp with the same std140 layout; UniformBlockGLTest checks it.
 
-// Per-placement constants of the height pass (paper §4 stage 1; SPEC §2).
+// Per-placement constants of the height pass (paper §4 stage 1; SPEC §2; surface placements
+// SPEC §8).
 layout(std140, binding = 0) uniform HeightPassBlock {
-    vec4 u_centerScale;  // footprint centre (u, v), footprint size (u, v) in UV units
+    vec4 u_centerScale;  // UV placement: footprint centre (u, v), footprint size (u, v) in UV
+                         // units; surface placement: the UV rectangle drawn (u0, v0, u1, v1)
     vec4 u_rotation;     // cos(rotation), sin(rotation), quad margin (s units, x and y)
     vec4 u_drive;        // h, t, gain(t) or offset(t) (dermis::deformConstant), 0
-    ivec4 u_mode;        // model (0 scale, 1 bias), target (0 bump, 1 displacement), response, 0
+    ivec4 u_mode;        // model (0 scale, 1 bias), target (0 bump, 1 displacement), response,
+                         // projection (0 uv, 1 surface)
     vec4 u_mapSize;      // map width, height, pattern width, height (texels)
+    vec4 u_anchor;       // surface: anchor position c (bind space), depth
+    vec4 u_anchorNormal; // surface: unit normal n, 1/w
+    vec4 u_anchorTangent; // surface: unit tangent t (rotation applied), 1/h
+    vec4 u_anchorBinormal; // surface: b = n × t, 0
 };
 
 // Per-frame constants of the skin pass (paper §4 stage 2).
@@ -22,7 +29,8 @@ layout(std140, binding = 1) uniform FrameBlock {
 };
 
 // Outlines on the skin (the editor's selection, hover and place brush): footprint rectangles in
-// UV space (SPEC §2: centre, size, rotation), drawn as a band where v_uv lies on their border.
+// the height maps' UV space (SPEC §2: centre, size, rotation), drawn as a band where v_mapUv
+// lies on their border.
 layout(std140, binding = 3) uniform OutlineBlock {
     ivec4 u_outlineCount;    // outlines in use (0..8), 0, 0, 0
     vec4 u_outlineRect[8];   // centre u, v; size u, v
@@ -32,7 +40,9 @@ layout(std140, binding = 3) uniform OutlineBlock {
 // Per-part constants of the skin pass.
 layout(std140, binding = 2) uniform PartBlock {
     vec4 u_baseColor;  // material base colour factor (linear)
-    ivec4 u_part;      // first palette matrix of the part, has base-colour texture, has UVs,
-                       // view (0 shaded, 1 bump, 2 displacement, 3 normal: FrameView in
-                       // server/core/render_settings.hpp; the same for every part of a frame)
+    ivec4 u_part;      // first palette matrix of the part, has a base-colour texture and the
+                       // model's UVs to sample it (a_uv), has height-map UVs (a_mapUv: the
+                       // layout in use covers the part), view (0 shaded, 1 bump, 2 displacement,
+                       // 3 normal: FrameView in server/core/render_settings.hpp; the same for
+                       // every part of a frame)
 };

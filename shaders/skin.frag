@@ -8,17 +8,22 @@
 // (clamped to [−1, 1]), 3 the perturbed world normal as bytes 255·(n·0.5 + 0.5). Those are
 // picture values: written through the sRGB EOTF so that the target's encoding gives them back.
 //
-// Outlines (OutlineBlock, common.glsl): footprint rectangles in UV space drawn over any view as
-// a band about 2 pixels wide where v_uv lies on their border — selected (orange, with a faint
-// tint inside and a dark rim outside), hovered (pale blue), the place brush (dashed cyan). With
-// u_outlineCount.x = 0 nothing runs and the frame is exactly the one without outlines.
+// Outlines (OutlineBlock, common.glsl): footprint rectangles in the height maps' UV space drawn
+// over any view as a band about 2 pixels wide where v_mapUv lies on their border — selected
+// (orange, with a faint tint inside and a dark rim outside), hovered (pale blue), the place brush
+// (dashed cyan). With u_outlineCount.x = 0 nothing runs and the frame is exactly the one without
+// outlines.
+//
+// Two UVs (SPEC §8): v_uv is the model's TEXCOORD_0 (base colour), v_mapUv the UV of the height
+// maps' layout (heights, bump gradient, outlines) — the same values when the layout is the model's.
 
 layout(binding = 0) uniform sampler2D u_heightMap;        // RG32F: bump, displacement
 layout(binding = 2) uniform sampler2D u_baseColorTexture; // sRGB8_A8, decoded to linear by the sampler
 
 in vec3 v_position;
 in vec3 v_normal;
-in vec2 v_uv;
+in vec2 v_uv;    // the model's TEXCOORD_0: base colour
+in vec2 v_mapUv; // the height-map layout's UV (SPEC §8): heights and outlines
 
 layout(location = 0) out vec4 o_color;
 
@@ -31,11 +36,11 @@ float surfaceHeight(vec2 uv) {
 vec3 perturbedNormal(vec3 n) {
     // dH/du, dH/dv by differences one texel apart (three samples of the RG map).
     vec2 e = u_heightmapSize.zw;
-    vec2 uv0 = v_uv - 0.5 * e;
+    vec2 uv0 = v_mapUv - 0.5 * e;
     float h0 = surfaceHeight(uv0);
     float dHdu = (surfaceHeight(uv0 + vec2(e.x, 0.0)) - h0) / e.x;
     float dHdv = (surfaceHeight(uv0 + vec2(0.0, e.y)) - h0) / e.y;
-    vec2 dUVdx = dFdx(v_uv), dUVdy = dFdy(v_uv);
+    vec2 dUVdx = dFdx(v_mapUv), dUVdy = dFdy(v_mapUv);
     float dBs = dHdu * dUVdx.x + dHdv * dUVdx.y; // dH along screen x
     float dBt = dHdu * dUVdy.x + dHdv * dUVdy.y; // dH along screen y
     vec3 sigmaS = dFdx(v_position), sigmaT = dFdy(v_position);
@@ -63,7 +68,7 @@ vec3 outlined(vec3 color) {
         vec4 st = u_outlineStyle[i];
         int kind = int(st.z);
         // s − 0.5 = R(−rotation)·(uv − centre) / size (SPEC §2): q in [−0.5, 0.5]² inside.
-        vec2 d = v_uv - r.xy;
+        vec2 d = v_mapUv - r.xy;
         vec2 q = vec2(st.x * d.x + st.y * d.y, -st.y * d.x + st.x * d.y) / r.zw;
         vec2 perPixel = max(fwidth(q), vec2(1e-7));
         vec2 e = (abs(q) - 0.5) / perPixel; // pixels beyond each edge (negative inside)
@@ -90,7 +95,7 @@ void main() {
     if (u_part.z != 0) n = perturbedNormal(n);
 
     if (u_part.w == 1 || u_part.w == 2) { // bump or displacement height as grey
-        vec2 heights = u_part.z != 0 ? textureLod(u_heightMap, v_uv, 0.0).rg : vec2(0.0);
+        vec2 heights = u_part.z != 0 ? textureLod(u_heightMap, v_mapUv, 0.0).rg : vec2(0.0);
         float height = clamp(u_part.w == 1 ? heights.r : heights.g, -1.0, 1.0);
         o_color = vec4(outlined(pictureValue(vec3((128.0 + 127.0 * height) / 255.0))), 1.0);
         return;
@@ -101,7 +106,7 @@ void main() {
     }
 
     vec4 base = u_baseColor;
-    if (u_part.y != 0 && u_part.z != 0) base *= texture(u_baseColorTexture, v_uv);
+    if (u_part.y != 0) base *= texture(u_baseColorTexture, v_uv);
 
     vec3 l = u_lightDir.xyz;
     float diffuse = max(dot(n, l), 0.0);

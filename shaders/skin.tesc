@@ -6,9 +6,11 @@ layout(vertices = 3) out;
 in vec3 v_position[];
 in vec3 v_normal[];
 in vec2 v_uv[];
+in vec2 v_mapUv[];
 out vec3 tc_position[];
 out vec3 tc_normal[];
 out vec2 tc_uv[];
+out vec2 tc_mapUv[];
 
 vec2 toScreen(vec3 p) {
     vec4 c = u_viewProj * vec4(p, 1.0);
@@ -24,6 +26,7 @@ void main() {
     tc_position[gl_InvocationID] = v_position[gl_InvocationID];
     tc_normal[gl_InvocationID] = v_normal[gl_InvocationID];
     tc_uv[gl_InvocationID] = v_uv[gl_InvocationID];
+    tc_mapUv[gl_InvocationID] = v_mapUv[gl_InvocationID];
     if (gl_InvocationID == 0) {
         // Outer level i is the edge opposite corner i.
         gl_TessLevelOuter[0] = edgeLevel(1, 2);

@@ -9,17 +9,19 @@ layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
 layout(location = 3) in uvec4 a_joints;
 layout(location = 4) in vec4 a_weights;
+layout(location = 5) in vec2 a_mapUv; // the height maps' layout (SPEC §8); a_uv keeps the model's
 
 // world(node_k) · inverseBind_k of every influence of every part; a part starts at u_part.x.
 layout(std430, binding = 0) readonly buffer Palette {
     mat4 u_palette[];
 };
 
-layout(binding = 0) uniform sampler2D u_heightMap; // RG32F in UV space: bump, displacement
+layout(binding = 0) uniform sampler2D u_heightMap; // RG32F in the layout's UV space: bump, displacement
 
 out vec3 v_position; // world space
 out vec3 v_normal;   // world space, unit
-out vec2 v_uv;
+out vec2 v_uv;    // the model's TEXCOORD_0: base colour
+out vec2 v_mapUv; // the height-map layout's UV: bump, displacement, outlines
 
 void main() {
     int base = u_part.x;
@@ -31,8 +33,9 @@ void main() {
     vec3 p = (m * vec4(a_position, 1.0)).xyz;
     vec3 n = normalize(transpose(inverse(mat3(m))) * a_normal);
     v_uv = a_uv;
+    v_mapUv = a_mapUv;
 #if !defined(DERMIS_TESSELLATED) && !defined(DERMIS_CAPTURE)
-    if (u_part.z != 0) p += n * (textureLod(u_heightMap, a_uv, 0.0).g * u_heights.x);
+    if (u_part.z != 0) p += n * (textureLod(u_heightMap, a_mapUv, 0.0).g * u_heights.x);
 #endif
     v_position = p;
     v_normal = n;

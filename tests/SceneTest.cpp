@@ -116,6 +116,14 @@ std::string placement(const std::string& extra) {
                (extra.empty() ? std::string() : "," + extra) + "}]");
 }
 
+/// A surface placement (SPEC §8) with anchor and size, plus `extra` (members given twice: the
+/// later one wins, as nlohmann reads objects).
+std::string surface(const std::string& extra) {
+    return placement(std::string(R"("projection":"surface",)") +
+                     R"("anchor":{"position":[0.1,1.2,0.05],"normal":[0,0,1],"tangent":[1,0,0]},)" +
+                     R"("size":[0.08,0.05])" + (extra.empty() ? std::string() : "," + extra));
+}
+
 /// A pose with one joint "spine" whose value is `value`.
 std::string spine(const std::string& value) {
     return doc(R"("pose":{"joints":{"spine":)" + value + "}}");
@@ -341,6 +349,74 @@ TEST(SceneTest, EnabledAndLabelRoundTrip) {
     expectStableRoundTrip(placement(R"("enabled":false,"label":")" + std::string(120, 'y') + R"(")"));
 }
 
+TEST(SceneTest, UvLayoutDefaultsToAutoAndRoundTrips) {
+    EXPECT_EQ(parseOk(doc("")).uvLayout, dermis::UvLayoutMode::Auto);
+    EXPECT_EQ(dermis::toJson(parseOk(doc("")))["uv_layout"], "auto");
+    for (const char* mode : {"auto", "model", "generated"}) {
+        const Scene s = parseOk(doc(std::string(R"("uv_layout":")") + mode + "\""));
+        EXPECT_EQ(dermis::toString(s.uvLayout), mode);
+        EXPECT_EQ(dermis::toJson(s)["uv_layout"], mode);
+        expectStableRoundTrip(doc(std::string(R"("uv_layout":")") + mode + "\""));
+    }
+}
+
+TEST(SceneTest, SurfacePlacementParsesAndEchoesItsMembers) {
+    const Scene s = parseOk(surface(R"("rotation":30)"));
+    const dermis::Placement& p = s.placements[0];
+    EXPECT_EQ(p.projection, dermis::Projection::Surface);
+    EXPECT_EQ(p.anchor.position, (std::array<double, 3>{0.1, 1.2, 0.05}));
+    EXPECT_EQ(p.anchor.normal, (std::array<double, 3>{0, 0, 1}));
+    EXPECT_EQ(p.anchor.tangent, (std::array<double, 3>{1, 0, 0}));
+    EXPECT_EQ(p.size, (std::array<double, 2>{0.08, 0.05}));
+    EXPECT_FALSE(p.depth.has_value());
+    EXPECT_DOUBLE_EQ(p.depthOrDefault(), 0.04); // max(w, h) / 2
+    const json j = dermis::toJson(s)["placements"][0];
+    EXPECT_EQ(j["projection"], "surface");
+    EXPECT_EQ(j["anchor"]["position"], json::array({0.1, 1.2, 0.05}));
+    EXPECT_EQ(j["anchor"]["normal"], json::array({0.0, 0.0, 1.0}));
+    EXPECT_EQ(j["anchor"]["tangent"], json::array({1.0, 0.0, 0.0}));
+    EXPECT_EQ(j["size"], json::array({0.08, 0.05}));
+    EXPECT_EQ(j["depth"], "auto");
+    EXPECT_EQ(j["rotation"], 30.0);
+    expectStableRoundTrip(surface(R"("rotation":30)"));
+
+    const Scene d = parseOk(surface(R"("depth":0.02)"));
+    EXPECT_DOUBLE_EQ(d.placements[0].depthOrDefault(), 0.02);
+    EXPECT_EQ(dermis::toJson(d)["placements"][0]["depth"], 0.02);
+    EXPECT_FALSE(parseOk(surface(R"("depth":"auto")")).placements[0].depth.has_value());
+}
+
+TEST(SceneTest, UvPlacementsEchoProjectionButNoSurfaceMembers) {
+    const json j = dermis::toJson(parseOk(placement("")))["placements"][0];
+    EXPECT_EQ(j["projection"], "uv");
+    for (const char* key : {"anchor", "size", "depth"}) EXPECT_FALSE(j.contains(key)) << key;
+    // Surface members on a UV placement are checked (above) but not kept: switching back to
+    // "uv" drops them from the canonical document.
+    const Scene s = parseOk(surface(R"("projection":"uv")"));
+    EXPECT_EQ(s.placements[0].projection, dermis::Projection::Uv);
+    EXPECT_FALSE(dermis::toJson(s)["placements"][0].contains("anchor"));
+}
+
+TEST(SceneTest, AnchorIsNormalisedAndTheTangentMadeOrthogonal) {
+    const Scene s = parseOk(surface(
+        R"("anchor":{"position":[1,2,3],"normal":[0,0,2],"tangent":[3,0,4]})"));
+    const dermis::SurfaceAnchor& a = s.placements[0].anchor;
+    EXPECT_EQ(a.normal, (std::array<double, 3>{0, 0, 1}));
+    EXPECT_NEAR(a.tangent[0], 1.0, 1e-15);
+    EXPECT_NEAR(a.tangent[1], 0.0, 1e-15);
+    EXPECT_NEAR(a.tangent[2], 0.0, 1e-15);
+    // Oblique vectors: unit, orthogonal, and stable through parse → serialise → parse.
+    const std::string oblique =
+        surface(R"("anchor":{"position":[1,2,3],"normal":[0.3,-0.7,0.2],"tangent":[0.9,0.4,0.5]})");
+    const Scene o = parseOk(oblique);
+    const auto& n = o.placements[0].anchor.normal;
+    const auto& t = o.placements[0].anchor.tangent;
+    EXPECT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0, 1e-14);
+    EXPECT_NEAR(t[0] * t[0] + t[1] * t[1] + t[2] * t[2], 1.0, 1e-14);
+    EXPECT_NEAR(n[0] * t[0] + n[1] * t[1] + n[2] * t[2], 0.0, 1e-14);
+    expectStableRoundTrip(oblique);
+}
+
 TEST(SceneTest, SerialisationWritesEveryField) {
     json j = dermis::toJson(parseOk(placement("")));
     EXPECT_EQ(j["format"], "dermis.scene/1");
@@ -351,8 +427,9 @@ TEST(SceneTest, SerialisationWritesEveryField) {
     const json& p = j["placements"][0];
     for (const char* key : {"id", "pattern", "center", "scale", "rotation", "joint", "axis",
                             "theta_min", "theta_max", "h", "model", "target", "response",
-                            "enabled", "label"})
+                            "enabled", "label", "projection"})
         EXPECT_TRUE(p.contains(key)) << key;
+    EXPECT_EQ(j["uv_layout"], "auto");
     EXPECT_EQ(p["axis"], "x");
     EXPECT_EQ(p["response"], "log2");
     EXPECT_FALSE(j["pose"].contains("animation")); // absent = the model's first clip
@@ -586,6 +663,34 @@ const BadCase kBadCases[] = {
     {"DisplacementScaleHuge", doc(R"("render":{"displacement_scale":1e39})"),
      "/render/displacement_scale"},
     {"BumpStrengthHuge", doc(R"("render":{"bump_strength":100.5})"), "/render/bump_strength"},
+    // uv_layout and surface placements (SPEC §8).
+    {"UvLayoutUnknown", doc(R"("uv_layout":"atlas")"), "/uv_layout"},
+    {"UvLayoutNumber", doc(R"("uv_layout":1)"), "/uv_layout"},
+    {"ProjectionUnknown", placement(R"("projection":"planar")"), "/placements/0/projection"},
+    {"SurfaceWithoutAnchor", placement(R"("projection":"surface","size":[0.1,0.1])"),
+     "/placements/0/anchor"},
+    {"SurfaceWithoutSize", surface(R"("size":null)"), "/placements/0/size"},
+    {"AnchorArray", placement(R"("projection":"surface","anchor":[0,0,0],"size":[1,1])"),
+     "/placements/0/anchor"},
+    {"AnchorWithoutNormal",
+     placement(R"("projection":"surface","anchor":{"position":[0,0,0],"tangent":[1,0,0]},"size":[1,1])"),
+     "/placements/0/anchor/normal"},
+    {"AnchorPositionHuge", surface(R"("anchor":{"position":[0,2e6,0],"normal":[0,0,1],"tangent":[1,0,0]})"),
+     "/placements/0/anchor/position/1"},
+    {"AnchorPositionString", surface(R"("anchor":{"position":[0,"1",0],"normal":[0,0,1],"tangent":[1,0,0]})"),
+     "/placements/0/anchor/position/1"},
+    {"AnchorNormalZero", surface(R"("anchor":{"position":[0,0,0],"normal":[0,0,0],"tangent":[1,0,0]})"),
+     "/placements/0/anchor/normal"},
+    {"AnchorTangentParallel", surface(R"("anchor":{"position":[0,0,0],"normal":[0,0,1],"tangent":[0,0,-3]})"),
+     "/placements/0/anchor/tangent"},
+    {"AnchorTangentTwoElements", surface(R"("anchor":{"position":[0,0,0],"normal":[0,0,1],"tangent":[1,0]})"),
+     "/placements/0/anchor/tangent"},
+    {"SurfaceSizeZero", surface(R"("size":[0, 0.1])"), "/placements/0/size/0"},
+    {"SurfaceSizeHuge", surface(R"("size":[0.1, 1e5])"), "/placements/0/size/1"},
+    {"SurfaceDepthNegative", surface(R"("depth":-1)"), "/placements/0/depth"},
+    {"SurfaceDepthWord", surface(R"("depth":"deep")"), "/placements/0/depth"},
+    {"SurfaceDepthHuge", surface(R"("depth":1e300)"), "/placements/0/depth"},
+    {"SizeCheckedOnUvPlacements", placement(R"("size":[-1, 1])"), "/placements/0/size/0"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Table, SceneBadInput, testing::ValuesIn(kBadCases),

@@ -64,20 +64,68 @@ Result<double> placementAngle(const Model& model, const LocalPose& pose, const P
     return jointAngle(model.nodes[n].rotation, pose.rotation[n], axis);
 }
 
+namespace {
+
+/// Whether any part of `model` has TEXCOORD_0 for every vertex (modelTextureLayout not empty).
+bool anyPartHasUVs(const Model& model) {
+    for (const MeshPart& part : model.parts)
+        if (!part.positions.empty() && part.uvs.size() >= part.positions.size() &&
+            part.indices.size() >= 3)
+            return true;
+    return false;
+}
+
+/// The anchor frame of surface placement `p` (SPEC §8) into `b`: unit normal, tangent made
+/// orthogonal to it (Gram–Schmidt, as the parser does) and turned by `rotation` degrees about the
+/// normal (towards b = n × t), size and depth. False when the anchor is degenerate (possible only
+/// for scenes built in code).
+bool surfaceFrameOf(const Placement& p, BakePlacement& b) {
+    const glm::dvec3 n0(p.anchor.normal[0], p.anchor.normal[1], p.anchor.normal[2]);
+    const glm::dvec3 t0(p.anchor.tangent[0], p.anchor.tangent[1], p.anchor.tangent[2]);
+    const double nl = glm::length(n0);
+    if (!(nl > 0.0) || !std::isfinite(nl)) return false;
+    const glm::dvec3 n = n0 / nl;
+    glm::dvec3 t = t0 - glm::dot(t0, n) * n;
+    const double tl = glm::length(t);
+    if (!(tl > 1e-9) || !std::isfinite(tl)) return false;
+    t /= tl;
+    const glm::dvec3 bt = glm::cross(n, t);
+    const double a = glm::radians(p.rotation);
+    b.surface = true;
+    b.anchorPosition = glm::dvec3(p.anchor.position[0], p.anchor.position[1], p.anchor.position[2]);
+    b.anchorNormal = n;
+    b.anchorTangent = glm::normalize(std::cos(a) * t + std::sin(a) * bt);
+    b.size = glm::dvec2(p.size[0], p.size[1]);
+    b.depth = p.depthOrDefault();
+    return b.size.x > 0.0 && b.size.y > 0.0 && b.depth > 0.0;
+}
+
+} // namespace
+
 Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const Model& model,
                                                      const LocalPose& pose,
-                                                     const PatternImages& images) {
+                                                     const PatternImages& images,
+                                                     const TextureLayout* layout) {
     const char* where = "dermis::resolvePlacements";
     std::vector<BakePlacement> out;
     out.reserve(scene.placements.size());
-    const bool uvs = model.hasUVs();
+    // UV placements live in the layout in use; without one given, the model's own UVs (every
+    // part must have them, as before layouts existed).
+    const bool uvs = layout ? !layout->empty() : model.hasUVs();
+    const bool surfaceUvs = layout ? !layout->empty() : anyPartHasUVs(model);
     for (std::size_t i = 0; i < scene.placements.size(); ++i) {
         const Placement& p = scene.placements[i];
         const std::string ptr = "/placements/" + std::to_string(i);
-        if (!uvs)
+        if (p.projection == Projection::Surface && !surfaceUvs)
+            return makeError(ErrorCode::InvalidArgument, where, "/uv_layout",
+                             "placement " + p.id + " is a surface placement, but the height-map "
+                             "layout in use (" + (layout ? layout->kind : std::string("model")) +
+                             ") has no UVs: the model has no TEXCOORD_0; use uv_layout "
+                             "\"generated\"");
+        if (p.projection == Projection::Uv && !uvs)
             return makeError(ErrorCode::InvalidArgument, where, ptr,
                              "the model has no TEXCOORD_0, so patterns cannot be placed in its "
-                             "texture space");
+                             "texture space (a surface placement can: projection \"surface\")");
         auto it = images.find(p.pattern);
         if (it == images.end())
             return makeError(ErrorCode::NotFound, where, ptr + "/pattern",
@@ -94,6 +142,10 @@ Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const M
         b.footprint.center = {p.center[0], p.center[1]};
         b.footprint.scale = {p.scale[0], p.scale[1]};
         b.footprint.rotationDeg = p.rotation;
+        if (p.projection == Projection::Surface && !surfaceFrameOf(p, b))
+            return makeError(ErrorCode::InvalidArgument, where, ptr + "/anchor",
+                             "needs a non-zero normal, a tangent not parallel to it, a size and a "
+                             "depth > 0");
         b.model = p.model;
         b.target = p.target;
         b.response = p.response;
@@ -109,6 +161,7 @@ Result<HeightMaps> bakeScene(const Scene& scene, const Model& model, const Patte
                              const SceneBakeOptions& options) {
     FrameOverrides overrides;
     overrides.time = options.time;
+    overrides.layout = options.layout;
     auto plan = planFrame(scene, model, images, options.base, overrides);
     if (!plan) return plan.error();
     return bakeHeightMaps(plan->heights, options.threads);

@@ -38,16 +38,24 @@ Result<double> placementAngle(const Model& model, const LocalPose& pose, const P
 using PatternImages = std::map<std::string, std::shared_ptr<const PatternImage>>;
 
 /// Resolves every enabled placement to a BakePlacement (pointers into `images`, patternId set), in
-/// document order; disabled ones are checked like the others but left out. Fails when the model
-/// has no TEXCOORD_0 ("/placements/<i>": why), a joint is unknown, or an image is missing.
+/// document order; disabled ones are checked like the others but left out. A surface placement
+/// (SPEC §8) gets its anchor frame (tangent orthonormalised and turned by `rotation` about the
+/// normal), size and depth (default max(w, h)/2). `layout` is the height-map layout in use (null:
+/// the model's own UVs). Fails when a UV placement has no UVs to live in — the layout given is
+/// empty, or without one not every part has TEXCOORD_0 ("/placements/<i>": why) —, when a
+/// surface placement's layout has no UVs at all ("/uv_layout"), on a degenerate anchor of a
+/// scene built in code ("/placements/<i>/anchor"), an unknown joint or a missing image.
 Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const Model& model,
                                                      const LocalPose& pose,
-                                                     const PatternImages& images);
+                                                     const PatternImages& images,
+                                                     const TextureLayout* layout = nullptr);
 
 struct SceneBakeOptions {
     std::optional<double> time; ///< overrides pose.time
     std::shared_ptr<const PatternImage> base;
     int threads = 0;
+    /// The height-map layout (FrameOverrides::layout); null = the model's own UVs.
+    std::shared_ptr<const TextureLayout> layout;
 };
 
 /// planFrame (core/frame_plan.hpp) → bakeHeightMaps at the scene's heightmap size.

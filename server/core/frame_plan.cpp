@@ -1,5 +1,6 @@
 #include "frame_plan.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dermis {
@@ -27,7 +28,7 @@ Result<FramePlan> planFrame(const Scene& scene, const Model& model, const Patter
     plan.world = worldMatrices(model, *pose);
     plan.view = o.view;
     if (!scene.placements.empty()) {
-        auto placements = resolvePlacements(scene, model, *pose, images);
+        auto placements = resolvePlacements(scene, model, *pose, images, o.layout.get());
         if (!placements) return placements.error();
         plan.heights.placements = std::move(*placements);
         for (const Placement& p : scene.placements)
@@ -36,6 +37,20 @@ Result<FramePlan> planFrame(const Scene& scene, const Model& model, const Patter
     plan.pose = std::move(*pose);
     plan.heights.width = scene.heightmapSize[0];
     plan.heights.height = scene.heightmapSize[1];
+    plan.heights.layout = o.layout;
+    const bool surface = std::any_of(plan.heights.placements.begin(), plan.heights.placements.end(),
+                                     [](const BakePlacement& b) { return b.surface; });
+    if (surface) {
+        const int W = plan.heights.width, H = plan.heights.height;
+        if (o.rest && o.rest->width == W && o.rest->height == H) {
+            plan.heights.rest = o.rest;
+        } else if (o.layout) {
+            plan.heights.rest = std::make_shared<const RestSurfaceMap>(bakeRestSurface(model, *o.layout, W, H));
+        } else {
+            plan.heights.rest = std::make_shared<const RestSurfaceMap>(
+                bakeRestSurface(model, modelTextureLayout(model), W, H));
+        }
+    }
     if (base) {
         plan.heights.base = &base->pixels;
         plan.heights.baseId = base->contentId;
@@ -51,6 +66,7 @@ BakeSettings settingsOf(const HeightMapInput& in, int threads) {
     s.width = in.width;
     s.height = in.height;
     s.base = in.base;
+    s.rest = in.rest.get();
     s.threads = threads;
     return s;
 }

@@ -15,6 +15,7 @@
 #include "result.hpp"
 #include "rig.hpp"
 #include "scene.hpp"
+#include "texture_layout.hpp"
 
 #include <glm/glm.hpp>
 
@@ -43,6 +44,14 @@ struct FrameOverrides {
     std::optional<double> yaw, pitch, distance;
     std::optional<std::array<double, 3>> target; ///< the camera's target (Camera::target)
     FrameView view = FrameView::Shaded; ///< what the frame shows (never in the scene)
+    /// The height-map layout the scene uses (SPEC §8), chosen by the caller (the service's
+    /// layoutFor; the CLI: the model's own). Null = the model's own UVs, as before layouts: the
+    /// plan's HeightMapInput::layout stays null then and the renderer uses the model's UVs.
+    std::shared_ptr<const TextureLayout> layout;
+    /// The rest-surface map of `layout` (of the model's own UVs when null) at the scene's
+    /// height-map size, when the caller keeps one (a cache per layout and size): used when a
+    /// surface placement needs one and its size matches; otherwise planFrame bakes it.
+    std::shared_ptr<const RestSurfaceMap> rest;
 };
 
 struct FramePlan {
@@ -59,7 +68,10 @@ struct FramePlan {
 /// (validateRenderSettings with `limits`), then evaluates the pose and resolves the placements.
 /// Fails like validateRenderSettings (field "/render/…"), evaluatePose ("/pose/…") and
 /// resolvePlacements ("/placements/<i>…"); a time override must be finite and ≥ 0 ("/pose/time").
-/// A model without UVs but with placements fails at "/placements/0".
+/// UV placements on a model without UVs (and no layout given) fail at "/placements/<i>", surface
+/// placements without a layout that has UVs at "/uv_layout" (resolvePlacements). The plan's
+/// heights carry o.layout and, when an enabled surface placement needs it, the rest-surface map
+/// (o.rest when it has the map's size, else bakeRestSurface of the layout in use).
 Result<FramePlan> planFrame(const Scene& scene, const Model& model, const PatternImages& images,
                             std::shared_ptr<const PatternImage> base,
                             const FrameOverrides& overrides = {}, const RenderLimits& limits = {});

@@ -8,11 +8,14 @@
 // bilinear weights; HeightmapTest checks this against a straightforward per-texel evaluation.
 #include "heightmap.hpp"
 
+#include "texture_layout.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <thread>
 #include <tuple>
 
@@ -220,6 +223,7 @@ struct Prepared {
     const float* pattern = nullptr;
     int pw = 0, ph = 0;
     HeightImage* out = nullptr;
+    const BakePlacement* surface = nullptr; ///< a surface placement (SPEC §8): per texel, below
 
     /// s of texel (i, ·) with dv = v − center.v, with exactly the arithmetic of
     /// Footprint::toPattern (so that the inside test below agrees with placementHeight).
@@ -262,6 +266,39 @@ struct RowSpan {
     std::int64_t X = 0, Y = 0;  ///< fixed-point x + 1, y + 1 at i0
 };
 
+/// Adds surface placement `p`'s L_out (surfacePlacementHeight at each texel's rest-surface
+/// point, SPEC §8) to rows [r0, r1) of `out` within `rect`, skipping the rest map's tiles it
+/// cannot reach and texels without coverage. Same arithmetic as surfacePlacementHeight.
+void addSurfaceRows(const BakePlacement& p, const RestSurfaceMap& rest, const TexelRect& rect,
+                    int r0, int r1, HeightImage& out) {
+    const SurfaceFrame frame(p);
+    const float h = static_cast<float>(p.h), k = deformConstant(p.model, p.response, p.t);
+    constexpr int T = RestSurfaceMap::kTile;
+    const bool tiled = rest.tileMin.size() == static_cast<std::size_t>(rest.tilesX) * rest.tilesY &&
+                       rest.tileMax.size() == rest.tileMin.size();
+    const int W = rest.width;
+    for (int j = r0; j < r1; ++j) {
+        float* row = &out.data[static_cast<std::size_t>(j) * W];
+        for (int i0 = rect.x0; i0 < rect.x1;) {
+            const int i1 = std::min(rect.x1, (i0 / T + 1) * T); // to the end of this tile
+            if (tiled && !surfaceTileNear(frame, rest, static_cast<std::size_t>(j / T) * rest.tilesX +
+                                                           static_cast<std::size_t>(i0 / T))) {
+                i0 = i1;
+                continue;
+            }
+            for (int i = i0; i < i1; ++i) {
+                const std::size_t idx = static_cast<std::size_t>(j) * W + i;
+                if (!rest.coverage[idx]) continue;
+                glm::dvec2 s;
+                if (!frame.toPattern(glm::dvec3(rest.position[idx]), glm::dvec3(rest.normal[idx]), s))
+                    continue;
+                row[i] += applyDeform(p.model, sampleBilinear(*p.pattern, s.x, s.y), h, p.t, k);
+            }
+            i0 = i1;
+        }
+    }
+}
+
 /// Pattern rows per band of the placement loop (see bakeRows).
 constexpr int kBandRows = 32;
 
@@ -293,6 +330,22 @@ Status bakeHeightMapsInto(const std::vector<BakePlacement>& placements,
             return makeError(ErrorCode::InvalidArgument, where,
                              "/placements/" + std::to_string(k) + "/scale", "must be > 0");
     }
+    const RestSurfaceMap* rest = settings.rest;
+    for (std::size_t k = 0; k < placements.size(); ++k) {
+        const BakePlacement& p = placements[k];
+        if (!p.surface) continue;
+        const std::string field = "/placements/" + std::to_string(k);
+        if (!rest || rest->width != W || rest->height != H ||
+            rest->position.size() != static_cast<std::size_t>(W) * H ||
+            rest->normal.size() != rest->position.size() || rest->coverage.size() != rest->position.size())
+            return makeError(ErrorCode::InvalidArgument, where, field + "/projection",
+                             "a surface placement needs the rest-surface map of the layout in use "
+                             "at the map size (" + std::to_string(W) + "x" + std::to_string(H) + ")");
+        if (!(p.size.x > 0.0) || !(p.size.y > 0.0))
+            return makeError(ErrorCode::InvalidArgument, where, field + "/size", "must be > 0");
+        if (!(p.depth > 0.0))
+            return makeError(ErrorCode::InvalidArgument, where, field + "/depth", "must be > 0");
+    }
     const HeightImage* base = settings.base;
     if (base && (base->width <= 0 || base->height <= 0 ||
                  base->data.size() != static_cast<std::size_t>(base->width) * base->height))
@@ -313,6 +366,14 @@ Status bakeHeightMapsInto(const std::vector<BakePlacement>& placements,
     for (const BakePlacement& p : placements) {
         if (p.t <= 0.0) continue;
         Prepared a;
+        if (p.surface) {
+            a.rect = surfacePlacementTexels(p, *rest);
+            if (a.rect.x0 >= a.rect.x1 || a.rect.y0 >= a.rect.y1) continue; // reaches no texel
+            a.surface = &p;
+            a.out = p.target == Target::Bump ? &maps.bump : &maps.displacement;
+            active.push_back(a);
+            continue;
+        }
         a.rect = footprintTexels(p.footprint, W, H);
         if (a.rect.x0 >= a.rect.x1 || a.rect.y0 >= a.rect.y1) continue; // off the map
         const double rad = glm::radians(p.footprint.rotationDeg);
@@ -368,6 +429,10 @@ Status bakeHeightMapsInto(const std::vector<BakePlacement>& placements,
         for (const Prepared& a : active) {
             const int r0 = std::max(y0, a.rect.y0), r1 = std::min(y1, a.rect.y1);
             if (r0 >= r1) continue;
+            if (a.surface) {
+                addSurfaceRows(*a.surface, *rest, a.rect, r0, r1, *a.out);
+                continue;
+            }
             // Along row j, s(i) = R(−rotation)·((i + 0.5)/W − cu, dv)/scale + 0.5 is affine in i:
             // s = (ax + bx·i, ay + by·i).
             const double du0 = 0.5 / W - a.center.x;

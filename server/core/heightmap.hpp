@@ -1,5 +1,6 @@
-// Dermis core — height images, pattern placements in texture space, and the CPU reference of
-// the height-map stage (paper §4, first stage; SPEC §2 "Height maps" and "Conventions").
+// Dermis core — height images, pattern placements in texture space (and on the rest surface,
+// SPEC §8), and the CPU reference of the height-map stage (paper §4, first stage; SPEC §2
+// "Height maps" and "Conventions").
 //
 // Pure and deterministic: the same inputs give bit-identical maps for any thread count (each
 // texel sums its placements in document order; threads split rows).
@@ -78,19 +79,47 @@ struct BakePlacement {
     // Surface placements (SPEC §8): the footprint is unused; the pattern coordinate of a texel
     // comes from its rest-surface point (RestSurfaceMap) and these, in bind space.
     bool surface = false;
-    glm::dvec3 anchorPosition{0.0}, anchorNormal{0, 0, 1}, anchorTangent{1, 0, 0}; ///< orthonormal
+    /// Orthonormal. anchorTangent is the pattern's u direction with the placement's `rotation`
+    /// already applied (resolvePlacements turns the anchor's tangent about its normal).
+    glm::dvec3 anchorPosition{0.0}, anchorNormal{0, 0, 1}, anchorTangent{1, 0, 0};
     glm::dvec2 size{0.1, 0.1}; ///< > 0, model units
     double depth = 0.05;       ///< > 0, model units
 };
 
 /// The contribution of one placement at a UV point (0 outside its footprint).
 float placementHeight(const BakePlacement& p, glm::dvec2 uv);
+
+/// A surface placement's projection (SPEC §8) with its constants computed once: c = anchor
+/// position, n = anchor normal, t = anchor tangent (rotation applied), b = n × t.
+struct SurfaceFrame {
+    glm::dvec3 c{0.0}, n{0, 0, 1}, t{1, 0, 0}, b{0, 1, 0};
+    double invW = 10.0, invH = 10.0, depth = 0.05;
+
+    explicit SurfaceFrame(const BakePlacement& p);
+    /// The pattern coordinate s = (((p−c)·t)/w + ½, ((p−c)·b)/h + ½) of rest-surface point
+    /// `position` with unit normal `normal`; false where the decal does not reach it:
+    /// |(p−c)·n| > depth, normal·n ≤ 0, or s outside [0,1]².
+    bool toPattern(glm::dvec3 position, glm::dvec3 normal, glm::dvec2& s) const;
+    /// Radius of a sphere about c holding every point the decal reaches (the pattern box
+    /// w × h × 2·depth), slightly widened against rounding.
+    double reach() const;
+};
+
 /// The contribution of one surface placement at a rest-surface point p with unit normal n
 /// (SPEC §8: pattern at (((p−c)·t)/w + ½, ((p−c)·b)/h + ½), 0 where |(p−c)·n| > depth or
-/// n_p·n ≤ 0 or outside the pattern square).
+/// n_p·n ≤ 0 or outside the pattern square), sampled bilinearly like placementHeight and put
+/// through the deformation model (paper eq. 1, 2) with p.t.
 float surfacePlacementHeight(const BakePlacement& p, glm::dvec3 position, glm::dvec3 normal);
 
 struct RestSurfaceMap; // texture_layout.hpp
+
+/// Texel rectangle of `rest` (clipped to the map) outside which surface placement `p` adds
+/// nothing: the union of the rest map's tiles whose bounds come within SurfaceFrame::reach of
+/// the anchor. Empty (x0 ≥ x1) when none does.
+TexelRect surfacePlacementTexels(const BakePlacement& p, const RestSurfaceMap& rest);
+/// Whether tile `tile` of `rest` (RestSurfaceMap::tileMin/Max index) may hold a texel that the
+/// decal of `frame` reaches (its bounds within reach of the anchor).
+bool surfaceTileNear(const SurfaceFrame& frame, const RestSurfaceMap& rest, std::size_t tile);
 
 struct HeightMaps {
     HeightImage bump, displacement;
@@ -105,7 +134,10 @@ struct BakeSettings {
 };
 
 /// Bakes both maps: every texel centre sums its placements' L_out into the target map, plus the
-/// base map on bump. Fails on a non-positive or > kMaxHeightmapSize size or a null pattern.
+/// base map on bump. A surface placement's L_out at a texel is surfacePlacementHeight at the
+/// texel's rest-surface point (settings.rest; texels with coverage 0 get nothing).
+/// Fails on a non-positive or > kMaxHeightmapSize size, a null pattern, or a surface placement
+/// without a rest map of the map's size ("/placements/<k>/projection").
 Result<HeightMaps> bakeHeightMaps(const std::vector<BakePlacement>& placements,
                                   const BakeSettings& settings);
 

@@ -1,6 +1,8 @@
 // Probe of one texel. See probe.hpp.
 #include "probe.hpp"
 
+#include "texture_layout.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -30,14 +32,32 @@ Result<ProbeResult> probeHeights(const HeightMapInput& in, double u, double v) {
         if (!p.pattern || p.pattern->data.empty())
             return makeError(ErrorCode::InvalidArgument, where,
                              "/placements/" + std::to_string(k) + "/pattern", "no pattern image");
-        const glm::dvec2 s = p.footprint.toPattern(uv);
-        if (s.x < 0.0 || s.x > 1.0 || s.y < 0.0 || s.y > 1.0) continue;
+        glm::dvec2 s;
+        float height = 0.0f;
+        if (p.surface) {
+            // SPEC §8: the decal at the texel's rest-surface point.
+            const RestSurfaceMap* rest = in.rest.get();
+            if (!rest || rest->width != in.width || rest->height != in.height ||
+                rest->position.size() != static_cast<std::size_t>(in.width) * in.height)
+                return makeError(ErrorCode::InvalidArgument, where,
+                                 "/placements/" + std::to_string(k) + "/projection",
+                                 "a surface placement needs the rest-surface map at the map size");
+            const std::size_t idx = static_cast<std::size_t>(r.texelY) * in.width + r.texelX;
+            if (!rest->coverage[idx]) continue;
+            const glm::dvec3 pos(rest->position[idx]), nrm(rest->normal[idx]);
+            if (!SurfaceFrame(p).toPattern(pos, nrm, s)) continue;
+            if (p.t > 0.0) height = surfacePlacementHeight(p, pos, nrm);
+        } else {
+            s = p.footprint.toPattern(uv);
+            if (s.x < 0.0 || s.x > 1.0 || s.y < 0.0 || s.y > 1.0) continue;
+            if (p.t > 0.0) height = placementHeight(p, uv);
+        }
         ProbeContribution c;
         c.source = p.source;
         c.target = p.target;
         c.t = p.t;
         c.L = sampleBilinear(*p.pattern, s.x, s.y);
-        c.height = p.t <= 0.0 ? 0.0f : placementHeight(p, uv);
+        c.height = height;
         (p.target == Target::Bump ? r.bump : r.displacement) += c.height;
         r.contributions.push_back(c);
     }

@@ -24,14 +24,16 @@ struct ProbeResult {
     double u = 0.0, v = 0.0;    ///< that texel's centre
     float base = 0.0f;          ///< the static base map there (0 without one)
     float bump = 0.0f, displacement = 0.0f; ///< the maps' values, as bakeHeightMaps gives them
-    /// Placements whose footprint covers the texel centre, in document order (t = 0 included,
-    /// with height 0).
+    /// Placements whose footprint covers the texel centre — for a surface placement (SPEC §8):
+    /// whose decal reaches the texel's rest-surface point (HeightMapInput::rest) —, in document
+    /// order (t = 0 included, with height 0).
     std::vector<ProbeContribution> contributions;
 };
 
 /// Probes the texel of `in`'s maps containing (u, v) ∈ [0, 1]² (u = 1 or v = 1 is the last
 /// texel). Fails (InvalidArgument, field "u" or "v") outside [0, 1] or when not finite, and like
-/// bakeHeightMaps on a bad map size or a placement without a pattern.
+/// bakeHeightMaps on a bad map size, a placement without a pattern or a surface placement
+/// without a rest map of the map's size.
 Result<ProbeResult> probeHeights(const HeightMapInput& in, double u, double v);
 
 } // namespace dermis

@@ -1,6 +1,6 @@
 // Dermis core — serialisation of the scene document `dermis.scene/1` (SPEC §2b): toJson(Scene)
 // writes every field explicitly ("auto" where optional values are absent), so that parse →
-// serialise → parse → serialise is byte-stable; and the names of DisplacementMode.
+// serialise → parse → serialise is byte-stable; and the names of DisplacementMode and Projection.
 // Parsing is in scene_parse.cpp, the pattern manifest in scene_manifest.cpp, the shared JSON
 // reader and predicates in scene_json.hpp.
 #include "scene.hpp"
@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <string_view>
 #include <utility>
 
@@ -28,6 +29,10 @@ std::optional<DisplacementMode> displacementModeFromString(std::string_view s) {
 
 std::string_view toString(Projection p) { return p == Projection::Surface ? "surface" : "uv"; }
 
+double Placement::depthOrDefault() const {
+    return depth ? *depth : std::max(size[0], size[1]) / 2.0;
+}
+
 std::optional<Projection> projectionFromString(std::string_view s) {
     if (s == "uv") return Projection::Uv;
     if (s == "surface") return Projection::Surface;
@@ -38,6 +43,7 @@ json toJson(const Scene& scene) {
     json doc = json::object();
     doc["format"] = kSceneFormat;
     doc["model"] = scene.model;
+    doc["uv_layout"] = std::string(toString(scene.uvLayout));
 
     json heightmap = json::object();
     heightmap["size"] = json::array({scene.heightmapSize[0], scene.heightmapSize[1]});
@@ -70,6 +76,17 @@ json toJson(const Scene& scene) {
         e["response"] = std::string(toString(p.response));
         e["enabled"] = p.enabled;
         e["label"] = p.label;
+        // SPEC §8: projection on every placement; the surface members only where they are used.
+        e["projection"] = std::string(toString(p.projection));
+        if (p.projection == Projection::Surface) {
+            const SurfaceAnchor& a = p.anchor;
+            e["anchor"] = json{
+                {"position", json::array({a.position[0], a.position[1], a.position[2]})},
+                {"normal", json::array({a.normal[0], a.normal[1], a.normal[2]})},
+                {"tangent", json::array({a.tangent[0], a.tangent[1], a.tangent[2]})}};
+            e["size"] = json::array({p.size[0], p.size[1]});
+            e["depth"] = p.depth ? json(*p.depth) : json("auto");
+        }
         placements.push_back(std::move(e));
     }
     doc["placements"] = std::move(placements);

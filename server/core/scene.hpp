@@ -53,10 +53,15 @@ std::string_view toString(Projection p);
 std::optional<Projection> projectionFromString(std::string_view s);
 
 /// Where a surface placement sits, in bind (rest-pose model) space: MeshPart positions' space.
+/// In the document: "anchor": {"position": [x, y, z], "normal": [x, y, z], "tangent": [x, y, z]},
+/// all three required for a surface placement.
 struct SurfaceAnchor {
-    std::array<double, 3> position{0, 0, 0};
+    std::array<double, 3> position{0, 0, 0}; ///< each coordinate in [−kMaxAnchorCoordinate, kMaxAnchorCoordinate]
     std::array<double, 3> normal{0, 0, 1};  ///< unit (normalised on parse)
-    std::array<double, 3> tangent{1, 0, 0}; ///< the pattern's u direction; made ⟂ normal on parse
+    /// The pattern's u direction; made ⟂ normal and unit on parse (Gram–Schmidt; a tangent already
+    /// orthonormal to within 1e-12 is kept bit for bit, so parse → serialise is stable). A tangent
+    /// parallel to the normal is an error.
+    std::array<double, 3> tangent{1, 0, 0};
 };
 
 struct Placement {
@@ -78,8 +83,11 @@ struct Placement {
     // (rotation turns the pattern about the anchor normal there too).
     Projection projection = Projection::Uv;
     SurfaceAnchor anchor;
-    std::array<double, 2> size{0.1, 0.1}; ///< model units (w along tangent, h along normal × tangent)
-    std::optional<double> depth;          ///< model units; absent = max(w, h) / 2
+    std::array<double, 2> size{0.1, 0.1}; ///< model units (w along tangent, h along normal × tangent), each in (0, kMaxSurfaceSize]
+    std::optional<double> depth;          ///< model units in (0, kMaxSurfaceSize]; absent ("auto") = max(w, h) / 2
+
+    /// The depth in use: `depth`, else max(size) / 2 (SPEC §8).
+    double depthOrDefault() const;
 };
 
 /// Longest placement label, in bytes.
@@ -100,6 +108,8 @@ constexpr double kMaxCameraDistance = 10000.0;  ///< camera distance ∈ (0, 100
 constexpr double kMaxCameraTarget = 1.0e6;      ///< each camera target coordinate ∈ [−1e6, 1e6]
 constexpr double kMaxDisplacementScale = 1000.0; ///< displacement_scale ∈ [0, 1000]
 constexpr double kMaxBumpStrength = 100.0;       ///< bump_strength ∈ [0, 100]
+constexpr double kMaxAnchorCoordinate = 1.0e6;   ///< each anchor position coordinate ∈ [−1e6, 1e6]
+constexpr double kMaxSurfaceSize = 10000.0;      ///< surface size w, h and depth ∈ (0, 10000] model units
 
 /// A joint override of the pose: exactly one of rotation / axisAngles is set.
 struct JointPose {

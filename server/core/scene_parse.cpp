@@ -1,6 +1,6 @@
 // Dermis core — parsing of the scene document `dermis.scene/1` (SPEC §2b): JSON → Scene, one
 // parser per field group (heightmap, patterns, placements and their id / pattern / footprint /
-// driver / model fields, pose, render), defaults applied, ranges checked; and text → JSON that
+// driver / model / projection fields, pose, render), defaults applied, ranges checked; and text → JSON that
 // reports a number too large for a double at its JSON pointer (parseSceneText).
 //
 // Every reader below takes the value and the RFC 6901 pointer of where it sits in the document,
@@ -276,6 +276,96 @@ Status parsePlacementModel(const Reader& rd, const json& v, const std::string& p
     return Ok{};
 }
 
+/// How the pattern reaches the map (SPEC §8): projection ("uv" default | "surface"), and for a
+/// surface placement its anchor {position, normal, tangent} (required), size [w, h] (required)
+/// and depth (number or "auto"). The members are checked whenever they are given, so a
+/// placement switched back to "uv" keeps valid ones; only "surface" requires them.
+Status parsePlacementProjection(const Reader& rd, const json& v, const std::string& ptr,
+                                Placement& out) {
+    if (const json* p = Reader::find(v, "projection")) {
+        auto e = rd.enumeration(*p, ptr + "/projection", projectionFromString,
+                                "\"uv\" or \"surface\"");
+        if (!e) return e.error();
+        out.projection = *e;
+    }
+    const bool surface = out.projection == Projection::Surface;
+    const json* anchor = Reader::find(v, "anchor");
+    if (!anchor && surface)
+        return rd.bad(ptr + "/anchor",
+                      "is required for a surface placement ({\"position\", \"normal\", "
+                      "\"tangent\"} in bind space)");
+    if (anchor) {
+        const std::string ap = ptr + "/anchor";
+        if (auto s = rd.object(*anchor, ap); !s) return s;
+        for (const char* key : {"position", "normal", "tangent"})
+            if (!Reader::find(*anchor, key))
+                return rd.bad(ap + "/" + key, "is required (a 3-vector in bind space)");
+        auto pos = rd.numbers<3>(*Reader::find(*anchor, "position"), ap + "/position");
+        if (!pos) return pos.error();
+        for (std::size_t i = 0; i < 3; ++i)
+            if (std::abs((*pos)[i]) > kMaxAnchorCoordinate)
+                return rd.bad(member(ap + "/position", i),
+                              "must be in [" + Reader::fmt(-kMaxAnchorCoordinate) + ", " +
+                                  Reader::fmt(kMaxAnchorCoordinate) + "], got " +
+                                  Reader::fmt((*pos)[i]));
+        auto normal = rd.numbers<3>(*Reader::find(*anchor, "normal"), ap + "/normal");
+        if (!normal) return normal.error();
+        if (!normalizeInPlace(*normal)) return rd.bad(ap + "/normal", "must have a non-zero length");
+        auto tangent = rd.numbers<3>(*Reader::find(*anchor, "tangent"), ap + "/tangent");
+        if (!tangent) return tangent.error();
+        if (!normalizeInPlace(*tangent))
+            return rd.bad(ap + "/tangent", "must have a non-zero length");
+        // Gram–Schmidt against the normal, only where it is not already orthogonal (to within
+        // the tolerance of normalizeInPlace): a canonical tangent reads back bit for bit.
+        double dot = 0.0;
+        for (std::size_t i = 0; i < 3; ++i)
+            dot += (*tangent)[i] * (*normal)[i];
+        if (std::abs(dot) > 1e-12) {
+            for (std::size_t i = 0; i < 3; ++i)
+                (*tangent)[i] -= dot * (*normal)[i];
+            double len = 0.0;
+            for (double c : *tangent)
+                len += c * c;
+            if (!(std::sqrt(len) > 1e-6) || !normalizeInPlace(*tangent))
+                return rd.bad(ap + "/tangent", "must not be parallel to the normal");
+        }
+        out.anchor.position = *pos;
+        out.anchor.normal = *normal;
+        out.anchor.tangent = *tangent;
+    }
+    const json* size = Reader::find(v, "size");
+    if (!size && surface)
+        return rd.bad(ptr + "/size", "is required for a surface placement ([w, h] in model units)");
+    if (size) {
+        auto wh = rd.numbers<2>(*size, ptr + "/size");
+        if (!wh) return wh.error();
+        for (std::size_t i = 0; i < 2; ++i)
+            if ((*wh)[i] <= 0.0 || (*wh)[i] > kMaxSurfaceSize)
+                return rd.bad(member(ptr + "/size", i), "must be in (0, " +
+                                                            Reader::fmt(kMaxSurfaceSize) +
+                                                            "], got " + Reader::fmt((*wh)[i]));
+        out.size = *wh;
+    }
+    if (const json* d = Reader::find(v, "depth")) {
+        const std::string dp = ptr + "/depth";
+        if (d->is_string()) {
+            if (d->get_ref<const std::string&>() != "auto")
+                return rd.bad(dp, "must be \"auto\" or a number");
+            out.depth.reset();
+        } else {
+            if (!d->is_number())
+                return rd.bad(dp, "expected \"auto\" or a number, got " + describeType(*d));
+            auto n = rd.number(*d, dp);
+            if (!n) return n.error();
+            if (*n <= 0.0 || *n > kMaxSurfaceSize)
+                return rd.bad(dp, "must be in (0, " + Reader::fmt(kMaxSurfaceSize) +
+                                      "] (or \"auto\"), got " + Reader::fmt(*n));
+            out.depth = *n;
+        }
+    }
+    return Ok{};
+}
+
 /// For people and the editor: enabled (default true), label (≤ kMaxLabelLength bytes).
 Status parsePlacementMeta(const Reader& rd, const json& v, const std::string& ptr, Placement& out) {
     if (const json* e = Reader::find(v, "enabled")) {
@@ -304,6 +394,7 @@ Status parsePlacement(const Reader& rd, const json& v, std::size_t index, const 
     if (auto s = parsePlacementId(rd, v, ptr, index, reservedIds, seenIds, out); !s) return s;
     if (auto s = parsePlacementPattern(rd, v, ptr, scene, manifest, out); !s) return s;
     if (auto s = parsePlacementFootprint(rd, v, ptr, out); !s) return s;
+    if (auto s = parsePlacementProjection(rd, v, ptr, out); !s) return s;
     if (auto s = parsePlacementDriver(rd, v, ptr, out); !s) return s;
     if (auto s = parsePlacementMeta(rd, v, ptr, out); !s) return s;
     return parsePlacementModel(rd, v, ptr, out);
@@ -573,6 +664,12 @@ Result<Scene> parseScene(const json& doc, const PatternManifest& manifest) {
             return rd.bad("/model", "built-in model name '" + *s +
                                         "' must be \"builtin:\" followed by [A-Za-z0-9_-]+");
         scene.model = *s;
+    }
+    if (const json* l = Reader::find(doc, "uv_layout")) {
+        auto e = rd.enumeration(*l, "/uv_layout", uvLayoutModeFromString,
+                                "\"auto\", \"model\" or \"generated\"");
+        if (!e) return e.error();
+        scene.uvLayout = *e;
     }
     if (const json* h = Reader::find(doc, "heightmap"))
         if (auto s = parseHeightmap(rd, *h, scene); !s) return s.error();

@@ -54,17 +54,36 @@ TextureLayout modelTextureLayout(const Model& model);
 /// normals), or — within `dilate` texels of a covered texel — those of the nearest covered texel
 /// (gutters, so bilinear sampling across a chart edge reads continuous heights). coverage: 0 none,
 /// 1 covered, 2 dilated. Where triangles overlap, the later triangle (part, then index order) wins.
+///
+/// Texels are rasterised at their centres: a centre on a shared edge belongs to both triangles
+/// (the later wins), so no texel inside the union of a chart's triangles is left out. Degenerate
+/// (zero UV area) triangles and triangles with an index out of range are skipped. The nearest
+/// covered texel of a gutter texel is the one at the smallest Euclidean texel distance (≤
+/// `dilate`); ties go to the smaller |row offset|, then the row above, then the column to the
+/// left — a fixed rule, so the map is the same for any thread count.
 struct RestSurfaceMap {
     int width = 0, height = 0;
-    std::vector<glm::vec3> position; ///< width·height, row 0 first
+    std::vector<glm::vec3> position; ///< width·height, row 0 first; 0 where coverage is 0
     std::vector<glm::vec3> normal;   ///< unit where coverage > 0, else 0
     std::vector<std::uint8_t> coverage;
     std::uint64_t contentId = 0;     ///< process-unique (a GPU cache key), > 0 once baked
+
+    /// Culling aid for surface placements (bakeHeightMaps, the GPU pass): the map cut into tiles
+    /// of kTile × kTile texels (the last row/column of tiles may be smaller), tilesX · tilesY of
+    /// them, row-major; per tile the bounds of the positions of its texels with coverage > 0
+    /// (tileMin > tileMax: the tile has none).
+    static constexpr int kTile = 16;
+    int tilesX = 0, tilesY = 0;
+    std::vector<glm::vec3> tileMin, tileMax;
 };
 
 /// Bakes the rest-surface map. Deterministic (bit-identical for the same inputs and any thread
-/// count). Preconditions: width, height in [1, kMaxHeightmapSize].
+/// count; rows are split between up to `threads` threads, 0 = hardware concurrency). Content ids
+/// come from their own counter with bit 62 set, so they never equal a PatternImage's id (a small
+/// counter) or a GPU pixel hash (bit 63), and may share the renderer's texture cache with them.
+/// Preconditions: width, height in [1, kMaxHeightmapSize] (else an empty map with contentId 0);
+/// dilate ≥ 0.
 RestSurfaceMap bakeRestSurface(const Model& model, const TextureLayout& layout, int width,
-                               int height, int dilate = 4);
+                               int height, int dilate = 4, int threads = 0);
 
 } // namespace dermis

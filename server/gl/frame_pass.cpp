@@ -116,6 +116,11 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     FrameResult out;
     auto gm = modelFor(req.model);
     if (!gm) return gm.error();
+    // The vertex arrays for the maps' layout (SPEC §8; the model's own UVs when none is given).
+    const std::shared_ptr<const TextureLayout> layout =
+        req.layout ? req.layout : (req.heights ? req.heights->layout : nullptr);
+    auto parts = partsFor(model, **gm, layout);
+    if (!parts) return parts.error();
 
     // Stage 1: the height maps this frame samples.
     auto t0 = std::chrono::steady_clock::now();
@@ -140,8 +145,9 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     out.cameraDistance = camera.distance;
     uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
     uploadOutlineBlock(req.outlines);
-    const std::size_t partStride = uploadPartBlocks(model, **gm, req.view);
-    const GLuint readFbo = drawSkinPass(model, **gm, rs, heightSource->texture, partStride, samples);
+    const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view);
+    const GLuint readFbo =
+        drawSkinPass(model, **gm, **parts, rs, heightSource->texture, partStride, samples);
     if (auto s = checkGl("skin pass"); !s) return s.error();
     if (req.profile) glFinish();
     out.timings.skinMs = msSince(t0);
@@ -206,17 +212,18 @@ void Renderer::Impl::uploadOutlineBlock(const std::vector<FrameOutline>& outline
 
 /// One PartBlock per part in partUbo (bound by range per draw), each with the frame's view in
 /// part.w (shaders/skin.frag); returns the stride.
-std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm, FrameView view) {
+std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm,
+                                             const std::vector<GpuModel::Part>& parts, FrameView view) {
     const std::size_t stride = uboStride(sizeof(PartBlock));
-    std::vector<std::uint8_t> partBlocks(stride * std::max<std::size_t>(1, gm.parts.size()), 0);
-    for (std::size_t pi = 0; pi < gm.parts.size(); ++pi) {
-        const GpuModel::Part& gp = gm.parts[pi];
+    std::vector<std::uint8_t> partBlocks(stride * std::max<std::size_t>(1, parts.size()), 0);
+    for (std::size_t pi = 0; pi < parts.size(); ++pi) {
+        const GpuModel::Part& gp = parts[pi];
         PartBlock pb{};
         pb.baseColor = glm::vec4(0.80f, 0.62f, 0.54f, 1.0f); // skin tone when there is no material
         if (gp.material >= 0 && static_cast<std::size_t>(gp.material) < model.materials.size())
             pb.baseColor = model.materials[static_cast<std::size_t>(gp.material)].baseColorFactor;
-        const bool textured = gm.baseColorTexture(model, gp) != 0;
-        pb.part = glm::ivec4(gp.paletteOffset, textured ? 1 : 0, gp.hasUVs ? 1 : 0,
+        const bool textured = gm.baseColorTexture(model, gp) != 0 && gp.hasUVs;
+        pb.part = glm::ivec4(gp.paletteOffset, textured ? 1 : 0, gp.hasMapUVs ? 1 : 0,
                              static_cast<int>(view));
         std::memcpy(partBlocks.data() + stride * pi, &pb, sizeof pb);
     }
@@ -228,6 +235,7 @@ std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel&
 
 /// Draws every part into the frame targets and resolves MSAA; returns the framebuffer to read.
 GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
+                                    const std::vector<GpuModel::Part>& parts,
                                     const RenderSettings& rs, GLuint heightTexture,
                                     std::size_t partStride, int samples) {
     const int W = frame.width, H = frame.height;
@@ -249,8 +257,8 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
     if (tess) glPatchParameteri(GL_PATCH_VERTICES, 3);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, heightTexture);
-    for (std::size_t pi = 0; pi < gm.parts.size(); ++pi) {
-        const GpuModel::Part& gp = gm.parts[pi];
+    for (std::size_t pi = 0; pi < parts.size(); ++pi) {
+        const GpuModel::Part& gp = parts[pi];
         if (gp.indexCount == 0) continue;
         glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
                           static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));

@@ -12,6 +12,7 @@ using namespace gl;
 void Renderer::Impl::erasePattern(std::map<std::uint64_t, PatternTexture>::iterator it) {
     if (baseTexture == it->second.tex) baseTexture = 0;
     glDeleteTextures(1, &it->second.tex);
+    if (it->second.tex2) glDeleteTextures(1, &it->second.tex2);
     patternBytes -= it->second.bytes;
     patterns.erase(it);
 }

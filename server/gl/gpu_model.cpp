@@ -22,13 +22,23 @@ GLuint GpuModel::baseColorTexture(const Model& model, const Part& part) const {
                : 0;
 }
 
-void GpuModel::destroy() {
-    for (Part& p : parts) {
+namespace {
+
+void destroyParts(std::vector<GpuModel::Part>& parts) {
+    for (GpuModel::Part& p : parts) {
         glDeleteVertexArrays(1, &p.vao);
-        glDeleteBuffers(6, p.buffers);
+        glDeleteBuffers(7, p.buffers);
     }
-    if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     parts.clear();
+}
+
+} // namespace
+
+void GpuModel::destroy() {
+    destroyParts(parts);
+    for (auto& [key, lp] : layouts) destroyParts(lp.parts);
+    layouts.clear();
+    if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     textures.clear();
 }
 
@@ -162,35 +172,99 @@ PartAttributes partAttributes(const MeshPart& part, bool hasUVs) {
     return a;
 }
 
-/// The vertex array and buffers of one part (attribute slots 0–4 as in shaders/skin.vert).
-void uploadPart(const MeshPart& part, GpuModel::Part& gp) {
-    const std::size_t nv = part.positions.size();
-    const PartAttributes a = partAttributes(part, gp.hasUVs);
-    gp.indexCount = static_cast<GLsizei>(a.indices.size());
-    glGenVertexArrays(1, &gp.vao);
-    glBindVertexArray(gp.vao);
-    glGenBuffers(6, gp.buffers);
-    auto attrib = [&](int slot, const void* data, std::size_t bytes, GLint comps, GLenum type,
-                      bool integer) {
-        glBindBuffer(GL_ARRAY_BUFFER, gp.buffers[slot]);
+/// Vertex attribute `slot` of the bound vertex array from `buffer`, filled with `bytes` of
+/// `data` (`data` null: the buffer is already filled).
+void attribute(GLuint buffer, int slot, const void* data, std::size_t bytes, GLint comps,
+               GLenum type, bool integer) {
+    glBindBuffer(GL_ARRAY_BUFFER, buffer);
+    if (data || bytes == 0)
         glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(bytes), bytes ? data : nullptr,
                      GL_STATIC_DRAW);
-        glEnableVertexAttribArray(static_cast<GLuint>(slot));
-        if (integer)
-            glVertexAttribIPointer(static_cast<GLuint>(slot), comps, type, 0, nullptr);
-        else
-            glVertexAttribPointer(static_cast<GLuint>(slot), comps, type, GL_FALSE, 0, nullptr);
-    };
-    attrib(0, part.positions.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
-    attrib(1, a.normals.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
-    attrib(2, a.uvs.data(), nv * sizeof(glm::vec2), 2, GL_FLOAT, false);
-    attrib(3, a.joints.data(), nv * sizeof(glm::u16vec4), 4, GL_UNSIGNED_SHORT, true);
-    attrib(4, a.weights.data(), nv * sizeof(glm::vec4), 4, GL_FLOAT, false);
+    glEnableVertexAttribArray(static_cast<GLuint>(slot));
+    if (integer)
+        glVertexAttribIPointer(static_cast<GLuint>(slot), comps, type, 0, nullptr);
+    else
+        glVertexAttribPointer(static_cast<GLuint>(slot), comps, type, GL_FALSE, 0, nullptr);
+}
+
+/// Attribute slots 0–5 (shaders/skin.vert) and the indices of one part into a new vertex array
+/// of `gp`. `mapUvs` null: slot 5 reads the uv buffer (the maps use the model's UVs).
+void uploadArrays(GpuModel::Part& gp, const std::vector<glm::vec3>& positions,
+                  const PartAttributes& a, const std::vector<glm::vec2>* mapUvs) {
+    const std::size_t nv = positions.size();
+    gp.indexCount = static_cast<GLsizei>(a.indices.size());
+    gp.vertexCount = static_cast<GLsizei>(nv);
+    glGenVertexArrays(1, &gp.vao);
+    glBindVertexArray(gp.vao);
+    glGenBuffers(mapUvs ? 7 : 6, gp.buffers);
+    attribute(gp.buffers[0], 0, positions.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
+    attribute(gp.buffers[1], 1, a.normals.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
+    attribute(gp.buffers[2], 2, a.uvs.data(), nv * sizeof(glm::vec2), 2, GL_FLOAT, false);
+    attribute(gp.buffers[3], 3, a.joints.data(), nv * sizeof(glm::u16vec4), 4, GL_UNSIGNED_SHORT, true);
+    attribute(gp.buffers[4], 4, a.weights.data(), nv * sizeof(glm::vec4), 4, GL_FLOAT, false);
+    if (mapUvs)
+        attribute(gp.buffers[6], 5, mapUvs->data(), nv * sizeof(glm::vec2), 2, GL_FLOAT, false);
+    else
+        attribute(gp.buffers[2], 5, nullptr, nv * sizeof(glm::vec2), 2, GL_FLOAT, false);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gp.buffers[5]);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                  static_cast<GLsizeiptr>(a.indices.size() * sizeof(std::uint32_t)),
                  a.indices.empty() ? nullptr : a.indices.data(), GL_STATIC_DRAW);
     glBindVertexArray(0);
+}
+
+/// The vertex array and buffers of one part with the model's own UVs as the maps' UVs.
+void uploadPart(const MeshPart& part, GpuModel::Part& gp) {
+    gp.hasMapUVs = gp.hasUVs;
+    uploadArrays(gp, part.positions, partAttributes(part, gp.hasUVs), nullptr);
+}
+
+/// Whether `pl` is part `part`'s own UVs (what modelTextureLayout makes of it): identity source,
+/// the part's indices and UVs; or empty where the part has no UVs.
+bool isModelLayout(const MeshPart& part, const PartLayout& pl, bool partHasUVs) {
+    if (pl.indices.empty()) return !partHasUVs || part.indices.empty();
+    if (!partHasUVs || pl.source.size() != part.positions.size() || pl.indices != part.indices ||
+        pl.uvs.size() != pl.source.size())
+        return false;
+    for (std::uint32_t v = 0; v < pl.source.size(); ++v)
+        if (pl.source[v] != v || pl.uvs[v] != part.uvs[v]) return false;
+    return true;
+}
+
+/// The vertex array and buffers of `part` split as layout part `pl` (SPEC §8): each layout
+/// vertex copies its source vertex (position, normal, joints, weights, the model's UV for the
+/// base colour), with the layout's UV as the map UV; the layout's triangles (any with an index
+/// out of range dropped). Returns the bytes uploaded.
+std::size_t uploadLayoutPart(const MeshPart& part, const PartLayout& pl, GpuModel::Part& gp) {
+    const std::size_t nv = part.positions.size();
+    const PartAttributes src = partAttributes(part, gp.hasUVs);
+    const std::size_t lv = std::min(pl.source.size(), pl.uvs.size());
+    std::vector<std::uint32_t> source(lv);
+    for (std::size_t v = 0; v < lv; ++v) source[v] = pl.source[v] < nv ? pl.source[v] : 0;
+    PartAttributes a;
+    std::vector<glm::vec3> positions(lv);
+    a.normals.resize(lv);
+    a.uvs.resize(lv);
+    a.joints.resize(lv);
+    a.weights.resize(lv);
+    for (std::size_t v = 0; v < lv; ++v) {
+        const std::uint32_t s = source[v];
+        positions[v] = nv ? part.positions[s] : glm::vec3(0.0f);
+        a.normals[v] = nv ? src.normals[s] : glm::vec3(0, 0, 1);
+        a.uvs[v] = nv ? src.uvs[s] : glm::vec2(0.0f);
+        a.joints[v] = nv ? src.joints[s] : glm::u16vec4(0);
+        a.weights[v] = nv ? src.weights[s] : glm::vec4(1, 0, 0, 0);
+    }
+    std::vector<glm::vec2> mapUvs(pl.uvs.begin(), pl.uvs.begin() + static_cast<long>(lv));
+    for (std::size_t i = 0; i + 2 < pl.indices.size(); i += 3)
+        if (pl.indices[i] < lv && pl.indices[i + 1] < lv && pl.indices[i + 2] < lv &&
+            pl.source[pl.indices[i]] < nv && pl.source[pl.indices[i + 1]] < nv &&
+            pl.source[pl.indices[i + 2]] < nv)
+            a.indices.insert(a.indices.end(), pl.indices.begin() + static_cast<long>(i),
+                             pl.indices.begin() + static_cast<long>(i) + 3);
+    gp.hasMapUVs = !a.indices.empty();
+    uploadArrays(gp, positions, a, &mapUvs);
+    return lv * 64 + a.indices.size() * 4;
 }
 
 } // namespace
@@ -242,6 +316,50 @@ Result<GpuModel*> Renderer::Impl::modelFor(const std::shared_ptr<const Model>& m
     modelBytes += gm.bytes;
     auto [it, inserted] = models.emplace(model.get(), std::move(gm));
     return &it->second;
+}
+
+Result<const std::vector<GpuModel::Part>*> Renderer::Impl::partsFor(
+    const Model& model, GpuModel& gm, const std::shared_ptr<const TextureLayout>& layout) {
+    // Layouts whose owner is gone: their address may be reused by a new one.
+    for (auto it = gm.layouts.begin(); it != gm.layouts.end();) {
+        if (it->second.owner.expired()) {
+            destroyParts(it->second.parts);
+            gm.bytes -= it->second.bytes;
+            modelBytes -= it->second.bytes;
+            it = gm.layouts.erase(it);
+        } else {
+            ++it;
+        }
+    }
+    if (!layout) return &gm.parts;
+    if (auto it = gm.layouts.find(layout.get()); it != gm.layouts.end())
+        return it->second.identity ? &gm.parts : &it->second.parts;
+    if (layout->parts.size() != model.parts.size())
+        return makeError(ErrorCode::InvalidArgument, kWhere, "layout",
+                         "the height-map layout has " + std::to_string(layout->parts.size()) +
+                             " parts, the model " + std::to_string(model.parts.size()));
+    GpuModel::LayoutParts lp;
+    lp.owner = layout;
+    lp.identity = true;
+    for (std::size_t k = 0; k < model.parts.size() && lp.identity; ++k)
+        lp.identity = isModelLayout(model.parts[k], layout->parts[k], gm.parts[k].hasUVs);
+    if (!lp.identity) {
+        for (std::size_t k = 0; k < model.parts.size(); ++k) {
+            GpuModel::Part gp = gm.parts[k]; // palette offset, material, hasUVs
+            for (GLuint& b : gp.buffers) b = 0;
+            gp.vao = 0;
+            lp.bytes += uploadLayoutPart(model.parts[k], layout->parts[k], gp);
+            lp.parts.push_back(gp);
+        }
+        if (auto s = checkGl("uploading a height-map layout"); !s) {
+            destroyParts(lp.parts);
+            return s.error();
+        }
+    }
+    gm.bytes += lp.bytes;
+    modelBytes += lp.bytes;
+    auto [it, inserted] = gm.layouts.emplace(layout.get(), std::move(lp));
+    return it->second.identity ? &gm.parts : &it->second.parts;
 }
 
 void Renderer::Impl::uploadPalette(const Model& model, const GpuModel& gm,

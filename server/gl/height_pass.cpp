@@ -1,10 +1,14 @@
 // Stage 1 of the renderer: pattern and base textures cached by content id (in the byte budget of
-// gpu_cache.cpp), the height targets, the height pass (one quad per placement, additive), readback
-// and upload of maps (see renderer_impl.hpp). On a software rasterizer a pass covering many map
+// gpu_cache.cpp), the height targets, the height pass (one quad per placement, additive; a surface
+// placement's quad covers the texels it may reach and reads the rest-surface map, SPEC §8, whose
+// two RGB32F textures are cached like patterns), readback and upload of maps (see
+// renderer_impl.hpp). On a software rasterizer a pass covering many map
 // areas is baked by the CPU and uploaded (RendererOptions::softwareCpuBakeCoverage).
 #include "gl/renderer_impl.hpp"
 
 #include "gl/uniform_blocks.hpp"
+
+#include "core/texture_layout.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -56,6 +60,7 @@ HeightKey heightKey(const HeightPassInput& in, const ResolvedPatterns& resolved,
     key.height = in.height;
     key.base = baseKey;
     key.patterns = resolved.ids;
+    key.rest = resolved.restId;
     for (std::size_t k = 0; k < in.placements.size(); ++k) {
         if (!resolved.textures[k]) continue;
         const BakePlacement& p = in.placements[k];
@@ -63,7 +68,13 @@ HeightKey heightKey(const HeightPassInput& in, const ResolvedPatterns& resolved,
                           {p.footprint.center.x, p.footprint.center.y, p.footprint.scale.x,
                            p.footprint.scale.y, p.footprint.rotationDeg, p.h, p.t,
                            double(static_cast<int>(p.model)), double(static_cast<int>(p.target)),
-                           double(static_cast<int>(p.response))});
+                           double(static_cast<int>(p.response)), p.surface ? 1.0 : 0.0});
+        if (p.surface)
+            key.params.insert(key.params.end(),
+                              {p.anchorPosition.x, p.anchorPosition.y, p.anchorPosition.z,
+                               p.anchorNormal.x, p.anchorNormal.y, p.anchorNormal.z,
+                               p.anchorTangent.x, p.anchorTangent.y, p.anchorTangent.z, p.size.x,
+                               p.size.y, p.depth});
     }
     return key;
 }
@@ -92,17 +103,42 @@ HeightPassBlock placementBlock(const BakePlacement& p, int W, int H) {
     return b;
 }
 
+/// The uniform block of surface placement `p` (SPEC §8) drawn over texel rectangle `rect` of a
+/// W×H map: the constants of dermis::SurfaceFrame.
+HeightPassBlock surfaceBlock(const BakePlacement& p, const TexelRect& rect, int W, int H) {
+    HeightPassBlock b = placementBlock(p, W, H);
+    b.centerScale = glm::vec4(static_cast<float>(rect.x0) / W, static_cast<float>(rect.y0) / H,
+                              static_cast<float>(rect.x1) / W, static_cast<float>(rect.y1) / H);
+    b.mode.w = 1;
+    const SurfaceFrame f(p);
+    b.anchor = glm::vec4(glm::vec3(f.c), static_cast<float>(f.depth));
+    b.anchorNormal = glm::vec4(glm::vec3(f.n), static_cast<float>(f.invW));
+    b.anchorTangent = glm::vec4(glm::vec3(f.t), static_cast<float>(f.invH));
+    b.anchorBinormal = glm::vec4(glm::vec3(f.b), 0.0f);
+    return b;
+}
+
 /// Whether this height pass is baked by the CPU (RendererOptions::softwareCpuBakeCoverage): a
 /// software rasterizer and footprints covering more than `coverage` map areas.
-bool bakeOnCpu(const HeightPassInput& in, double coverage, const std::string& glRenderer) {
+bool bakeOnCpu(const HeightPassInput& in, const std::vector<TexelRect>& rects, double coverage,
+               const std::string& glRenderer) {
     if (!(coverage > 0.0)) return false;
     const bool software = glRenderer.find("llvmpipe") != std::string::npos ||
                           glRenderer.find("softpipe") != std::string::npos ||
                           glRenderer.find("swrast") != std::string::npos;
     if (!software) return false;
     double covered = 0.0;
-    for (const BakePlacement& p : in.placements)
-        if (p.t > 0.0) covered += p.footprint.scale.x * p.footprint.scale.y;
+    for (std::size_t k = 0; k < in.placements.size(); ++k) {
+        const BakePlacement& p = in.placements[k];
+        if (!(p.t > 0.0)) continue;
+        if (!p.surface) {
+            covered += p.footprint.scale.x * p.footprint.scale.y;
+        } else if (k < rects.size()) { // the rectangle of texels its quad covers
+            const TexelRect& r = rects[k];
+            covered += static_cast<double>(r.x1 - r.x0) * (r.y1 - r.y0) /
+                       (static_cast<double>(in.width) * in.height);
+        }
+    }
     return covered > coverage;
 }
 
@@ -154,6 +190,61 @@ Result<ResolvedPatterns> Renderer::Impl::resolvePatterns(const HeightPassInput& 
     return r;
 }
 
+Status Renderer::Impl::resolveRest(const HeightPassInput& in, ResolvedPatterns& r) {
+    r.surfaceRects.assign(in.placements.size(), TexelRect{});
+    bool needed = false;
+    for (std::size_t k = 0; k < in.placements.size(); ++k) {
+        const BakePlacement& p = in.placements[k];
+        if (!p.surface) continue;
+        const std::string field = "/placements/" + std::to_string(k);
+        const RestSurfaceMap* rest = in.rest.get();
+        const std::size_t n = static_cast<std::size_t>(in.width) * in.height;
+        if (!rest || rest->width != in.width || rest->height != in.height ||
+            rest->position.size() != n || rest->normal.size() != n || rest->coverage.size() != n)
+            return makeError(ErrorCode::InvalidArgument, kWhere, field + "/projection",
+                             "a surface placement needs the rest-surface map of the layout in use "
+                             "at the map size (" + std::to_string(in.width) + "x" +
+                                 std::to_string(in.height) + ")");
+        if (!(p.size.x > 0.0) || !(p.size.y > 0.0))
+            return makeError(ErrorCode::InvalidArgument, kWhere, field + "/size", "must be > 0");
+        if (!(p.depth > 0.0))
+            return makeError(ErrorCode::InvalidArgument, kWhere, field + "/depth", "must be > 0");
+        if (!r.textures[k]) continue; // contributes nothing
+        r.surfaceRects[k] = surfacePlacementTexels(p, *rest);
+        const TexelRect& rect = r.surfaceRects[k];
+        if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) {
+            r.textures[k] = 0; // reaches no texel
+            r.ids[k] = 0;
+            continue;
+        }
+        needed = true;
+    }
+    if (!needed) return Ok{};
+    const RestSurfaceMap& rest = *in.rest;
+    // By content id, like the patterns (RestSurfaceMap ids never equal theirs).
+    const std::uint64_t id = rest.contentId ? rest.contentId : (std::uint64_t{3} << 62);
+    if (auto it = patterns.find(id); it != patterns.end() && rest.contentId) {
+        it->second.lastUse = useCounter;
+        r.restPosition = it->second.tex;
+        r.restNormal = it->second.tex2;
+        r.restId = id;
+        return Ok{};
+    }
+    if (auto it = patterns.find(id); it != patterns.end()) erasePattern(it); // no id: upload anew
+    PatternTexture pt;
+    pt.bytes = static_cast<std::size_t>(rest.width) * rest.height * 24;
+    makeRoom(pt.bytes);
+    pt.tex = makeFloatTexture(rest.width, rest.height, &rest.position[0].x, GL_NEAREST, 3);
+    pt.tex2 = makeFloatTexture(rest.width, rest.height, &rest.normal[0].x, GL_NEAREST, 3);
+    pt.lastUse = useCounter;
+    patterns[id] = pt;
+    patternBytes += pt.bytes;
+    r.restPosition = pt.tex;
+    r.restNormal = pt.tex2;
+    r.restId = rest.contentId;
+    return checkGl("uploading a rest-surface map");
+}
+
 Result<std::uint64_t> Renderer::Impl::resolveBase(const HeightPassInput& in) {
     const HeightImage* base = in.base;
     if (!base) return std::uint64_t{0};
@@ -198,21 +289,25 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
     // Resolve each placement's texture first, so that a bad input changes nothing.
     auto resolved = resolvePatterns(in);
     if (!resolved) return resolved.error();
+    if (auto s = resolveRest(in, *resolved); !s) return s;
     auto baseKey = resolveBase(in);
     if (!baseKey) return baseKey.error();
     if (auto s = ensureHeightTargets(W, H); !s) return s;
 
     HeightKey key = heightKey(in, *resolved, *baseKey);
+    if (resolved->restPosition && in.rest && !in.rest->contentId)
+        lastHeights.reset(); // a rest-surface map without an id: its pixels may have changed
     if (lastHeights && *lastHeights == key) {
         ++heightPassesSkipped;
         return Ok{};
     }
     lastHeights.reset();
-    if (bakeOnCpu(in, softwareCpuBakeCoverage, info.renderer)) {
+    if (bakeOnCpu(in, resolved->surfaceRects, softwareCpuBakeCoverage, info.renderer)) {
         BakeSettings settings;
         settings.width = W;
         settings.height = H;
         settings.base = in.base;
+        settings.rest = in.rest.get();
         if (auto s = dermis::bakeHeightMapsInto(in.placements, settings, cpuBake); !s) return s;
         if (auto s = uploadHeightMaps(cpuBake); !s) return s;
         lastHeights = std::move(key);
@@ -220,8 +315,8 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
         ++heightPassesOnCpu;
         return Ok{};
     }
-    const std::size_t stride = uploadHeightBlocks(in);
-    drawHeightPass(in, resolved->textures, stride);
+    const std::size_t stride = uploadHeightBlocks(in, *resolved);
+    drawHeightPass(in, *resolved, stride);
     if (auto st = checkGl("height pass"); !st) return st;
     lastHeights = std::move(key);
     ++heightPasses;
@@ -230,7 +325,7 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
 
 /// One block per placement in one buffer, bound by range per draw; slot 0 is the base draw's.
 /// Returns the stride between blocks.
-std::size_t Renderer::Impl::uploadHeightBlocks(const HeightPassInput& in) {
+std::size_t Renderer::Impl::uploadHeightBlocks(const HeightPassInput& in, const ResolvedPatterns& resolved) {
     const std::size_t stride = uboStride(sizeof(HeightPassBlock));
     const std::size_t count = in.placements.size() + 1;
     std::vector<std::uint8_t> blocks(stride * count, 0);
@@ -239,7 +334,10 @@ std::size_t Renderer::Impl::uploadHeightBlocks(const HeightPassInput& in) {
         glm::vec4(static_cast<float>(in.width), static_cast<float>(in.height), 0.0f, 0.0f);
     std::memcpy(blocks.data(), &baseBlock, sizeof baseBlock);
     for (std::size_t k = 0; k < in.placements.size(); ++k) {
-        const HeightPassBlock b = placementBlock(in.placements[k], in.width, in.height);
+        const BakePlacement& p = in.placements[k];
+        const HeightPassBlock b = p.surface && k < resolved.surfaceRects.size()
+                                      ? surfaceBlock(p, resolved.surfaceRects[k], in.width, in.height)
+                                      : placementBlock(p, in.width, in.height);
         std::memcpy(blocks.data() + stride * (k + 1), &b, sizeof b);
     }
     glBindBuffer(GL_UNIFORM_BUFFER, heightUbo);
@@ -250,8 +348,9 @@ std::size_t Renderer::Impl::uploadHeightBlocks(const HeightPassInput& in) {
 
 /// The base map (or zeros), then every placement with a texture, summed by additive blending in
 /// document order like the CPU reference.
-void Renderer::Impl::drawHeightPass(const HeightPassInput& in, const std::vector<GLuint>& textures,
+void Renderer::Impl::drawHeightPass(const HeightPassInput& in, const ResolvedPatterns& resolved,
                                     std::size_t stride) {
+    const std::vector<GLuint>& textures = resolved.textures;
     glBindFramebuffer(GL_FRAMEBUFFER, heights.fbo);
     glViewport(0, 0, in.width, in.height);
     glDisable(GL_DEPTH_TEST);
@@ -273,10 +372,18 @@ void Renderer::Impl::drawHeightPass(const HeightPassInput& in, const std::vector
     glEnable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE);
-    glUseProgram(heightProgram);
+    if (resolved.restPosition) { // surface placements read the rest-surface map (SPEC §8)
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, resolved.restPosition);
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D, resolved.restNormal);
+    }
+    GLuint program = 0;
     glActiveTexture(GL_TEXTURE0);
     for (std::size_t k = 0; k < in.placements.size(); ++k) {
         if (!textures[k]) continue;
+        const GLuint wanted = in.placements[k].surface ? heightSurfaceProgram : heightProgram;
+        if (wanted != program) glUseProgram(program = wanted);
         glBindBufferRange(GL_UNIFORM_BUFFER, kHeightPassBinding, heightUbo,
                           static_cast<GLintptr>(stride * (k + 1)), sizeof(HeightPassBlock));
         glBindTexture(GL_TEXTURE_2D, textures[k]);

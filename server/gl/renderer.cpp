@@ -17,10 +17,12 @@ GLuint gl::makeFloatTexture(int w, int h, const float* data, GLint filter, int c
     GLuint tex = 0;
     glGenTextures(1, &tex);
     glBindTexture(GL_TEXTURE_2D, tex);
-    glTexStorage2D(GL_TEXTURE_2D, 1, channels == 2 ? GL_RG32F : GL_R32F, w, h);
+    const GLenum internal = channels == 3 ? GL_RGB32F : channels == 2 ? GL_RG32F : GL_R32F;
+    const GLenum format = channels == 3 ? GL_RGB : channels == 2 ? GL_RG : GL_RED;
+    glTexStorage2D(GL_TEXTURE_2D, 1, internal, w, h);
     if (data) {
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, channels == 2 ? GL_RG : GL_RED, GL_FLOAT, data);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, GL_FLOAT, data);
     }
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
@@ -93,6 +95,8 @@ Status Renderer::Impl::buildPrograms() {
     };
     std::vector<Build> builds = {
         {&heightProgram, {{{GL_VERTEX_SHADER, "heightpass.vert"}, {GL_FRAGMENT_SHADER, "heightpass.frag"}}, {}, {}}},
+        {&heightSurfaceProgram,
+         {{{GL_VERTEX_SHADER, "heightpass.vert"}, {GL_FRAGMENT_SHADER, "heightpass.frag"}}, {"DERMIS_SURFACE"}, {}}},
         {&heightBaseProgram, {{{GL_VERTEX_SHADER, "fullscreen.vert"}, {GL_FRAGMENT_SHADER, "heightbase.frag"}}, {}, {}}},
         {&skinProgram, {{{GL_VERTEX_SHADER, "skin.vert"}, {GL_FRAGMENT_SHADER, "skin.frag"}}, {}, {}}},
         {&skinTessProgram,
@@ -147,7 +151,8 @@ void Renderer::Impl::shutdown() {
     dropPatternTextures();
     heights.destroy();
     frame.destroy();
-    for (GLuint p : {heightProgram, heightBaseProgram, skinProgram, skinTessProgram, captureProgram})
+    for (GLuint p : {heightProgram, heightSurfaceProgram, heightBaseProgram, skinProgram, skinTessProgram,
+                     captureProgram})
         glDeleteProgram(p);
     GLuint bufs[6] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer, outlineUbo};
     glDeleteBuffers(6, bufs);
@@ -188,6 +193,7 @@ FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> mo
     req.render = plan.render;
     req.view = plan.view;
     req.heights = plan.heights;
+    req.layout = plan.heights.layout;
     return req;
 }
 

@@ -2,10 +2,15 @@
 //
 //   stage 1: height maps by render-to-texture — one quad per placement over its footprint, the
 //            deformation model of SPEC §2 in the fragment shader, additive blending into the
-//            bump and displacement channels of one float target, plus the static base map;
-//            skipped when a frame's inputs equal those of the maps already rendered;
+//            bump and displacement channels of one float target, plus the static base map; a
+//            surface placement (SPEC §8) evaluates its decal per texel from the layout's
+//            rest-surface map (HeightMapInput::rest, uploaded as two RGB32F textures cached by
+//            content id like the patterns); skipped when a frame's inputs equal those of the
+//            maps already rendered;
 //   stage 2: the character — linear blend skinning in the vertex shader, displacement along the
-//            skinned normal (per vertex, or per tessellated vertex), bump mapping, base colour,
+//            skinned normal (per vertex, or per tessellated vertex), bump mapping (the maps
+//            sampled with the height-map layout's UVs, a second UV attribute), base colour (the
+//            model's own UVs),
 //            simple lighting, MSAA, sRGB output, an orbit camera framed on the posed bounds
 //            (core/camera.hpp: the same matrices a pick uses to cast rays from pixels).
 //
@@ -122,6 +127,12 @@ struct FrameRequest {
     bool profile = false;        ///< glFinish after each stage so that timings are per stage
     /// Outlines on the skin (at most kMaxFrameOutlines; none: the frame is exactly as without).
     std::vector<FrameOutline> outlines;
+    /// The layout the height maps live in (SPEC §8): its UVs are the second UV attribute the maps
+    /// and outlines are sampled with, while the base colour keeps the model's UVs. Null: the
+    /// model's own UVs for both. Must belong to `model` (one PartLayout per part, `source` within
+    /// the part's vertices; triangles with an index out of range are dropped). Buffers for a
+    /// layout are uploaded once per (model, layout object) and freed with either.
+    std::shared_ptr<const TextureLayout> layout;
 };
 
 struct FrameResult {
@@ -212,7 +223,7 @@ private:
 };
 
 /// A frame request for `plan` (world matrices, render settings, view, GPU height pass on its
-/// heights).
+/// heights, the height-map layout of its heights).
 /// The request points into the plan's images: keep `plan` alive while the request is used.
 FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> model);
 

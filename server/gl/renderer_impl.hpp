@@ -44,7 +44,7 @@ inline double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// A float texture: one channel (R32F) or two (RG32F, `data` interleaved), clamped to the edge,
+/// A float texture: one channel (R32F), two (RG32F) or three (RGB32F; `data` interleaved), clamped to the edge,
 /// with `filter` for both minification and magnification. `data` may be null (storage only).
 /// The caller owns the texture. Leaves it bound to GL_TEXTURE_2D of the active unit.
 GLuint makeFloatTexture(int w, int h, const float* data, GLint filter, int channels = 1);
@@ -54,13 +54,28 @@ struct GpuModel {
     std::weak_ptr<const Model> owner;
     struct Part {
         GLuint vao = 0;
-        GLuint buffers[6] = {}; ///< position, normal, uv, joints, weights, indices
+        /// position, normal, uv, joints, weights, indices, map uv (attribute slots 0–4 and 5;
+        /// the model's own parts read slot 5 from the uv buffer and leave buffers[6] at 0)
+        GLuint buffers[7] = {};
         GLsizei indexCount = 0, vertexCount = 0;
         int paletteOffset = 0;
         int material = -1;
-        bool hasUVs = false;
+        bool hasUVs = false;    ///< the model's TEXCOORD_0 (base colour)
+        bool hasMapUVs = false; ///< height-map UVs (the layout covers the part)
     };
-    std::vector<Part> parts;
+    std::vector<Part> parts; ///< with the model's own UVs as the maps' layout
+    /// The parts drawn with another height-map layout (SPEC §8): vertices split as the layout's
+    /// (each a copy of its part vertex, `source`), map UV = layout UV, base-colour UV = the
+    /// part's. A layout equal to the model's own (modelTextureLayout: identity source, the part's
+    /// indices and UVs) is `identity` and draws `parts`. Freed with the model, or when the
+    /// layout's owner is gone.
+    struct LayoutParts {
+        std::weak_ptr<const TextureLayout> owner;
+        bool identity = false;
+        std::vector<Part> parts;
+        std::size_t bytes = 0;
+    };
+    std::map<const TextureLayout*, LayoutParts> layouts;
     std::vector<GLuint> textures; ///< one per Model::images entry, sRGB
     int paletteSize = 0;
     double autoDisplacement = 0.01;
@@ -79,13 +94,17 @@ struct HeightKey {
     int width = 0, height = 0;
     std::uint64_t base = 0;              ///< content id of the base map (0 = none)
     std::vector<std::uint64_t> patterns; ///< content id per placement (0 = skipped)
-    std::vector<double> params; ///< per placement: centre, scale, rotation, h, t, model, target, response
+    std::uint64_t rest = 0;              ///< content id of the rest-surface map (0 = none used)
+    /// per placement: centre, scale, rotation, h, t, model, target, response; for a surface
+    /// placement also its anchor, tangent, normal, size and depth
+    std::vector<double> params;
     bool operator==(const HeightKey&) const = default;
 };
 
 struct PatternTexture {
     GLuint tex = 0;
-    std::size_t bytes = 0;     ///< width × height × 4 (R32F)
+    GLuint tex2 = 0;           ///< a rest-surface map's normals (tex: its positions, RGB32F); else 0
+    std::size_t bytes = 0;     ///< width × height × 4 (R32F), × 24 for a rest-surface map
     std::uint64_t lastUse = 0; ///< job counter of its last use, for evicting the least recent
 };
 
@@ -103,10 +122,14 @@ struct HeightTargets {
     void destroy();
 };
 
-/// Each placement's pattern texture and content id (0 for placements that contribute nothing).
+/// Each placement's pattern texture and content id (0 for placements that contribute nothing),
+/// and the rest-surface map's textures when a surface placement contributes (SPEC §8).
 struct ResolvedPatterns {
     std::vector<GLuint> textures;
     std::vector<std::uint64_t> ids;
+    std::vector<TexelRect> surfaceRects; ///< per placement: the texels a surface placement may reach
+    GLuint restPosition = 0, restNormal = 0;
+    std::uint64_t restId = 0;
 };
 
 /// Multisampled colour + depth, the single-sampled resolve target, and the pixel-pack buffer.
@@ -182,8 +205,8 @@ struct Renderer::Impl {
     // --- render-thread state ----------------------------------------------------------------------
     std::unique_ptr<gl::GlContext> context;
     RendererInfo info;
-    GLuint heightProgram = 0, heightBaseProgram = 0, skinProgram = 0, skinTessProgram = 0,
-           captureProgram = 0;
+    GLuint heightProgram = 0, heightSurfaceProgram = 0, heightBaseProgram = 0, skinProgram = 0,
+           skinTessProgram = 0, captureProgram = 0;
     GLuint emptyVao = 0, heightUbo = 0, frameUbo = 0, partUbo = 0, paletteSsbo = 0,
            feedbackBuffer = 0, outlineUbo = 0;
     GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
@@ -238,6 +261,10 @@ struct Renderer::Impl {
 
     // gpu_model.cpp
     Result<gl::GpuModel*> modelFor(const std::shared_ptr<const Model>& model);
+    /// The parts of `gm` to draw with height-map layout `layout` (null: the model's own UVs):
+    /// `gm.parts`, or the layout's buffers, uploaded on first use (SPEC §8).
+    Result<const std::vector<gl::GpuModel::Part>*> partsFor(const Model& model, gl::GpuModel& gm,
+                                                            const std::shared_ptr<const TextureLayout>& layout);
     void dropOrphanedModels();
     void uploadPalette(const Model& model, const gl::GpuModel& gm, const std::vector<glm::mat4>& world);
 
@@ -247,8 +274,11 @@ struct Renderer::Impl {
     Result<gl::ResolvedPatterns> resolvePatterns(const HeightPassInput& in);
     Result<GLuint> patternTexture(std::uint64_t id, const HeightImage& image, const std::string& field);
     Result<std::uint64_t> resolveBase(const HeightPassInput& in);
-    std::size_t uploadHeightBlocks(const HeightPassInput& in);
-    void drawHeightPass(const HeightPassInput& in, const std::vector<GLuint>& textures,
+    /// The rest-surface map's textures (cached like patterns, by RestSurfaceMap::contentId) into
+    /// `r` when a surface placement contributes; fails without a map of the height maps' size.
+    Status resolveRest(const HeightPassInput& in, gl::ResolvedPatterns& r);
+    std::size_t uploadHeightBlocks(const HeightPassInput& in, const gl::ResolvedPatterns& resolved);
+    void drawHeightPass(const HeightPassInput& in, const gl::ResolvedPatterns& resolved,
                         std::size_t stride);
     Status ensureHeightTargets(int w, int h);
     Status readHeightTargets(HeightMaps& maps);
@@ -262,8 +292,10 @@ struct Renderer::Impl {
     void uploadFrameBlock(const FrameCamera& camera, double dispScale, double bumpScale,
                           glm::vec2 heightmapSize);
     void uploadOutlineBlock(const std::vector<FrameOutline>& outlines);
-    std::size_t uploadPartBlocks(const Model& model, const gl::GpuModel& gm, FrameView view);
-    GLuint drawSkinPass(const Model& model, const gl::GpuModel& gm, const RenderSettings& rs,
+    std::size_t uploadPartBlocks(const Model& model, const gl::GpuModel& gm,
+                                 const std::vector<gl::GpuModel::Part>& parts, FrameView view);
+    GLuint drawSkinPass(const Model& model, const gl::GpuModel& gm,
+                        const std::vector<gl::GpuModel::Part>& parts, const RenderSettings& rs,
                         GLuint heightTexture, std::size_t partStride, int samples);
     Status readFrame(GLuint readFbo, Image8& image);
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,

@@ -14,11 +14,17 @@ namespace dermis::gl {
 
 /// HeightPassBlock, binding 0: one placement of the height pass.
 struct HeightPassBlock {
-    glm::vec4 centerScale; ///< centre u, v; size u, v
+    glm::vec4 centerScale; ///< centre u, v; size u, v — surface: the UV rectangle u0, v0, u1, v1
     glm::vec4 rotation;    ///< cos, sin, quad margin in pattern units (x, y)
     glm::vec4 drive;       ///< h, t, deformConstant(model, response, t), 0
-    glm::ivec4 mode;       ///< model (0 scale, 1 bias), target (0 bump, 1 displacement), response, 0
+    glm::ivec4 mode;       ///< model (0 scale, 1 bias), target (0 bump, 1 displacement), response,
+                           ///< projection (0 uv, 1 surface)
     glm::vec4 mapSize;     ///< map width, height; pattern width, height
+    // Surface placements (SPEC §8, dermis::SurfaceFrame):
+    glm::vec4 anchor;         ///< anchor position c, depth
+    glm::vec4 anchorNormal;   ///< n, 1/w
+    glm::vec4 anchorTangent;  ///< t (rotation applied), 1/h
+    glm::vec4 anchorBinormal; ///< b = n × t, 0
 };
 
 /// FrameBlock, binding 1: per-frame constants of the skin pass.
@@ -34,7 +40,9 @@ struct FrameBlock {
 /// PartBlock, binding 2: per-part constants of the skin pass.
 struct PartBlock {
     glm::vec4 baseColor;
-    glm::ivec4 part; ///< first palette matrix, has texture, has UVs, view (FrameView as int)
+    /// first palette matrix, has a base-colour texture and UVs to sample it, has height-map UVs
+    /// (the layout in use covers the part), view (FrameView as int)
+    glm::ivec4 part;
 };
 
 /// OutlineBlock, binding 3: the outlines of a frame's skin pass (FrameOutline in renderer.hpp).
@@ -55,7 +63,7 @@ enum BlockBinding : unsigned {
 };
 
 static_assert(sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
-static_assert(sizeof(HeightPassBlock) == 80);
+static_assert(sizeof(HeightPassBlock) == 144);
 static_assert(sizeof(FrameBlock) == 144);
 static_assert(sizeof(PartBlock) == 32);
 static_assert(sizeof(OutlineBlock) == 16 + 2 * 8 * 16);
