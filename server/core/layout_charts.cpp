@@ -172,9 +172,112 @@ std::vector<std::vector<std::uint32_t>> growCharts(const PartMesh& mesh,
                 queue.push({cost, ou});
             }
         }
-        std::sort(charts.back().begin(), charts.back().end());
     }
-    return charts;
+    const std::size_t nc = charts.size();
+    std::vector<glm::dvec3> sums(nc, glm::dvec3(0));
+    std::vector<double> areas(nc, 0.0);
+    for (std::size_t t = 0; t < nt; ++t)
+        if (label[t] >= 0) {
+            sums[static_cast<std::size_t>(label[t])] += mesh.normals[t] * mesh.areas[t];
+            areas[static_cast<std::size_t>(label[t])] += mesh.areas[t];
+        }
+    auto fits = [&](std::size_t t, std::size_t c) {
+        const double l = glm::length(sums[c]);
+        return l > 0 && glm::dot(mesh.normals[t], sums[c] / l) >= cosCone;
+    };
+    // Smoother borders: a triangle with two inner-edge neighbours in one other chart joins it
+    // when it fits that chart's cone (it has at most one neighbour left in its own chart, so
+    // that chart stays connected).
+    for (int pass = 0; pass < 8; ++pass) {
+        bool changed = false;
+        for (std::size_t t = 0; t < nt; ++t) {
+            if (label[t] < 0) continue;
+            int other = -1;
+            for (int c = 0; c < 3 && other < 0; ++c) {
+                const int o = mesh.adj[t][static_cast<std::size_t>(c)];
+                if (o < 0 || label[static_cast<std::size_t>(o)] == label[t]) continue;
+                const int lo = label[static_cast<std::size_t>(o)];
+                int same = 0;
+                for (int d = 0; d < 3; ++d) {
+                    const int q = mesh.adj[t][static_cast<std::size_t>(d)];
+                    same += q >= 0 && label[static_cast<std::size_t>(q)] == lo;
+                }
+                if (same >= 2) other = lo;
+            }
+            if (other < 0 || !fits(t, static_cast<std::size_t>(other))) continue;
+            const auto from = static_cast<std::size_t>(label[t]), to = static_cast<std::size_t>(other);
+            sums[from] -= mesh.normals[t] * mesh.areas[t];
+            areas[from] -= mesh.areas[t];
+            sums[to] += mesh.normals[t] * mesh.areas[t];
+            areas[to] += mesh.areas[t];
+            label[t] = other;
+            changed = true;
+        }
+        if (!changed) break;
+    }
+    // Small charts (under a tenth of the mean chart area) join the neighbour they share most
+    // inner edges with, smallest first, when every triangle fits that neighbour's cone.
+    std::vector<std::vector<std::uint32_t>> members(nc);
+    for (std::size_t t = 0; t < nt; ++t)
+        if (label[t] >= 0) members[static_cast<std::size_t>(label[t])].push_back(static_cast<std::uint32_t>(t));
+    double partArea = 0;
+    std::size_t live = 0;
+    for (std::size_t c = 0; c < nc; ++c)
+        if (!members[c].empty()) {
+            partArea += areas[c];
+            ++live;
+        }
+    const double small = live > 0 ? 0.1 * partArea / static_cast<double>(live) : 0.0;
+    std::vector<std::size_t> bySize;
+    for (std::size_t c = 0; c < nc; ++c)
+        if (!members[c].empty() && areas[c] < small) bySize.push_back(c);
+    std::stable_sort(bySize.begin(), bySize.end(),
+                     [&](std::size_t a, std::size_t b) { return areas[a] < areas[b]; });
+    for (std::size_t c : bySize) {
+        std::vector<std::pair<int, int>> shared; // (chart, edges)
+        for (std::uint32_t t : members[c])
+            for (int e = 0; e < 3; ++e) {
+                const int o = mesh.adj[t][static_cast<std::size_t>(e)];
+                if (o < 0 || label[static_cast<std::size_t>(o)] == static_cast<int>(c)) continue;
+                const int lo = label[static_cast<std::size_t>(o)];
+                auto it = std::find_if(shared.begin(), shared.end(), [&](const auto& x) { return x.first == lo; });
+                if (it == shared.end())
+                    shared.push_back({lo, 1});
+                else
+                    ++it->second;
+            }
+        std::stable_sort(shared.begin(), shared.end(),
+                         [](const auto& a, const auto& b) { return a.second > b.second; });
+        for (const auto& [target, edgesShared] : shared) {
+            (void)edgesShared;
+            const auto to = static_cast<std::size_t>(target);
+            bool all = true;
+            for (std::uint32_t t : members[c])
+                all = all && fits(t, to);
+            if (!all) continue;
+            for (std::uint32_t t : members[c]) {
+                label[t] = target;
+                members[to].push_back(t);
+            }
+            sums[to] += sums[c];
+            areas[to] += areas[c];
+            members[c].clear();
+            break;
+        }
+    }
+    // Charts in order of their first triangle, each sorted.
+    std::vector<std::vector<std::uint32_t>> out;
+    std::vector<int> renumber(nc, -1);
+    for (std::size_t t = 0; t < nt; ++t) {
+        if (label[t] < 0) continue;
+        int& r = renumber[static_cast<std::size_t>(label[t])];
+        if (r < 0) {
+            r = static_cast<int>(out.size());
+            out.emplace_back();
+        }
+        out[static_cast<std::size_t>(r)].push_back(static_cast<std::uint32_t>(t));
+    }
+    return out;
 }
 
 LocalChart buildLocalChart(const PartMesh& mesh, std::vector<std::uint32_t> tris,

@@ -141,43 +141,59 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
         glm::dvec2 q[3];
         for (int c = 0; c < 3; ++c)
             q[c] = t.uv[c] * static_cast<double>(n);
-        const double area = signedArea(q[0], q[1], q[2]);
-        const double s = area > 0 ? 1.0 : (area < 0 ? -1.0 : 0.0);
-        const glm::dvec2 lo = glm::min(q[0], glm::min(q[1], q[2])),
-                         hi = glm::max(q[0], glm::max(q[1], q[2]));
-        const int i0 = std::clamp(static_cast<int>(std::floor(lo.x)), 0, n - 1),
-                  i1 = std::clamp(static_cast<int>(std::floor(hi.x)), 0, n - 1),
-                  j0 = std::clamp(static_cast<int>(std::floor(lo.y)), 0, n - 1),
-                  j1 = std::clamp(static_cast<int>(std::floor(hi.y)), 0, n - 1);
-        auto edge = [&](int e, const glm::dvec2& x) {
-            const glm::dvec2 a = q[e], b = q[(e + 1) % 3];
-            return s * ((b.x - a.x) * (x.y - a.y) - (b.y - a.y) * (x.x - a.x));
-        };
+        const bool solid = signedArea(q[0], q[1], q[2]) != 0;
+        const double ylo = std::min({q[0].y, q[1].y, q[2].y}), yhi = std::max({q[0].y, q[1].y, q[2].y});
+        const int j0 = std::clamp(static_cast<int>(std::ceil(ylo)) - 1, 0, n - 1),
+                  j1 = std::clamp(static_cast<int>(std::floor(yhi)), 0, n - 1);
         const int id = static_cast<int>(t.chart);
-        for (int j = j0; j <= j1; ++j)
-            for (int i = i0; i <= i1; ++i) {
-                bool touches = true;
-                for (int e = 0; e < 3 && touches && s != 0; ++e) {
-                    double best = -1e300;
-                    for (int corner = 0; corner < 4; ++corner)
-                        best = std::max(best, edge(e, glm::dvec2(i + (corner & 1), j + (corner >> 1))));
-                    touches = best >= 0;
+        for (int j = j0; j <= j1; ++j) {
+            // Closed texel squares of row j touched: the triangle's x range over the strip
+            // [j, j+1] (its corners inside, its edges' crossings of the strip's sides).
+            double xlo = 1e300, xhi = -1e300, clo = 1e300, chi = -1e300;
+            for (int e = 0; e < 3; ++e) {
+                glm::dvec2 a = q[e], b = q[(e + 1) % 3];
+                if (a.y > b.y) std::swap(a, b);
+                if (b.y < j || a.y > j + 1) continue;
+                if (b.y > a.y) {
+                    for (double y : {std::clamp<double>(j, a.y, b.y), std::clamp<double>(j + 1, a.y, b.y)}) {
+                        const double x = a.x + (b.x - a.x) * ((y - a.y) / (b.y - a.y));
+                        xlo = std::min(xlo, x);
+                        xhi = std::max(xhi, x);
+                    }
+                    const double yc = j + 0.5;
+                    if (a.y <= yc && yc <= b.y) { // crossing of the centre line
+                        const double x = a.x + (b.x - a.x) * ((yc - a.y) / (b.y - a.y));
+                        clo = std::min(clo, x);
+                        chi = std::max(chi, x);
+                    }
+                } else {
+                    xlo = std::min({xlo, a.x, b.x});
+                    xhi = std::max({xhi, a.x, b.x});
                 }
-                if (!touches) continue;
-                const std::size_t at = static_cast<std::size_t>(j) * static_cast<std::size_t>(n) +
-                                       static_cast<std::size_t>(i);
-                if (touched[at] == -1)
-                    touched[at] = id;
-                else if (touched[at] != id)
-                    touched[at] = -2;
-                if (s == 0) continue;
-                const glm::dvec2 c(i + 0.5, j + 0.5);
-                if (edge(0, c) < 0 || edge(1, c) < 0 || edge(2, c) < 0) continue;
-                if (centre[at] == -1)
-                    centre[at] = id;
-                else if (centre[at] != id)
-                    overlap[at] = 1;
             }
+            if (xlo > xhi) continue;
+            const int i0 = std::clamp(static_cast<int>(std::ceil(xlo)) - 1, 0, n - 1),
+                      i1 = std::clamp(static_cast<int>(std::floor(xhi)), 0, n - 1);
+            const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(n);
+            for (int i = i0; i <= i1; ++i) {
+                int& o = touched[row + static_cast<std::size_t>(i)];
+                if (o == -1)
+                    o = id;
+                else if (o != id)
+                    o = -2;
+            }
+            if (!solid || clo > chi) continue;
+            // Texel centres of row j inside (edges included).
+            const int c0 = std::max(static_cast<int>(std::ceil(clo - 0.5)), 0),
+                      c1 = std::min(static_cast<int>(std::floor(chi - 0.5)), n - 1);
+            for (int i = c0; i <= c1; ++i) {
+                int& o = centre[row + static_cast<std::size_t>(i)];
+                if (o == -1)
+                    o = id;
+                else if (o != id)
+                    overlap[row + static_cast<std::size_t>(i)] = 1;
+            }
+        }
     }
     for (std::size_t at = 0; at < texels; ++at) {
         check.usedTexels += centre[at] >= 0;

@@ -103,6 +103,12 @@ Result<GeneratedLayout> attempt(const Model& model, const LayoutGenOptions& opti
                 cornerPoint[k][3 * fc.chart.tris[i] + static_cast<std::size_t>(j)] =
                     base + fc.chart.local[i][j];
     }
+    out.chartOf.resize(model.parts.size());
+    for (std::size_t k = 0; k < model.parts.size(); ++k)
+        out.chartOf[k].assign(model.parts[k].indices.size() / 3, static_cast<std::uint32_t>(charts.size()));
+    for (std::size_t c = 0; c < charts.size(); ++c)
+        for (std::uint32_t t : charts[c].chart.tris)
+            out.chartOf[static_cast<std::size_t>(charts[c].part)][t] = static_cast<std::uint32_t>(c);
     for (std::size_t d = 0; d < degenerate.size(); ++d) {
         const auto [k, t] = degenerate[d];
         for (int j = 0; j < 3; ++j) {

@@ -32,6 +32,7 @@
 #include "texture_layout.hpp"
 
 #include <cstdint>
+#include <vector>
 
 namespace dermis {
 
@@ -83,6 +84,8 @@ struct GeneratedLayout {
     TextureLayout layout;
     LayoutCheck check;            ///< at options.resolution, gutterCap = options.gutterTexels
     std::size_t charts = 0;       ///< charts packed (the degenerate grid not counted)
+    /// Per part, per triangle: its chart, in [0, charts); `charts` for a degenerate triangle.
+    std::vector<std::vector<std::uint32_t>> chartOf;
     std::size_t splits = 0;       ///< charts split because a flattening failed a check
     std::size_t degenerate = 0;   ///< degenerate triangles (one-texel cells)
     double texelsPerMetre = 0.0;  ///< density at options.resolution
