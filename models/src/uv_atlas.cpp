@@ -2,8 +2,8 @@
 // (made connected here), cuts into disks and flattening (with extra cuts to crushed parts),
 // orientation, density and packing — and builds and verifies the output (seam vertices, every UV
 // in [0,1], no flipped triangle, no overlapping charts, distortion statistics); uvAt looks a
-// surface point up in the atlas. The steps themselves are in uv_atlas_regions.cpp,
-// uv_atlas_flatten.cpp and uv_atlas_pack.cpp (uv_atlas_internal.hpp).
+// surface point up in the atlas. The regions are in uv_atlas_regions.cpp (uv_atlas_internal.hpp),
+// flattening and packing in the core (core/uv_flatten.hpp, core/uv_pack.hpp).
 #include "uv_atlas.hpp"
 
 #include "uv_atlas_internal.hpp"
@@ -224,7 +224,12 @@ bool buildAtlas(const TriMesh& mesh, const Body& body, const Skeleton& skeleton,
                         " is not a disk after cutting (χ = " + std::to_string(chi) + ")";
                 return false;
             }
-            uv = flatten(lm, mesh, note);
+            ChartMesh chart;
+            chart.triangles = lm.local;
+            chart.positions.reserve(lm.source.size());
+            for (std::uint32_t v : lm.source)
+                chart.positions.emplace_back(mesh.positions[v]);
+            uv = flattenDisk(chart, lm.loops[0], note);
             if (uv.empty()) {
                 error = "region " + spec.name + ": " + note;
                 return false;

@@ -1,15 +1,19 @@
 // dermis-charactergen — private to models/src/uv_atlas*.cpp: the steps of the UV atlas that
-// buildAtlas (uv_atlas.cpp) runs, each in its own file:
+// buildAtlas (uv_atlas.cpp) runs:
 //   * uv_atlas_regions.cpp: the body regions (rules on the skeleton), mesh adjacency, and a
 //     region's triangles as a local mesh split along its boundary and cut edges (LocalMesh);
-//   * uv_atlas_flatten.cpp: flattening a disk-shaped local mesh (Tutte, then ARAP), distortion;
-//   * uv_atlas_pack.cpp: skyline packing of chart boxes.
-// Not included outside these files. Nothing here reports errors itself: flatten returns an empty
-// result with a note, skylinePack a height above 1; buildAtlas turns them into messages.
+//   * the core's general pieces (one implementation with the generated height-map layout):
+//     flattening a disk-shaped chart (Tutte, then ARAP) and distortion (core/uv_flatten.hpp),
+//     skyline packing of chart boxes (core/uv_pack.hpp).
+// Not included outside these files. Nothing here reports errors itself: flattenDisk returns an
+// empty result with a note, skylinePack a height above 1; buildAtlas turns them into messages.
 #pragma once
 
 #include "skeleton.hpp"
 #include "surface.hpp"
+
+#include "core/uv_flatten.hpp"
+#include "core/uv_pack.hpp"
 
 #include <glm/glm.hpp>
 
@@ -88,30 +92,13 @@ LocalMesh buildLocal(const TriMesh& mesh, const std::vector<std::array<int, 3>>&
                      const std::vector<int>& tris, const std::vector<int>& region, int r,
                      const std::set<EdgeKey>& cuts);
 
-// --- flattening (uv_atlas_flatten.cpp) ----------------------------------------------------------
+// --- flattening and packing (server/core/uv_flatten.hpp, uv_pack.hpp) ----------------------------
 
-/// Signed area of the 2-D triangle (a, b, c), positive when counter-clockwise.
-double signedArea(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c);
-
-/// σ_max / σ_min of the linear map taking a surface triangle onto its UV triangle.
-double conformalDistortion(const glm::vec3& q0, const glm::vec3& q1, const glm::vec3& q2,
-                           const glm::dvec2& u0, const glm::dvec2& u1, const glm::dvec2& u2);
-
-/// Flattens a disk-shaped local mesh. Returns UVs in metres (isometric scale), positively
-/// oriented triangles. Fails (empty result) when the Tutte embedding already flips (it cannot
-/// for a disk with a convex boundary, up to solver accuracy).
-std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::string& note);
-
-// --- packing (uv_atlas_pack.cpp) ----------------------------------------------------------------
-
-struct PackItem {
-    int chart;
-    double w, h; // size in UV units, padding included
-    double x = 0, y = 0;
-};
-
-/// Skyline bottom-left packing into a strip of width 1 (items sorted by height). Returns the
-/// height used.
-double skylinePack(std::vector<PackItem>& items);
+using dermis::ChartMesh;
+using dermis::conformalDistortion;
+using dermis::flattenDisk;
+using dermis::PackItem;
+using dermis::signedArea;
+using dermis::skylinePack;
 
 } // namespace dermis::chargen::atlas_detail

@@ -1,62 +1,56 @@
-// The default character's UV atlas (see uv_atlas.hpp), step 3: flattening one disk-shaped chart
-// — Tutte embedding on a circle, then as-rigid-as-possible local/global iterations (Liu et al.
-// 2008) with flip-free backtracking, keeping the last iterate whose boundary does not cross
-// itself — with the sparse symmetric solver it needs, and the distortion measure buildAtlas uses
-// to find crushed parts. Declared in uv_atlas_internal.hpp.
-#include "uv_atlas_internal.hpp"
+// Dermis core — flattening surface charts (uv_flatten.hpp): the measures, the sparse solver, and
+// the Tutte + ARAP disk flattening (moved here from the default character's generator,
+// models/src/uv_atlas*, unchanged in arithmetic so that its output stays bit-identical). LSCM is
+// in uv_lscm.cpp.
+#include "uv_flatten.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <tuple>
+#include <set>
 
-namespace dermis::chargen::atlas_detail {
-namespace {
+namespace dermis {
 
 // --- sparse symmetric solver ------------------------------------------------------------------
 
-struct Sparse {
-    int n = 0;
-    std::vector<int> rowStart, col;
-    std::vector<double> val;
-    static Sparse fromTriplets(int n, std::vector<std::tuple<int, int, double>> trip) {
-        std::sort(trip.begin(), trip.end(), [](const auto& a, const auto& b) {
-            return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) < std::get<0>(b)
-                                                    : std::get<1>(a) < std::get<1>(b);
-        });
-        Sparse m;
-        m.n = n;
-        m.rowStart.assign(static_cast<std::size_t>(n) + 1, 0);
-        for (std::size_t i = 0; i < trip.size();) {
-            std::size_t j = i;
-            double sum = 0;
-            while (j < trip.size() && std::get<0>(trip[j]) == std::get<0>(trip[i]) &&
-                   std::get<1>(trip[j]) == std::get<1>(trip[i]))
-                sum += std::get<2>(trip[j++]);
-            m.col.push_back(std::get<1>(trip[i]));
-            m.val.push_back(sum);
-            ++m.rowStart[static_cast<std::size_t>(std::get<0>(trip[i])) + 1];
-            i = j;
-        }
-        for (int r = 0; r < n; ++r)
-            m.rowStart[static_cast<std::size_t>(r) + 1] += m.rowStart[static_cast<std::size_t>(r)];
-        return m;
+SparseMatrix SparseMatrix::fromTriplets(int n, std::vector<std::tuple<int, int, double>> trip) {
+    std::sort(trip.begin(), trip.end(), [](const auto& a, const auto& b) {
+        return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) < std::get<0>(b)
+                                                : std::get<1>(a) < std::get<1>(b);
+    });
+    SparseMatrix m;
+    m.n = n;
+    m.rowStart.assign(static_cast<std::size_t>(n) + 1, 0);
+    for (std::size_t i = 0; i < trip.size();) {
+        std::size_t j = i;
+        double sum = 0;
+        while (j < trip.size() && std::get<0>(trip[j]) == std::get<0>(trip[i]) &&
+               std::get<1>(trip[j]) == std::get<1>(trip[i]))
+            sum += std::get<2>(trip[j++]);
+        m.col.push_back(std::get<1>(trip[i]));
+        m.val.push_back(sum);
+        ++m.rowStart[static_cast<std::size_t>(std::get<0>(trip[i])) + 1];
+        i = j;
     }
-    void mul(const std::vector<double>& x, std::vector<double>& y) const {
-        y.assign(static_cast<std::size_t>(n), 0.0);
-        for (int r = 0; r < n; ++r) {
-            double s = 0;
-            for (int k = rowStart[static_cast<std::size_t>(r)];
-                 k < rowStart[static_cast<std::size_t>(r) + 1]; ++k)
-                s += val[static_cast<std::size_t>(k)] *
-                     x[static_cast<std::size_t>(col[static_cast<std::size_t>(k)])];
-            y[static_cast<std::size_t>(r)] = s;
-        }
-    }
-};
+    for (int r = 0; r < n; ++r)
+        m.rowStart[static_cast<std::size_t>(r) + 1] += m.rowStart[static_cast<std::size_t>(r)];
+    return m;
+}
 
-/// Conjugate gradients for a symmetric positive definite system (x holds the initial guess).
-void conjugateGradient(const Sparse& a, const std::vector<double>& b, std::vector<double>& x,
-                       int maxIter = 4000, double tol = 1e-12) {
+void SparseMatrix::mul(const std::vector<double>& x, std::vector<double>& y) const {
+    y.assign(static_cast<std::size_t>(n), 0.0);
+    for (int r = 0; r < n; ++r) {
+        double s = 0;
+        for (int k = rowStart[static_cast<std::size_t>(r)];
+             k < rowStart[static_cast<std::size_t>(r) + 1]; ++k)
+            s += val[static_cast<std::size_t>(k)] *
+                 x[static_cast<std::size_t>(col[static_cast<std::size_t>(k)])];
+        y[static_cast<std::size_t>(r)] = s;
+    }
+}
+
+void conjugateGradient(const SparseMatrix& a, const std::vector<double>& b, std::vector<double>& x,
+                       int maxIter, double tol) {
     const auto n = static_cast<std::size_t>(a.n);
     std::vector<double> r(n), p(n), ap(n);
     a.mul(x, ap);
@@ -90,7 +84,52 @@ void conjugateGradient(const Sparse& a, const std::vector<double>& b, std::vecto
     }
 }
 
-// --- flattening -------------------------------------------------------------------------------
+int jacobiConjugateGradient(const SparseMatrix& a, const std::vector<double>& b,
+                            std::vector<double>& x, int maxIter, double tol) {
+    const auto n = static_cast<std::size_t>(a.n);
+    std::vector<double> inv(n, 1.0), r(n), z(n), p(n), ap(n);
+    for (int row = 0; row < a.n; ++row)
+        for (int k = a.rowStart[static_cast<std::size_t>(row)];
+             k < a.rowStart[static_cast<std::size_t>(row) + 1]; ++k)
+            if (a.col[static_cast<std::size_t>(k)] == row && a.val[static_cast<std::size_t>(k)] > 0)
+                inv[static_cast<std::size_t>(row)] = 1.0 / a.val[static_cast<std::size_t>(k)];
+    a.mul(x, ap);
+    double bb = 0, rz = 0, rr = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        r[i] = b[i] - ap[i];
+        z[i] = inv[i] * r[i];
+        bb += b[i] * b[i];
+        rz += r[i] * z[i];
+        rr += r[i] * r[i];
+    }
+    p = z;
+    if (bb == 0) bb = 1;
+    int it = 0;
+    for (; it < maxIter && rr > tol * tol * bb; ++it) {
+        a.mul(p, ap);
+        double pap = 0;
+        for (std::size_t i = 0; i < n; ++i)
+            pap += p[i] * ap[i];
+        if (!(pap > 0)) break;
+        const double alpha = rz / pap;
+        double rz2 = 0;
+        rr = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * ap[i];
+            z[i] = inv[i] * r[i];
+            rz2 += r[i] * z[i];
+            rr += r[i] * r[i];
+        }
+        const double beta = rz2 / rz;
+        rz = rz2;
+        for (std::size_t i = 0; i < n; ++i)
+            p[i] = z[i] + beta * p[i];
+    }
+    return it;
+}
+
+namespace {
 
 bool segmentsCross(const glm::dvec2& p1, const glm::dvec2& p2, const glm::dvec2& q1,
                    const glm::dvec2& q2) {
@@ -123,11 +162,12 @@ bool boundarySelfIntersects(const std::vector<std::uint32_t>& loop,
 
 } // namespace
 
+// --- measures -----------------------------------------------------------------------------------
+
 double signedArea(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
     return 0.5 * ((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
 }
 
-/// σ_max / σ_min of the linear map taking a surface triangle onto its UV triangle.
 double conformalDistortion(const glm::vec3& q0, const glm::vec3& q1, const glm::vec3& q2,
                            const glm::dvec2& u0, const glm::dvec2& u1, const glm::dvec2& u2) {
     const glm::dvec3 p0(q0), p1(q1), p2(q2);
@@ -145,15 +185,32 @@ double conformalDistortion(const glm::vec3& q0, const glm::vec3& q1, const glm::
     return smax / smin;
 }
 
-/// Flattens a disk-shaped local mesh. Returns UVs in metres (isometric scale), positively
-/// oriented triangles. Fails (empty result) when the Tutte embedding already flips (it cannot
-/// for a disk with a convex boundary, up to solver accuracy).
-std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::string& note) {
-    const std::size_t nv = lm.source.size();
-    const std::vector<std::uint32_t>& loop = lm.loops[0];
-    std::vector<glm::dvec3> P(nv);
-    for (std::size_t v = 0; v < nv; ++v)
-        P[v] = glm::dvec3(mesh.positions[lm.source[v]]);
+MapSingularValues mapSingularValues(const glm::dvec3& p0, const glm::dvec3& p1,
+                                    const glm::dvec3& p2, const glm::dvec2& u0,
+                                    const glm::dvec2& u1, const glm::dvec2& u2) {
+    const glm::dvec3 e1 = glm::normalize(p1 - p0),
+                     nrm = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    const glm::dvec3 e2 = glm::cross(nrm, e1);
+    const glm::dvec2 x1(glm::length(p1 - p0), 0), x2(glm::dot(p2 - p0, e1), glm::dot(p2 - p0, e2));
+    const glm::dmat2 X(x1, x2), U(u1 - u0, u2 - u0);
+    const glm::dmat2 J = U * glm::inverse(X);
+    const double a = J[0][0], b = J[1][0], c = J[0][1], d = J[1][1];
+    const double s1sq = 0.5 * (a * a + b * b + c * c + d * d);
+    const double det = std::abs(a * d - b * c);
+    const double disc = std::sqrt(std::max(s1sq * s1sq - det * det, 0.0));
+    return {std::sqrt(s1sq + disc), std::sqrt(std::max(s1sq - disc, 0.0)), det};
+}
+
+// --- Tutte + ARAP -------------------------------------------------------------------------------
+
+std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart, const std::vector<std::uint32_t>& boundary,
+                                    std::string& note, int iterations) {
+    const std::size_t nv = chart.positions.size();
+    const std::vector<std::uint32_t>& loop = boundary;
+    const std::vector<glm::dvec3>& P = chart.positions;
+    std::vector<char> onLoop(nv, 0);
+    for (std::uint32_t v : loop)
+        onLoop[v] = 1;
 
     // Tutte: boundary on a circle by arc length, interior = average of neighbours.
     std::vector<glm::dvec2> uv(nv, glm::dvec2(0));
@@ -173,9 +230,9 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
     std::vector<int> unknown(nv, -1);
     int nu = 0;
     for (std::size_t v = 0; v < nv; ++v)
-        if (lm.loopOf[v] < 0) unknown[v] = nu++;
+        if (!onLoop[v]) unknown[v] = nu++;
     std::vector<std::set<std::uint32_t>> ring(nv);
-    for (const auto& t : lm.local)
+    for (const auto& t : chart.triangles)
         for (int c = 0; c < 3; ++c) {
             ring[t[c]].insert(t[(c + 1) % 3]);
             ring[t[c]].insert(t[(c + 2) % 3]);
@@ -197,7 +254,7 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
                 }
             }
         }
-        const Sparse a = Sparse::fromTriplets(nu, trip);
+        const SparseMatrix a = SparseMatrix::fromTriplets(nu, trip);
         std::vector<double> x(static_cast<std::size_t>(nu), 0.0),
             y(static_cast<std::size_t>(nu), 0.0);
         conjugateGradient(a, bx, x, 20000, 1e-14);
@@ -209,13 +266,13 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
     }
     // Orientation: make the total signed area positive.
     double total = 0;
-    for (const auto& t : lm.local)
+    for (const auto& t : chart.triangles)
         total += signedArea(uv[t[0]], uv[t[1]], uv[t[2]]);
     if (total < 0)
         for (auto& p : uv)
             p.x = -p.x;
     auto allPositive = [&](const std::vector<glm::dvec2>& u) {
-        for (const auto& t : lm.local)
+        for (const auto& t : chart.triangles)
             if (!(signedArea(u[t[0]], u[t[1]], u[t[2]]) > 0.0)) return false;
         return true;
     };
@@ -225,19 +282,19 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
     }
 
     // ARAP (Liu et al. 2008, local/global) with a flip-free backtracking step.
-    const std::size_t nt = lm.local.size();
+    const std::size_t nt = chart.triangles.size();
     std::vector<std::array<glm::dvec2, 3>> iso(nt); // isometric local triangle
     std::vector<std::array<double, 3>> cot(nt);     // cot of the angle opposite edge (i, i+1)
     for (std::size_t t = 0; t < nt; ++t) {
-        const glm::dvec3 a = P[lm.local[t][0]], b = P[lm.local[t][1]], c = P[lm.local[t][2]];
+        const glm::dvec3 a = P[chart.triangles[t][0]], b = P[chart.triangles[t][1]], c = P[chart.triangles[t][2]];
         const glm::dvec3 e1 = glm::normalize(b - a);
         const glm::dvec3 nrm = glm::normalize(glm::cross(b - a, c - a));
         const glm::dvec3 e2 = glm::cross(nrm, e1);
         iso[t] = {glm::dvec2(0, 0), glm::dvec2(glm::length(b - a), 0),
                   glm::dvec2(glm::dot(c - a, e1), glm::dot(c - a, e2))};
         for (int i = 0; i < 3; ++i) {
-            const glm::dvec3 pi = P[lm.local[t][i]], pj = P[lm.local[t][(i + 1) % 3]],
-                             pk = P[lm.local[t][(i + 2) % 3]];
+            const glm::dvec3 pi = P[chart.triangles[t][i]], pj = P[chart.triangles[t][(i + 1) % 3]],
+                             pk = P[chart.triangles[t][(i + 2) % 3]];
             const glm::dvec3 u = pi - pk, w = pj - pk;
             cot[t][static_cast<std::size_t>(i)] = glm::dot(u, w) / glm::length(glm::cross(u, w));
         }
@@ -251,7 +308,7 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
     std::vector<std::tuple<int, int, double>> trip;
     for (std::size_t t = 0; t < nt; ++t)
         for (int i = 0; i < 3; ++i) {
-            const std::uint32_t a = lm.local[t][i], b = lm.local[t][(i + 1) % 3];
+            const std::uint32_t a = chart.triangles[t][i], b = chart.triangles[t][(i + 1) % 3];
             const double w = cot[t][static_cast<std::size_t>(i)];
             const int ia = idx[a], ib = idx[b];
             if (ia >= 0) trip.emplace_back(ia, ia, w);
@@ -261,21 +318,21 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
                 trip.emplace_back(ib, ia, -w);
             }
         }
-    const Sparse lap = Sparse::fromTriplets(n, trip);
+    const SparseMatrix lap = SparseMatrix::fromTriplets(n, trip);
     std::vector<std::vector<std::uint32_t>> vertexTris(nv);
     for (std::size_t t = 0; t < nt; ++t)
         for (int c = 0; c < 3; ++c)
-            vertexTris[lm.local[t][c]].push_back(static_cast<std::uint32_t>(t));
+            vertexTris[chart.triangles[t][c]].push_back(static_cast<std::uint32_t>(t));
     std::vector<glm::dvec2> best = uv;
     int accepted = 0;
-    for (int iter = 0; iter < 150; ++iter) {
+    for (int iter = 0; iter < iterations; ++iter) {
         // Local step: best rotation per triangle.
         std::vector<glm::dmat2> rot(nt);
         for (std::size_t t = 0; t < nt; ++t) {
             glm::dmat2 s(0.0); // Σ cot · (u_i − u_j)(x_i − x_j)ᵀ, column-major
             for (int i = 0; i < 3; ++i) {
                 const int j = (i + 1) % 3;
-                const glm::dvec2 du = uv[lm.local[t][i]] - uv[lm.local[t][j]];
+                const glm::dvec2 du = uv[chart.triangles[t][i]] - uv[chart.triangles[t][j]];
                 const glm::dvec2 dx =
                     iso[t][static_cast<std::size_t>(i)] - iso[t][static_cast<std::size_t>(j)];
                 const double w = cot[t][static_cast<std::size_t>(i)];
@@ -296,7 +353,7 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
         for (std::size_t t = 0; t < nt; ++t)
             for (int i = 0; i < 3; ++i) {
                 const int j = (i + 1) % 3;
-                const std::uint32_t a = lm.local[t][i], b = lm.local[t][j];
+                const std::uint32_t a = chart.triangles[t][i], b = chart.triangles[t][j];
                 const glm::dvec2 r = cot[t][static_cast<std::size_t>(i)] *
                                      (rot[t] * (iso[t][static_cast<std::size_t>(i)] -
                                                 iso[t][static_cast<std::size_t>(j)]));
@@ -353,8 +410,8 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
                     trial[v] = from + step * (target[v] - from);
                     bool ok = true;
                     for (std::uint32_t t : vertexTris[v])
-                        if (!(signedArea(trial[lm.local[t][0]], trial[lm.local[t][1]],
-                                         trial[lm.local[t][2]]) > 0.0)) {
+                        if (!(signedArea(trial[chart.triangles[t][0]], trial[chart.triangles[t][1]],
+                                         trial[chart.triangles[t][2]]) > 0.0)) {
                             ok = false;
                             break;
                         }
@@ -377,4 +434,4 @@ std::vector<glm::dvec2> flatten(const LocalMesh& lm, const TriMesh& mesh, std::s
     return best;
 }
 
-} // namespace dermis::chargen::atlas_detail
+} // namespace dermis
