@@ -7,18 +7,31 @@
 
 namespace dermis {
 
+namespace {
+
+void addEdges(const std::vector<std::uint32_t>& indices, const std::vector<glm::vec2>& uvs,
+              std::vector<UvEdge>& out) {
+    std::set<std::pair<std::uint32_t, std::uint32_t>> seen;
+    for (std::size_t t = 0; t + 2 < indices.size(); t += 3)
+        for (std::size_t k = 0; k < 3; ++k) {
+            std::uint32_t a = indices[t + k], b = indices[t + (k + 1) % 3];
+            if (a > b) std::swap(a, b);
+            if (b >= uvs.size() || !seen.insert({a, b}).second) continue;
+            out.push_back({uvs[a], uvs[b]});
+        }
+}
+
+} // namespace
+
 std::vector<UvEdge> uvEdges(const Model& model) {
     std::vector<UvEdge> out;
-    for (const MeshPart& p : model.parts) {
-        std::set<std::pair<std::uint32_t, std::uint32_t>> seen;
-        for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3)
-            for (std::size_t k = 0; k < 3; ++k) {
-                std::uint32_t a = p.indices[t + k], b = p.indices[t + (k + 1) % 3];
-                if (a > b) std::swap(a, b);
-                if (b >= p.uvs.size() || !seen.insert({a, b}).second) continue;
-                out.push_back({p.uvs[a], p.uvs[b]});
-            }
-    }
+    for (const MeshPart& p : model.parts) addEdges(p.indices, p.uvs, out);
+    return out;
+}
+
+std::vector<UvEdge> uvEdges(const TextureLayout& layout) {
+    std::vector<UvEdge> out;
+    for (const PartLayout& p : layout.parts) addEdges(p.indices, p.uvs, out);
     return out;
 }
 

@@ -52,8 +52,12 @@ void installModelRoutes(RouteTable& t) {
     });
     t.add("GET", "/models/{id}/uv-layout", [](Api::Impl& a, const Req& req, Res& res) {
         const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+        const auto mode = uvLayoutModeFromString(req.has_param("layout") ? req.get_param_value("layout") : "auto");
+        if (!mode)
+            return sendError(res, 422, "invalid_argument",
+                             "dermis-server: layout: must be auto, model or generated", "layout");
         if (format == "json") {
-            auto r = a.svc.uvLayout(req.matches[1]);
+            auto r = a.svc.uvLayout(req.matches[1], *mode);
             if (!r) return sendError(res, r.error());
             return sendJson(res, 200, *r);
         }
@@ -62,7 +66,7 @@ void installModelRoutes(RouteTable& t) {
                              "dermis-server: format: must be png or json", "format");
         std::optional<int> size;
         if (!intParam(req, res, "size", size)) return;
-        auto r = a.svc.uvLayoutPng(req.matches[1], size.value_or(1024));
+        auto r = a.svc.uvLayoutPng(req.matches[1], size.value_or(1024), *mode);
         if (!r) return sendError(res, r.error());
         sendImage(res, std::move(*r));
     });

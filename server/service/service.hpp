@@ -227,10 +227,13 @@ public:
     /// The summary of model `id` when it is loaded (as listModels has it), else nullopt.
     std::optional<nlohmann::json> storedModel(const std::string& id) const;
     Status deleteModel(const std::string& id);
-    /// The UV wireframe (core uvEdges): {"id", "edge_count", "edges": [u0,v0,u1,v1, …],
-    /// "convention"} (json), or a size×size PNG (core rasterizeUvEdges).
-    Result<nlohmann::json> uvLayout(const std::string& id) const;
-    Result<EncodedImage> uvLayoutPng(const std::string& id, int size) const;
+    /// The wireframe (core uvEdges) of the height-map layout `mode` names (SPEC §8; auto: the one a
+    /// scene with `uv_layout: auto` uses): {"id", "layout": "model"|"generated", "edge_count",
+    /// "edges": [u0,v0,u1,v1, …], "convention"} (json), or a size×size PNG (rasterizeUvEdges).
+    /// `model` on a model without UVs: InvalidArgument, field "layout".
+    Result<nlohmann::json> uvLayout(const std::string& id, UvLayoutMode mode = UvLayoutMode::Auto) const;
+    Result<EncodedImage> uvLayoutPng(const std::string& id, int size,
+                                     UvLayoutMode mode = UvLayoutMode::Auto) const;
     /// The model's base-colour texture as PNG, for the editor to draw the UV layout over: the
     /// image covering the most triangles (Model::dominantBaseColorImage), as decoded (RGBA8;
     /// alpha kept only when some pixel is not opaque), fitted into maxSide × maxSide with its

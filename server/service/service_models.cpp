@@ -3,7 +3,6 @@
 #include "service/service_state.hpp"
 
 #include "core/preview.hpp"
-#include "core/uv_layout.hpp"
 #include "io/frame_io.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/sha256.hpp"
@@ -230,41 +229,6 @@ Status Service::deleteModel(const std::string& id) {
     return Ok{};
 }
 
-namespace {
-
-/// The model behind `id` (kept alive by the caller's copy), under a shared lock.
-Result<std::shared_ptr<const Model>> findModel(const Service::State& st, const std::string& id) {
-    std::shared_lock<std::shared_mutex> lock(st.mutex);
-    auto it = st.models.find(id);
-    if (it == st.models.end()) return notFound("id", "no model \"" + id + "\"");
-    if (!it->second.model->hasUVs()) return bad("id", "model \"" + id + "\" has no TEXCOORD_0");
-    return it->second.model;
-}
-
-} // namespace
-
-Result<json> Service::uvLayout(const std::string& id) const {
-    auto model = findModel(*state_, id);
-    if (!model) return model.error();
-    const std::vector<UvEdge> edges = uvEdges(**model);
-    json flat = json::array();
-    auto r5 = [](float v) { return std::round(double(v) * 1e5) / 1e5; };
-    for (const UvEdge& e : edges)
-        for (float v : {e.a.x, e.a.y, e.b.x, e.b.y})
-            flat.push_back(r5(v));
-    return json{{"id", id}, {"edge_count", edges.size()}, {"edges", std::move(flat)},
-                {"convention", "u right, v down; each edge is u0, v0, u1, v1"}};
-}
-
-Result<EncodedImage> Service::uvLayoutPng(const std::string& id, int size) const {
-    if (size < 16 || size > limits_.maxRenderSide)
-        return bad("size", "must be in [16, " + std::to_string(limits_.maxRenderSide) + "]");
-    auto model = findModel(*state_, id);
-    if (!model) return model.error();
-    auto png = encodePng(rasterizeUvEdges(uvEdges(**model), size), true);
-    if (!png) return png.error();
-    return EncodedImage{std::move(*png), "image/png", ""};
-}
 
 Result<EncodedImage> Service::modelTexture(const std::string& id, std::optional<int> maxSide) const {
     if (maxSide && (*maxSide < 16 || *maxSide > 4096)) return bad("size", "must be in [16, 4096]");

@@ -18,6 +18,7 @@
 #include "core/model_derived.hpp"
 #include "io/gltf_loader.hpp"
 #include "service/content_cache.hpp"
+#include "service/layout_cache.hpp"
 
 #include <atomic>
 #include <deque>
@@ -180,6 +181,10 @@ private:
 
 } // namespace detail
 
+/// The service's cache of height-map layouts in `folder` (<data>/cache/layouts), generating with
+/// core generateTextureLayout at its default options (service_layouts.cpp).
+std::unique_ptr<LayoutCache> makeLayoutCache(const std::string& folder);
+
 struct Service::State {
     std::optional<Store> store;
     std::unique_ptr<DecodeBudget> decodeBudget; ///< pattern decodes in flight (limits.decodeBudgetBytes)
@@ -201,6 +206,16 @@ struct Service::State {
 
     std::atomic<int> inFlight{0};
     std::unique_ptr<ContentCache> content; ///< by address; its own lock (no order with the others)
+    std::unique_ptr<LayoutCache> layouts;  ///< height-map layouts per model; its own lock
+
+    /// The height-map layout `mode` names for `model` (SPEC §8; service_layouts.cpp): the model's
+    /// own UVs for Model, the generated layout for Generated, and for Auto the model's UVs when
+    /// the UV diagnosis finds them usable (present, overlap < 0.5 %), else generated. Needs no
+    /// lock (the model is shared and immutable). Fails for Model on a model without UVs
+    /// (InvalidArgument, field `field`) and as the generator does.
+    Result<std::shared_ptr<const TextureLayout>> layoutOf(const std::shared_ptr<const Model>& model,
+                                                          UvLayoutMode mode,
+                                                          const std::string& field = "uv_layout") const;
 
     /// The scene a document describes, validated against this server's models and patterns.
     struct Prepared {
