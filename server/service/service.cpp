@@ -295,9 +295,11 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
             continue;
         }
         SceneEntry& e = scenes[r.id];
-        e.history = std::move(*history);
+        e.history = std::move(history->revisions);
+        e.droppedBefore = history->droppedBefore;
         e.setCurrent({r.revision, std::make_shared<const json>(std::move(prepared->canonical)),
                       std::make_shared<const Scene>(std::move(prepared->scene))});
+        applyRetention(r.id); // the window moved while the server was down (--history-keep 30d)
     }
 }
 
@@ -310,6 +312,7 @@ Result<std::unique_ptr<Service>> Service::open(const ServiceConfig& config,
     svc->state_ = std::make_unique<State>();
     State& st = *svc->state_;
     st.limits = config.limits;
+    st.retention = config.history;
     st.contentDir = config.contentDir.empty() ? dermisContentDir() : config.contentDir;
     st.renderer = std::move(renderer);
     st.content = std::make_unique<ContentCache>(config.limits.contentCacheBytes);

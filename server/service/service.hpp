@@ -189,6 +189,9 @@ struct ServiceConfig {
     std::string dataDir;    ///< uploads and scenes, written durably (`serve --data`)
     std::string contentDir; ///< built-in content, read only (`serve --content`; dermisContentDir())
     ServerLimits limits;
+    /// How much of each scene's history is kept (`serve --history-keep`; default all): older
+    /// revisions answer Gone and their files are compacted away (Store::dropRevisionsBefore).
+    HistoryRetention history;
 };
 
 class Service {
