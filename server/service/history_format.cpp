@@ -199,13 +199,15 @@ Result<json> replayChunk(std::string_view bytes, std::uint64_t base, std::uint64
                      "the history holds no revision " + std::to_string(revision));
 }
 
-std::string HistoryRetention::flag() const {
-    if (keepsAll()) return "";
-    if (revisions > 0) return "--history-keep " + std::to_string(revisions);
+std::string HistoryRetention::text() const {
+    if (keepsAll()) return "all";
+    if (revisions > 0) return std::to_string(revisions);
     std::ostringstream days;
     days << seconds / 86400.0;
-    return "--history-keep " + days.str() + "d";
+    return days.str() + "d";
 }
+
+std::string HistoryRetention::flag() const { return keepsAll() ? "" : "--history-keep " + text(); }
 
 Result<HistoryRetention> parseHistoryRetention(const std::string& text) {
     auto bad = [&] {

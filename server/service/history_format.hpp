@@ -79,6 +79,8 @@ struct HistoryRetention {
     std::uint64_t revisions = 0; ///< keep the newest N revisions (0 = no count limit)
     double seconds = 0.0;        ///< keep revisions made in the last S seconds (0 = no age limit)
     bool keepsAll() const { return revisions == 0 && seconds <= 0.0; }
+    /// The flag's value: "500", "30d" (days as a shortest decimal), "all" when keepsAll.
+    std::string text() const;
     /// The flag as given, e.g. "--history-keep 500", "--history-keep 30d"; "" when keepsAll.
     std::string flag() const;
 };

@@ -26,7 +26,8 @@ json ServerLimits::toJson() const {
             {"request_timeout_seconds", requestTimeoutSeconds},
             {"max_batch_frames", maxBatchFrames},
             {"content_cache_bytes", contentCacheBytes},
-            {"presence_seconds", presenceSeconds}};
+            {"presence_seconds", presenceSeconds},
+            {"history_keep", historyKeep.text()}};
 }
 
 namespace detail {
@@ -312,7 +313,6 @@ Result<std::unique_ptr<Service>> Service::open(const ServiceConfig& config,
     svc->state_ = std::make_unique<State>();
     State& st = *svc->state_;
     st.limits = config.limits;
-    st.retention = config.history;
     st.contentDir = config.contentDir.empty() ? dermisContentDir() : config.contentDir;
     st.renderer = std::move(renderer);
     st.content = std::make_unique<ContentCache>(config.limits.contentCacheBytes);

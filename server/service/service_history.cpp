@@ -46,7 +46,7 @@ Status detail::keptRevision(const std::string& id, const SceneEntry& e, std::uin
 }
 
 void Service::State::applyRetention(const std::string& id) {
-    if (retention.keepsAll()) return;
+    if (limits.historyKeep.keepsAll()) return;
     std::uint64_t oldest = 0;
     std::vector<Store::RevisionInfo> kept;
     {
@@ -54,7 +54,7 @@ void Service::State::applyRetention(const std::string& id) {
         auto it = scenes.find(id);
         if (it == scenes.end()) return;
         SceneEntry& e = it->second;
-        oldest = oldestKept(e.history, retention, nowSeconds());
+        oldest = oldestKept(e.history, limits.historyKeep, nowSeconds());
         auto cut = std::lower_bound(e.history.begin(), e.history.end(), oldest,
                                     [](const Store::RevisionInfo& r, std::uint64_t b) {
                                         return r.revision < b;
@@ -107,7 +107,7 @@ Result<json> Service::getSceneRevision(const std::string& id, std::uint64_t revi
             return notFound("revision", "scene " + id + " has no revision " +
                                             std::to_string(revision) + " (current: " +
                                             std::to_string(current) + ")");
-        if (auto s = keptRevision(id, it->second, revision, state_->retention.flag()); !s)
+        if (auto s = keptRevision(id, it->second, revision, state_->limits.historyKeep.flag()); !s)
             return s.error();
         if (const SceneVersion* v = it->second.recentVersion(revision))
             return json{{"id", id}, {"revision", revision}, {"current_revision", current},
@@ -131,7 +131,7 @@ Result<json> Service::revert(const std::string& id, std::uint64_t revision, cons
         if (revision == 0 || revision > it->second.revision)
             return notFound("/revision", "scene " + id + " has no revision " +
                                              std::to_string(revision));
-        if (auto s = keptRevision(id, it->second, revision, state_->retention.flag()); !s) {
+        if (auto s = keptRevision(id, it->second, revision, state_->limits.historyKeep.flag()); !s) {
             Error e = s.error();
             e.field = "/revision";
             return e;

@@ -96,7 +96,7 @@ Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string
                 return notFound("revision",
                                 "scene " + id + " has no revision " + std::to_string(*p.revision));
             if (p.revision)
-                if (auto s = keptRevision(id, e, *p.revision, retention.flag()); !s) return s.error();
+                if (auto s = keptRevision(id, e, *p.revision, limits.historyKeep.flag()); !s) return s.error();
             const SceneVersion* v = e.recentVersion(p.revision ? *p.revision : current);
             // The current revision, or a recent one whose model and patterns are all still here,
             // renders from the scene validated at its commit: nothing to parse or check again.

@@ -197,7 +197,6 @@ struct Service::State {
     PatternManifest manifest;
     json defaultSceneDoc; ///< the default pattern set (null when not installed)
     ServerLimits limits;
-    HistoryRetention retention; ///< serve --history-keep
 
     std::mutex writeMutex;
     mutable std::shared_mutex mutex;
