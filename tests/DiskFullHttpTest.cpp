@@ -61,7 +61,8 @@ TEST(DiskFullHttpTest, EditsOnAFullDiskAreJson5xxThatNameNoServerPath) {
         for (int i = 0; i < 500 && http.get("/health").status != 200; ++i)
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
 
-        // A scene of 24 placements (the test limit) with long labels: each revision is tens of KB on disk.
+        // A scene of 24 placements (the test limit) with long labels, ~10 KB; each edit changes a
+        // label, so that its revision — a patch in the history — takes a few hundred bytes.
         json doc = smallScene();
         doc["placements"] = json::array();
         for (int k = 0; k < 24; ++k) {
@@ -74,9 +75,10 @@ TEST(DiskFullHttpTest, EditsOnAFullDiskAreJson5xxThatNameNoServerPath) {
         const std::string id = created.js()["id"];
         std::uint64_t acknowledged = created.js()["revision"];
         Reply refused;
-        for (int i = 0; i < 200; ++i) {
+        for (int i = 0; i < 5000; ++i) {
             Reply r = http.patch("/scenes/" + id + "/placements/p" + std::to_string(i % 24),
-                                 {{"h", 1.0 + 0.001 * (i + 1)}});
+                                 {{"h", 1.0 + 0.001 * (i + 1)},
+                                  {"label", std::to_string(i) + std::string(110, char('a' + i % 26))}});
             if (r.status != 200) {
                 refused = r;
                 break;

@@ -2,7 +2,8 @@
 // Service + Api on 127.0.0.1): ETag on reads and edits, If-Match on every edit route (412
 // stale_revision with the current revision, nothing changed; weak, malformed and multiple ETags
 // 400), X-Dermis-Client in the history and the events, revisions paged newest first, a revision's
-// document, revert as undo and redo, presence broadcast on the event stream.
+// document, revert as undo and redo, presence broadcast on the event stream; with
+// --history-keep, 410 gone for the revisions it dropped (read, revert, frame).
 #include "HttpTestFixture.hpp"
 
 using namespace dermis;
@@ -167,6 +168,36 @@ TEST_F(HistoryHttpTest, RevisionsRevertAndEventsCarryTheClient) {
     EXPECT_EQ(h.get(s).js()["revision"], 3);
     ASSERT_EQ(h.del(s).status, 204);
     ASSERT_EQ(h.del("/scenes/" + other).status, 204);
+}
+
+TEST(HistoryRetentionHttpTest, DroppedRevisionsAnswer410) {
+    ServerLimits limits = mainLimits();
+    limits.historyKeep = *parseHistoryRetention("3");
+    std::string error;
+    auto server = LiveServer::start(limits, "", error);
+    ASSERT_TRUE(server && error.empty()) << error;
+    Http h(server->port());
+    EXPECT_EQ(h.get("/info").js()["limits"]["history_keep"], "3");
+    Reply created = h.post("/scenes", smallScene());
+    ASSERT_EQ(created.status, 201) << created;
+    const std::string s = "/scenes/" + created.js()["id"].get<std::string>();
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(h.patch(s + "/placements/elbow", {{"h", 1.0 + k}}).status, 200); // → 7
+    Reply list = h.get(s + "/revisions");
+    ASSERT_EQ(list.status, 200) << list;
+    ASSERT_EQ(list.js()["revisions"].size(), 3u);
+    EXPECT_EQ(list.js()["revisions"][2]["revision"], 5);
+    Reply gone = h.get(s + "?revision=2");
+    expectError(gone, 410, "revision");
+    EXPECT_EQ(gone.js()["error"]["code"], "gone");
+    EXPECT_NE(gone.js()["error"]["message"].get<std::string>().find(
+                  "revision 2 was dropped by the history retention (--history-keep 3); the oldest kept revision is 5"),
+              std::string::npos)
+        << gone;
+    expectError(h.post(s + "/revert", {{"revision", 4}}), 410, "/revision");
+    expectError(h.get(s + "/frame?width=64&height=64&revision=1"), 410, "revision");
+    EXPECT_EQ(h.get(s + "?revision=5").status, 200);
+    expectError(h.get(s + "?revision=8"), 404, "revision");
+    EXPECT_EQ(h.get(s).js()["revision"], 7);
 }
 
 } // namespace

@@ -1,7 +1,8 @@
 // ServiceHistoryTest — SPEC §6 History, Concurrency and Presence on the service without HTTP or
 // GL: every edit kept as a revision with its op and client, any revision read back, revert (undo
 // and redo), history across a reopen and after an interrupted commit, If-Match (stale edits change
-// nothing), events carrying client/op/placement, presence broadcast and lapse.
+// nothing), events carrying client/op/placement, presence broadcast and lapse; the history
+// retention (--history-keep by count and by age): dropped revisions answer Gone, across reopens.
 #include "ServiceFixture.hpp"
 #include "TwoClientEdits.hpp"
 
@@ -375,6 +376,83 @@ TEST_F(ServiceHistoryTest, FramesOfRecentRevisionsComeFromTheCachedScene) {
     auto gone = svc_->frame(id, old);
     ASSERT_FALSE(gone);
     EXPECT_EQ(gone.error().code, ErrorCode::Conflict) << gone.error().message;
+}
+
+TEST_F(ServiceHistoryTest, RetentionDropsOldRevisionsThatThenAnswerGone) {
+    ServerLimits keep5;
+    keep5.historyKeep = *parseHistoryRetention("5");
+    open(keep5);
+    const std::string id = (*svc_->createScene(kEmpty))["id"];
+    for (int k = 0; k < 20; ++k) ASSERT_TRUE(svc_->patchPose(id, {{"time", 0.1 * k}})); // → 21
+    const json at19 = (*svc_->getSceneRevision(id, 19))["scene"];
+    auto expectKept = [&](std::uint64_t oldest) {
+        auto list = svc_->listRevisions(id, 100, std::nullopt);
+        ASSERT_TRUE(list);
+        ASSERT_EQ((*list)["revisions"].size(), 21 - oldest + 1);
+        EXPECT_EQ((*list)["revisions"].back()["revision"], oldest);
+    };
+    expectKept(17);
+    auto gone = [&](const Result<json>& r, const std::string& field) {
+        ASSERT_FALSE(r);
+        EXPECT_EQ(r.error().code, ErrorCode::Gone);
+        EXPECT_EQ(r.error().field, field);
+        EXPECT_NE(r.error().message.find("revision 3 was dropped by the history retention (--history-keep 5); "
+                                         "the oldest kept revision is 17"),
+                  std::string::npos)
+            << r.error().message;
+    };
+    gone(svc_->getSceneRevision(id, 3), "revision");
+    gone(svc_->revert(id, 3, EditContext{}), "/revision"); // nothing made: still 21
+    EXPECT_EQ(revisionOf(id), 21u);
+    FrameParams old;
+    old.revision = 16; // still among the recent revisions in memory: dropped all the same
+    auto frame = svc_->frame(id, old);
+    ASSERT_FALSE(frame);
+    EXPECT_EQ(frame.error().code, ErrorCode::Gone);
+    EXPECT_EQ(svc_->getSceneRevision(id, 22).error().code, ErrorCode::NotFound);
+    EXPECT_EQ((*svc_->getSceneRevision(id, 19))["scene"], at19);
+    EXPECT_EQ(svc_->info()["limits"]["history_keep"], "5");
+
+    // Reopened with the same flag: the same window; the files of dropped revisions go in batches.
+    for (int k = 0; k < 60; ++k) ASSERT_TRUE(svc_->patchPose(id, {{"time", 0.01 * k}})); // → 81
+    open(keep5);
+    auto list = svc_->listRevisions(id, 100, std::nullopt);
+    ASSERT_EQ((*list)["revisions"].size(), 5u);
+    EXPECT_EQ((*list)["revisions"][4]["revision"], 77);
+    EXPECT_EQ(svc_->getSceneRevision(id, 76).error().code, ErrorCode::Gone);
+    const fs::path hist = fs::path(dir_ / "data") / "scenes" / (id + ".history");
+    EXPECT_FALSE(fs::exists(hist / "c1.jsonl")) << "revisions 1 … 20 are still on disk";
+    std::string index;
+    {
+        std::ifstream in(hist / "index.jsonl");
+        std::getline(in, index);
+    }
+    EXPECT_EQ(index.rfind("{\"dropped_before\":", 0), 0u) << index;
+
+    // By age: revisions made before the window (their times put back 40 days) go at the next open.
+    open();
+    ASSERT_TRUE(svc_->replaceScene(id, kEmpty));
+    std::string lines, line;
+    {
+        std::ifstream in(hist / "index.jsonl");
+        while (std::getline(in, line)) {
+            json j = json::parse(line);
+            if (j.contains("revision") && j["revision"].get<std::uint64_t>() <= 79)
+                j["time"] = j["time"].get<double>() - 40 * 86400.0;
+            lines += j.dump() + "\n";
+        }
+    }
+    ASSERT_TRUE(writeFileAtomically((hist / "index.jsonl").string(), std::vector<std::uint8_t>(lines.begin(), lines.end())));
+    ServerLimits month;
+    month.historyKeep = *parseHistoryRetention("30d");
+    open(month);
+    list = svc_->listRevisions(id, 100, std::nullopt);
+    ASSERT_EQ((*list)["revisions"].size(), 3u); // 80, 81, 82
+    auto aged = svc_->getSceneRevision(id, 79);
+    ASSERT_FALSE(aged);
+    EXPECT_EQ(aged.error().code, ErrorCode::Gone);
+    EXPECT_NE(aged.error().message.find("(--history-keep 30d); the oldest kept revision is 80"), std::string::npos)
+        << aged.error().message;
 }
 
 TEST_F(ServiceHistoryTest, PresenceIsBroadcastListedAndChecked) {

@@ -128,6 +128,7 @@ struct ServeArgs {
     double gpuCacheMb = static_cast<double>(dermis::kDefaultGpuCacheBytes >> 20);
     double contentCacheMb = static_cast<double>(dermis::ServerLimits{}.contentCacheBytes >> 20);
     double decodeBudgetMb = static_cast<double>(dermis::ServerLimits{}.decodeBudgetBytes >> 20);
+    std::string historyKeep = "all";
     dermis::ApiOptions api; ///< connection limits (head deadline, per-address and total caps)
 };
 
@@ -142,6 +143,9 @@ int runServe(ServeArgs a) {
     a.limits.maxUploadBytes = static_cast<std::size_t>(a.maxUploadMb * 1024.0 * 1024.0);
     a.limits.contentCacheBytes = static_cast<std::size_t>(a.contentCacheMb * 1024.0 * 1024.0);
     a.limits.decodeBudgetBytes = static_cast<std::size_t>(a.decodeBudgetMb * 1024.0 * 1024.0);
+    auto keep = parseHistoryRetention(a.historyKeep);
+    if (!keep) return fail(keep.error());
+    a.limits.historyKeep = *keep;
     // SIGINT/SIGTERM are taken by a waiting thread (blocked here, before any thread starts).
     sigset_t signals;
     sigemptyset(&signals);
@@ -245,6 +249,16 @@ void addServeOptions(CLI::App& app, ServeArgs& s) {
                    "Memory of pattern decodes in flight (uploads, batch parts); a decode that does not "
                    "fit waits up to 2 s, then 503")
         ->check(CLI::Range(16.0, 65536.0));
+    app.add_option("--history-keep", s.historyKeep,
+                   "History each scene keeps: N (the newest N revisions), Nd (those of the last N "
+                   "days) or all (the default); older revisions answer 410 and their files are "
+                   "compacted away")
+        ->check(CLI::Validator(
+            [](std::string& v) {
+                auto r = dermis::parseHistoryRetention(v);
+                return r ? std::string() : r.error().message;
+            },
+            "N|Nd|all"));
     app.add_option("--max-streams-per-address", s.api.maxStreamsPerAddress,
                    "Event streams one peer address may hold (default: half of the server's 16); "
                    "raise it behind a reverse proxy, where every stream comes from its address")

@@ -15,6 +15,7 @@ const char* errorCodeName(ErrorCode code) {
     case ErrorCode::Unavailable: return "unavailable";
     case ErrorCode::Internal: return "internal";
     case ErrorCode::MissingContent: return "missing_content";
+    case ErrorCode::Gone: return "gone";
     }
     return "unknown";
 }

@@ -30,6 +30,7 @@ enum class ErrorCode {
     Unavailable,     ///< a needed resource cannot be had now (no GL backend starts, queue full)
     Internal,        ///< a failure of a lower layer that is not the caller's fault (GL errors)
     MissingContent,  ///< content named by hash ("sha256:<hex>") that this process does not hold
+    Gone,            ///< a thing that existed and was dropped for good (a revision past the history retention)
 };
 
 const char* errorCodeName(ErrorCode code);

@@ -40,6 +40,8 @@ int statusOf(ErrorCode code) {
         return 500;
     case ErrorCode::MissingContent:
         return 409;
+    case ErrorCode::Gone:
+        return 410;
     }
     return 500;
 }

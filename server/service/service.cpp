@@ -26,7 +26,8 @@ json ServerLimits::toJson() const {
             {"request_timeout_seconds", requestTimeoutSeconds},
             {"max_batch_frames", maxBatchFrames},
             {"content_cache_bytes", contentCacheBytes},
-            {"presence_seconds", presenceSeconds}};
+            {"presence_seconds", presenceSeconds},
+            {"history_keep", historyKeep.text()}};
 }
 
 namespace detail {
@@ -295,9 +296,11 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
             continue;
         }
         SceneEntry& e = scenes[r.id];
-        e.history = std::move(*history);
+        e.history = std::move(history->revisions);
+        e.droppedBefore = history->droppedBefore;
         e.setCurrent({r.revision, std::make_shared<const json>(std::move(prepared->canonical)),
                       std::make_shared<const Scene>(std::move(prepared->scene))});
+        applyRetention(r.id); // the window moved while the server was down (--history-keep 30d)
     }
 }
 

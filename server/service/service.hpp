@@ -65,6 +65,9 @@ struct ServerLimits {
     /// decode (DecodeBudget): a decode that does not fit waits up to 2 s, then Unavailable.
     std::size_t decodeBudgetBytes = 512u << 20;
     double presenceSeconds = 30.0; ///< a presence entry lapses this long after its last refresh
+    /// How much of each scene's history is kept (`serve --history-keep`; default all): older
+    /// revisions answer Gone and their files are compacted away (Store::dropRevisionsBefore).
+    HistoryRetention historyKeep;
     nlohmann::json toJson() const;
 };
 

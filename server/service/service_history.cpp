@@ -35,6 +35,41 @@ constexpr std::size_t kMaxColor = 32;
 
 } // namespace
 
+Status detail::keptRevision(const std::string& id, const SceneEntry& e, std::uint64_t revision,
+                            const std::string& flag) {
+    if (revision == 0 || revision >= e.droppedBefore) return Ok{};
+    return makeError(ErrorCode::Gone, "dermis::Service", "revision",
+                     "scene " + id + ": revision " + std::to_string(revision) +
+                         " was dropped by the history retention (" +
+                         (flag.empty() ? "an earlier --history-keep" : flag) +
+                         "); the oldest kept revision is " + std::to_string(e.droppedBefore));
+}
+
+void Service::State::applyRetention(const std::string& id) {
+    if (limits.historyKeep.keepsAll()) return;
+    std::uint64_t oldest = 0;
+    std::vector<Store::RevisionInfo> kept;
+    {
+        std::unique_lock<std::shared_mutex> lock(mutex);
+        auto it = scenes.find(id);
+        if (it == scenes.end()) return;
+        SceneEntry& e = it->second;
+        oldest = oldestKept(e.history, limits.historyKeep, nowSeconds());
+        auto cut = std::lower_bound(e.history.begin(), e.history.end(), oldest,
+                                    [](const Store::RevisionInfo& r, std::uint64_t b) {
+                                        return r.revision < b;
+                                    });
+        if (cut != e.history.begin()) {
+            e.history.erase(e.history.begin(), cut);
+            e.droppedBefore = std::max(e.droppedBefore, oldest);
+        }
+        if (e.droppedBefore == 0 || !store->compactionDue(id, e.droppedBefore)) return;
+        oldest = e.droppedBefore;
+        kept = e.history;
+    }
+    (void)store->dropRevisionsBefore(id, oldest, kept); // a failure: tried again at the next edit
+}
+
 std::string checkClientName(const std::string& name) {
     if (name.size() > 64) return "longer than 64 characters";
     for (unsigned char c : name)
@@ -72,11 +107,14 @@ Result<json> Service::getSceneRevision(const std::string& id, std::uint64_t revi
             return notFound("revision", "scene " + id + " has no revision " +
                                             std::to_string(revision) + " (current: " +
                                             std::to_string(current) + ")");
+        if (auto s = keptRevision(id, it->second, revision, state_->limits.historyKeep.flag()); !s)
+            return s.error();
         if (const SceneVersion* v = it->second.recentVersion(revision))
             return json{{"id", id}, {"revision", revision}, {"current_revision", current},
                         {"scene", *v->doc}};
     }
-    // Older revisions are read from disk, outside the lock (files are never rewritten).
+    // Older revisions are read from disk, outside the lock (a chunk is only appended to; a
+    // compaction deletes files of dropped revisions only).
     auto doc = state_->store->readRevision(id, revision);
     if (!doc) return doc.error();
     return json{{"id", id}, {"revision", revision}, {"current_revision", current}, {"scene", *doc}};
@@ -93,6 +131,11 @@ Result<json> Service::revert(const std::string& id, std::uint64_t revision, cons
         if (revision == 0 || revision > it->second.revision)
             return notFound("/revision", "scene " + id + " has no revision " +
                                              std::to_string(revision));
+        if (auto s = keptRevision(id, it->second, revision, state_->limits.historyKeep.flag()); !s) {
+            Error e = s.error();
+            e.field = "/revision";
+            return e;
+        }
         if (const SceneVersion* v = it->second.recentVersion(revision)) recent = v->doc;
     }
     if (recent) // undo and redo of a recent edit: no file to read

@@ -95,6 +95,8 @@ Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string
             if (p.revision && (*p.revision == 0 || *p.revision > current))
                 return notFound("revision",
                                 "scene " + id + " has no revision " + std::to_string(*p.revision));
+            if (p.revision)
+                if (auto s = keptRevision(id, e, *p.revision, limits.historyKeep.flag()); !s) return s.error();
             const SceneVersion* v = e.recentVersion(p.revision ? *p.revision : current);
             // The current revision, or a recent one whose model and patterns are all still here,
             // renders from the scene validated at its commit: nothing to parse or check again.

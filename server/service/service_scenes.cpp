@@ -125,9 +125,10 @@ Result<json> Service::State::commit(const std::string& id, const json& newDoc, c
     // Durable before visible; readers and renders go on meanwhile (writeMutex keeps other
     // mutations out, so the state validated above is still the state swapped into below).
     const Store::RevisionInfo kept{revision, nowSeconds(), info.op, ctx.client};
-    if (auto s = store->putScene(id, kept, prepared.canonical); !s) return s.error();
-    json answer = {{"id", id}, {"revision", revision}, {"scene", prepared.canonical}};
-    SceneVersion version{revision, std::make_shared<const json>(std::move(prepared.canonical)),
+    auto canonical = std::make_shared<const json>(std::move(prepared.canonical));
+    if (auto s = store->putScene(id, kept, canonical); !s) return s.error(); // keeps `canonical`
+    json answer = {{"id", id}, {"revision", revision}, {"scene", *canonical}};
+    SceneVersion version{revision, std::move(canonical),
                          std::make_shared<const Scene>(std::move(prepared.scene))};
     {
         std::unique_lock<std::shared_mutex> lock(mutex);
@@ -135,6 +136,7 @@ Result<json> Service::State::commit(const std::string& id, const json& newDoc, c
         e.setCurrent(std::move(version));
         e.history.push_back(kept);
     }
+    applyRetention(id);
     json event = {{"type", info.type}, {"scene", id},      {"revision", revision},
                   {"client", ctx.client}, {"op", info.op}, {"placement", info.placement}};
     if (info.placement.empty()) event["placement"] = nullptr;

@@ -100,6 +100,9 @@ struct SceneEntry {
     std::shared_ptr<const Scene> scene; ///< the current revision's scene
     std::uint64_t revision = 1;
     std::vector<Store::RevisionInfo> history; ///< kept revisions, oldest first (last = current)
+    /// Revisions below it were dropped by the history retention (0: none were): read, revert and
+    /// frames of them answer Gone (keptRevision).
+    std::uint64_t droppedBefore = 0;
     /// The last kRecentRevisions revisions, oldest first; back() is the current one (the same
     /// pointers as doc and scene). Revisions loaded from the data folder start with the current.
     std::deque<SceneVersion> recent;
@@ -130,6 +133,12 @@ struct EditInfo {
     std::string op;         ///< history op: "patch placement elbow_l", …
     std::string placement;  ///< the placement it concerns ("" = none)
 };
+
+/// Gone when revision `revision` of scene `id` (entry `e`) was dropped by the history retention
+/// (`flag`: the --history-keep in force, "" when none is), naming the oldest kept revision;
+/// Ok otherwise (whether the revision exists is not checked here). Caller holds the state's mutex.
+Status keptRevision(const std::string& id, const SceneEntry& e, std::uint64_t revision,
+                    const std::string& flag);
 
 /// One person's presence on a scene.
 struct PresenceEntry {
@@ -263,6 +272,11 @@ struct Service::State {
     /// and announces it. Caller holds `writeMutex` (and not `mutex`).
     Result<json> commit(const std::string& id, const json& newDoc, const detail::EditInfo& info,
                         const EditContext& ctx, bool create);
+    /// Drops scene `id`'s revisions beyond `retention` from its history (they answer Gone from
+    /// here on) and compacts its files when Store::compactionDue says so. Caller holds
+    /// `writeMutex` (and not `mutex`). A failed compaction changes nothing on disk and is tried
+    /// again at the next edit; it never fails the edit that triggered it.
+    void applyRetention(const std::string& id);
     /// Takes `writeMutex`, checks ctx.ifMatch against `scope` (checkIfMatch), copies scene `id`'s
     /// document, lets `change` modify the copy (it may also complete `info`), commits. `change`
     /// runs under `writeMutex` (not `mutex`): the scene stays as it read it until the commit.

@@ -9,19 +9,27 @@
 //   models/<id>.glb      + models/<id>.json    (metadata, written last: the commit record)
 //   patterns/<id>.<ext>  + patterns/<id>.json
 //   scenes/<id>.json     ({"id", "revision", "scene"}: the current revision)
-//   scenes/<id>.history/ (r<N>.json per kept revision, index.jsonl: one line per revision)
+//   scenes/<id>.history/ (index.jsonl: one line per revision; c<B>.jsonl: chunks of up to
+//                         kChunkRevisions revisions from B on, a snapshot then patches
+//                         (history_format.hpp); r<N>.json: a whole revision, as versions before
+//                         chunks wrote them: read, never written)
 // Ids are generated ("m_…", "p_…", "s_…": 16 hex digits) — never taken from a client — so no file
 // name comes from a request. Scene ids are random; model and pattern ids are content addresses
 // (contentId: the first 16 hex digits of the SHA-256 of the uploaded bytes), so one upload of the
-// same bytes is stored once. Random model and pattern ids of earlier versions stay valid. Thread-safe: the caller serialises mutations (Service's lock).
+// same bytes is stored once. Random model and pattern ids of earlier versions stay valid.
+// Thread-safe when the caller serialises mutations (Service's writer lock): the store remembers
+// where each scene's history goes on (its last chunk) for its writers only; readers
+// (readRevision, listScenes, listBlobs) touch nothing but files and may run meanwhile.
 #pragma once
 
 #include "core/result.hpp"
+#include "service/history_format.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -62,34 +70,66 @@ public:
     std::vector<Blob> listBlobs(const std::string& kind, std::vector<std::string>& skipped) const;
     Status removeBlob(const std::string& kind, const std::string& id);
 
-    /// One kept revision of a scene (SPEC §6 History).
-    struct RevisionInfo {
-        std::uint64_t revision = 0;
-        double time = 0.0;  ///< seconds since the Unix epoch
-        std::string op;     ///< what made it, e.g. "patch placement elbow_l"
-        std::string client; ///< X-Dermis-Client of the edit ("" = not named)
-    };
-    /// Writes a new revision of a scene, each step durable, in this order: the revision's own
-    /// document scenes/<id>.history/r<N>.json = {"revision", "time", "op", "client", "scene"},
-    /// a line {"revision", "time", "op", "client"} appended to scenes/<id>.history/index.jsonl,
-    /// then the current record scenes/<id>.json = {"id", "revision", "scene"} — the commit
-    /// point: a crash before it leaves the scene at its previous revision (loadHistory forgets
-    /// the newer leftovers).
+    /// One kept revision of a scene (SPEC §6 History): history_format.hpp.
+    using RevisionInfo = dermis::RevisionInfo;
+    /// Writes a new revision of a scene, each step durable, in this order: the revision itself in
+    /// its chunk, scenes/<id>.history/c<B>.jsonl — a patch line appended (and fsync'd) to the
+    /// chunk the previous revision ends, or a new chunk starting with the whole document (temp
+    /// file, fsync, rename: a snapshot) when this store did not write the previous revision since
+    /// it opened, that chunk holds kChunkRevisions revisions, or its patches would outweigh its
+    /// snapshot —; a line {"revision", "time", "op", "client"} appended to index.jsonl; then
+    /// the current record scenes/<id>.json = {"id", "revision", "scene"} — the commit point: a
+    /// crash before it leaves the scene at its previous revision (loadHistory forgets the newer
+    /// leftovers). The store keeps `doc` (shared, not copied) to diff the next revision against.
+    /// Io error when a step fails; what it appended is cut off again and the next revision starts
+    /// a new chunk.
+    Status putScene(const std::string& id, const RevisionInfo& info,
+                    std::shared_ptr<const nlohmann::json> doc);
+    /// Same with a copy of `doc`.
     Status putScene(const std::string& id, const RevisionInfo& info, const nlohmann::json& doc);
     /// Same with no op or client and the current time (tests, tools).
     Status putScene(const std::string& id, std::uint64_t revision, const nlohmann::json& doc);
     /// Removes the current record, then the scene's history.
     Status removeScene(const std::string& id);
-    /// The document of revision `revision` of scene `id` (history/r<N>.json): NotFound (field
-    /// "revision") when that revision is not kept, Parse when its file is damaged.
+    /// The document of revision `revision` of scene `id`, byte for byte (once dumped) the one
+    /// putScene was given: a whole-revision file r<N>.json when there is one, else the chunk
+    /// c<B>.jsonl with the largest B ≤ N (at most kChunkRevisions − 1 below), replayed up to N.
+    /// NotFound (field "revision") when no file holds that revision, Parse when one on the way is
+    /// damaged. Does not know the retention window (the service answers dropped revisions).
     Result<nlohmann::json> readRevision(const std::string& id, std::uint64_t revision) const;
-    /// The kept revisions of a scene whose current record says `current`, oldest first, from
-    /// the index (later lines win over earlier ones for the same revision; a torn last line is
-    /// ignored; revisions above `current` — an interrupted commit — are dropped). A scene written
-    /// before history existed, or whose current revision is missing from the index, gets that
-    /// revision written now from `currentDoc` (op "imported"). Io error when that write fails.
-    Result<std::vector<RevisionInfo>> loadHistory(const std::string& id, std::uint64_t current,
-                                                  const nlohmann::json& currentDoc);
+
+    /// A scene's history as loadHistory finds it.
+    struct History {
+        std::vector<RevisionInfo> revisions; ///< kept, oldest first; the last is the current one
+        /// Revisions below it were dropped by the history retention (0: none were), as the last
+        /// compaction recorded (index.jsonl's first line {"dropped_before": N}).
+        std::uint64_t droppedBefore = 0;
+    };
+    /// The kept revisions of a scene whose current record says `current`, from the index
+    /// (later lines win over earlier ones for the same revision; a torn last line is ignored;
+    /// revisions above `current` — an interrupted commit — and below the recorded retention
+    /// window are dropped). Tidies the folder of what a crash left: temp files, chunks and
+    /// whole-revision files above `current` or wholly below the window, chunk lines after
+    /// `current`'s. A scene written before history existed, or whose current revision is not
+    /// readable, gets that revision written now from `currentDoc` (op "imported", a new chunk).
+    /// Io error when that write fails.
+    Result<History> loadHistory(const std::string& id, std::uint64_t current,
+                                const nlohmann::json& currentDoc);
+    /// Whether dropRevisionsBefore(id, oldestKept, …) would remove files now: the history holds
+    /// a whole chunk (or whole-revision file) below `oldestKept`'s chunk. Cheap (no I/O).
+    bool compactionDue(const std::string& id, std::uint64_t oldestKept) const;
+    /// Compacts a scene's history to the retention window that starts at `oldestKept` (a kept
+    /// revision), `kept` being the kept revisions, oldest first. Crash-safe in three steps: (1)
+    /// the new index — {"dropped_before": oldestKept}, then the lines of `kept` — is written
+    /// beside the old one, fsync'd and renamed over it (the switch: before it the old history
+    /// stands whole, after it the new one); (2) then the chunks whose every revision is below
+    /// `oldestKept`'s chunk and the whole-revision files below `oldestKept` are deleted (a crash
+    /// in between leaves files loadHistory deletes). No snapshot is written: the chunk holding
+    /// `oldestKept` stays whole (its first revisions, below the window, are no longer listed
+    /// or served, and go with that chunk). Io error when the index cannot be written (nothing
+    /// changed) or a file not deleted (the next compaction or open tries again).
+    Status dropRevisionsBefore(const std::string& id, std::uint64_t oldestKept,
+                               const std::vector<RevisionInfo>& kept);
     struct SceneRecord {
         std::string id;
         std::uint64_t revision = 0;
@@ -107,11 +147,14 @@ private:
                              const std::map<std::string, std::vector<std::uint8_t>>& files,
                              const std::string& mainFile, nlohmann::json meta);
     Status removeBlobImpl(const std::string& kind, const std::string& id);
-    Status putSceneImpl(const std::string& id, const RevisionInfo& info, const nlohmann::json& doc);
+    Status putSceneImpl(const std::string& id, const RevisionInfo& info,
+                        std::shared_ptr<const nlohmann::json> doc);
     Status removeSceneImpl(const std::string& id);
     Result<nlohmann::json> readRevisionImpl(const std::string& id, std::uint64_t revision) const;
-    Result<std::vector<RevisionInfo>> loadHistoryImpl(const std::string& id, std::uint64_t current,
-                                                      const nlohmann::json& currentDoc);
+    Result<History> loadHistoryImpl(const std::string& id, std::uint64_t current,
+                                    const nlohmann::json& currentDoc);
+    Status dropRevisionsBeforeImpl(const std::string& id, std::uint64_t oldestKept,
+                                   const std::vector<RevisionInfo>& kept);
     /// `r` with the data folder written "<data>" in its error's message and field.
     template <class R> R hidden(R r) const {
         if (r) return r;
@@ -122,6 +165,18 @@ private:
         return R(std::move(e));
     }
 
+    /// Where a scene's history goes on, for its writers (putScene, dropRevisionsBefore).
+    struct Tail {
+        std::uint64_t base = 0;         ///< the last chunk, c<base>.jsonl (0: none yet)
+        std::uint64_t last = 0;         ///< its last revision
+        std::size_t snapshotBytes = 0;  ///< its first line
+        std::size_t patchBytes = 0;     ///< its other lines
+        std::shared_ptr<const nlohmann::json> lastDoc; ///< `last`'s document as written; null
+                                                       ///< after an open: the next one is a snapshot
+        std::uint64_t oldestFile = 0;   ///< the oldest revision a file holds (0: unknown)
+        std::uint64_t oldestChunkEnd = 0; ///< the first revision past that file (its successor's start)
+    };
+    std::map<std::string, Tail> tails_;
     std::string dir_;
 };
 
