@@ -65,9 +65,11 @@ struct LintFinding {
 /// validation reports, not lint.
 std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,
                                    const PatternImages& images);
-/// The same findings, identical, on derived.model() with its cached UV index, rest skin and
-/// symmetry plane (the last two built on the first mirror pair only, if not built yet). Never
-/// fails either; the caller keeps `derived` alive for the call.
+/// The same findings, identical, on derived.model() with its cached UV index, rest skin,
+/// symmetry plane and UV diagnosis (built if not yet: the diagnosis — and with it the rest skin
+/// and plane — for a scene with an enabled UV placement on a model with UVs, the rest skin and
+/// plane on the first mirror pair). Never fails either; the caller keeps `derived` alive for the
+/// call.
 std::vector<LintFinding> lintScene(const Scene& scene, const ModelDerived& derived,
                                    const PatternImages& images);
 
