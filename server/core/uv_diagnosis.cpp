@@ -256,12 +256,17 @@ UvDiagnosis diagnoseUvs(const Model& model, const RestSkin& rest, const Symmetry
     }
 
     // --- rasterization: claims per texel ----------------------------------------------------
-    std::vector<std::int32_t> first(texelCount, -1);
-    std::vector<std::pair<std::uint32_t, std::int32_t>> extra; // further claims (texel, triangle)
+    // Per texel its first claim; further claims in a list per texel (extraHead → extra).
+    std::vector<std::int32_t> first(texelCount, -1), extraHead(texelCount, -1);
+    std::vector<std::pair<std::int32_t, std::int32_t>> extra; // (triangle, next claim or −1)
     auto claim = [&](std::int64_t i, std::int64_t j, std::int32_t tri) {
         const std::size_t texel = static_cast<std::size_t>(wrap(j, n) * n + wrap(i, n));
-        if (first[texel] < 0) first[texel] = tri;
-        else extra.emplace_back(static_cast<std::uint32_t>(texel), tri);
+        if (first[texel] < 0) {
+            first[texel] = tri;
+        } else {
+            extra.emplace_back(tri, extraHead[texel]);
+            extraHead[texel] = static_cast<std::int32_t>(extra.size() - 1);
+        }
     };
     const double scale = static_cast<double>(period);
     for (std::size_t ti = 0; ti < tris.size(); ++ti) {
@@ -320,7 +325,6 @@ UvDiagnosis diagnoseUvs(const Model& model, const RestSkin& rest, const Symmetry
     }
 
     // --- per texel: the regions claiming it, overlapped or not ------------------------------
-    std::sort(extra.begin(), extra.end());
     d.texelSets.assign(texelCount, 0);
     d.regionSets.resize(d.regions.size());
     std::map<std::vector<int>, std::uint32_t> setIndex;
@@ -330,13 +334,14 @@ UvDiagnosis diagnoseUvs(const Model& model, const RestSkin& rest, const Symmetry
     }
     std::vector<std::size_t> setTexels(d.regions.size(), 0), setOverlaps(d.regions.size(), 0);
     std::vector<std::int32_t> claims;
-    std::vector<int> islandsHere, regionsHere;
-    std::size_t e = 0;
+    std::vector<int> islandsHere, regionsHere, lastRegions;
+    std::uint32_t lastSet = 0;
     for (std::size_t texel = 0; texel < texelCount; ++texel) {
         if (first[texel] < 0) continue;
         ++d.usedTexels;
         claims.assign(1, first[texel]);
-        while (e < extra.size() && extra[e].first == texel) claims.push_back(extra[e++].second);
+        for (std::int32_t e = extraHead[texel]; e >= 0; e = extra[static_cast<std::size_t>(e)].second)
+            claims.push_back(extra[static_cast<std::size_t>(e)].first);
         std::uint32_t set = static_cast<std::uint32_t>(tris[static_cast<std::size_t>(claims[0])].region);
         bool overlapped = false;
         if (claims.size() > 1) {
@@ -357,13 +362,19 @@ UvDiagnosis diagnoseUvs(const Model& model, const RestSkin& rest, const Symmetry
             std::sort(regionsHere.begin(), regionsHere.end());
             regionsHere.erase(std::unique(regionsHere.begin(), regionsHere.end()), regionsHere.end());
             if (regionsHere.size() > 1) {
-                auto [it, added] = setIndex.emplace(regionsHere, static_cast<std::uint32_t>(d.regionSets.size()));
-                if (added) {
-                    d.regionSets.push_back(regionsHere);
-                    setTexels.push_back(0);
-                    setOverlaps.push_back(0);
+                // Neighbouring texels mostly have the same regions: the last set first.
+                if (regionsHere != lastRegions) {
+                    auto it = setIndex.find(regionsHere);
+                    if (it == setIndex.end()) {
+                        it = setIndex.emplace(regionsHere, static_cast<std::uint32_t>(d.regionSets.size())).first;
+                        d.regionSets.push_back(regionsHere);
+                        setTexels.push_back(0);
+                        setOverlaps.push_back(0);
+                    }
+                    lastRegions = regionsHere;
+                    lastSet = it->second;
                 }
-                set = it->second;
+                set = lastSet;
             }
         }
         ++setTexels[set];
