@@ -1,5 +1,6 @@
 // dermis-inspectbench — prints JSON figures (milliseconds) for the Service's inspection routes that
-// read per-model derived data (UV index, symmetry plane, clip ranges): lint, pick by UV, mirror.
+// read per-model derived data (UV index, symmetry plane, clip ranges, UV diagnosis): lint, pick by
+// UV, mirror, a model's details (GET /models/{id}).
 // Usage: dermis-inspectbench [--repeat N] [--model PATH]…
 //   (default 15 repetitions; models: the built-in default character, ../shared's CesiumMan and
 //   KayKit Barbarian when present, or the --model files given)
@@ -10,13 +11,15 @@
 // model a pair of placements on the first joint with a mirror twin (by name) and that twin, at
 // the texture point where that joint's skin weight is largest. Per route it reports the first call on a freshly
 // opened service (`first_ms`: whatever the route builds per model on a cold start) and the median
-// of the next N calls (`median_ms`); `core` times building the UV index and the symmetry plane
-// alone (median of min(N, 5)). Mirror adds a placement (a durable edit, fsync included);
+// of the next N calls (`median_ms`); `core` times building the UV index, the symmetry plane and
+// the UV diagnosis (with the rest skin and plane it reads) alone (median of min(N, 5)). Lint's
+// first call builds the UV diagnosis (its uv_overlap); the model's details then read it. Mirror adds a placement (a durable edit, fsync included);
 // the twin is deleted again after each (`delete_placement`: that durable edit alone) so the
 // scene stays the same.
 #include "bench_common.hpp"
 
 #include "core/mirror.hpp"
+#include "core/uv_diagnosis.hpp"
 #include "core/uv_lookup.hpp"
 #include "io/atomic_file.hpp"
 #include "io/gltf_loader.hpp"
@@ -194,6 +197,7 @@ json benchModel(const std::string& label, const std::string& path, int repeat,
                    .back()["id"];
     };
     auto undoMirror = [&] { checked(svc->deletePlacement(id, twin, {}), "delete twin"); };
+    auto details = [&] { checked(svc->getModel(modelId), "model"); };
 
     // Each route's first call on its own fresh service would need three opens per model; the
     // routes share what they build, so the first of the three (lint) would pay for the others.
@@ -203,17 +207,20 @@ json benchModel(const std::string& label, const std::string& path, int repeat,
     const double mirrorFirst = timeMs(mirror);
     undoMirror();
     const double lintFirst = timeMs(lint);
-    std::vector<double> lintMs, pickMs, mirrorMs, editMs;
+    const double detailsFirst = timeMs(details);
+    std::vector<double> lintMs, pickMs, mirrorMs, editMs, detailsMs;
     for (int r = 0; r < repeat; ++r) {
         lintMs.push_back(timeMs(lint));
         pickMs.push_back(timeMs(pick));
         mirrorMs.push_back(timeMs(mirror));
         editMs.push_back(timeMs(undoMirror));
+        detailsMs.push_back(timeMs(details));
     }
     routes["pick_uv"] = {{"first_ms", round2(pickFirst)}, {"median_ms", round2(medianMs(pickMs))}};
     routes["mirror"] = {{"first_ms", round2(mirrorFirst)},
                         {"median_ms", round2(medianMs(mirrorMs))}};
     routes["lint"] = {{"first_ms", round2(lintFirst)}, {"median_ms", round2(medianMs(lintMs))}};
+    routes["model_details"] = {{"first_ms", round2(detailsFirst)}, {"median_ms", round2(medianMs(detailsMs))}};
     // The durable edit alone (deleting the twin again), which mirror also pays.
     routes["delete_placement"] = {{"median_ms", round2(medianMs(editMs))}};
     out["routes"] = routes;
@@ -221,13 +228,15 @@ json benchModel(const std::string& label, const std::string& path, int repeat,
     const std::string file =
         path.empty() ? resolveModelPath("builtin:default", "", dermisContentDir()) : path;
     const Model model = checked(loadGltfFile(file), file);
-    std::vector<double> lookupMs, planeMs;
+    std::vector<double> lookupMs, planeMs, diagnosisMs;
     for (int r = 0; r < std::min(repeat, 5); ++r) {
         lookupMs.push_back(timeMs([&] { const UvLookup lookup(model); }));
         planeMs.push_back(timeMs([&] { (void)symmetryPlane(model); }));
+        diagnosisMs.push_back(timeMs([&] { (void)diagnoseUvs(model); }));
     }
     out["core"] = {{"uv_lookup_build_ms", round2(medianMs(lookupMs))},
-                   {"symmetry_plane_ms", round2(medianMs(planeMs))}};
+                   {"symmetry_plane_ms", round2(medianMs(planeMs))},
+                   {"uv_diagnosis_ms", round2(medianMs(diagnosisMs))}};
     out["repetitions"] = repeat;
     return out;
 }

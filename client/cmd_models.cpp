@@ -1,4 +1,6 @@
-// model upload|list|show|rm, pattern upload|list|rm.
+// model upload|list|show|rm, pattern upload|list|rm. `model show` prints the model's UV diagnosis
+// (SPEC §8) too: used and overlapping texels, the regions sharing texels, mirrored island pairs,
+// texel density per driving joint.
 // Uploads print the id alone on stdout (M=$(dermis model upload a.glb)); the server answers 201
 // for new bytes and 200 for bytes it holds already (content-addressed: the same id again).
 #include "commands.hpp"
@@ -6,6 +8,7 @@
 #include "http_client.hpp"
 #include "output.hpp"
 
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -31,6 +34,45 @@ std::string imageContentType(const std::string& path) {
     if (ext == "tif" || ext == "tiff") return "image/tiff";
     if (ext == "exr") return "image/x-exr";
     return "application/octet-stream";
+}
+
+std::string percentCell(const nlohmann::json& fraction) {
+    if (!fraction.is_number()) return "-";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f%%", 100.0 * fraction.get<double>());
+    return buf;
+}
+
+/// The UV diagnosis of `model show` (the `uv` member of GET /models/{id}), after its key rows.
+void printUvDiagnosis(const nlohmann::json& uv) {
+    std::vector<std::vector<std::string>> regions;
+    for (const auto& r : uv.value("sharing", nlohmann::json::array())) {
+        std::string with;
+        for (const auto& o : r.value("shares_with", nlohmann::json::array()))
+            with += (with.empty() ? "" : ", ") + o.value("region", std::string());
+        const auto more = r.value("shares_with_more", 0);
+        if (more > 0) with += " and " + std::to_string(more) + " more";
+        if (with.empty()) with = "(folds onto itself)";
+        regions.push_back({cell(r["region"]), cell(r["shared_texels"]), with});
+    }
+    if (!regions.empty()) {
+        std::cout << "\n";
+        printTable({"REGION", "SHARED TEXELS", "SHARES TEXELS WITH"}, regions);
+    }
+    std::vector<std::vector<std::string>> mirrored;
+    for (const auto& p : uv.value("mirrored_pairs", nlohmann::json::array()))
+        mirrored.push_back({cell(p["regions"][0]), cell(p["regions"][1]), cell(p["islands"])});
+    if (!mirrored.empty()) {
+        std::cout << "\n";
+        printTable({"MIRRORED", "AND", "ISLANDS"}, mirrored);
+    }
+    std::vector<std::vector<std::string>> density;
+    for (const auto& j : uv.value("density", nlohmann::json::array()))
+        density.push_back({cell(j["joint"]), cell(j["triangles"]), cell(j["texels_per_unit"])});
+    if (!density.empty()) {
+        std::cout << "\n";
+        printTable({"JOINT", "TRIANGLES", "TEXELS/UNIT @" + cell(uv.value("resolution", nlohmann::json()))}, density);
+    }
 }
 
 void removeEach(Context& ctx, const std::string& kind, const std::vector<std::string>& ids) {
@@ -89,7 +131,7 @@ void addModelCommands(CLI::App& app, Context& ctx) {
             return kExitOk;
         };
     });
-    CLI::App* show = model->add_subcommand("show", "A model's joints and clips");
+    CLI::App* show = model->add_subcommand("show", "A model's joints, clips and UV diagnosis");
     show->add_option("id", o->id, "Model id (e.g. builtin:default)")->required();
     show->callback([&ctx, o] {
         ctx.action = [&ctx, o] {
@@ -98,12 +140,25 @@ void addModelCommands(CLI::App& app, Context& ctx) {
                 printJson(j);
                 return kExitOk;
             }
-            printTable({"KEY", "VALUE"}, {{"id", cell(j["id"])},
-                                          {"name", cell(j["name"])},
-                                          {"triangles", cell(j.value("triangles", nlohmann::json()))},
-                                          {"vertices", cell(j.value("vertices", nlohmann::json()))},
-                                          {"joints", cell(j.value("joint_count", nlohmann::json()))},
-                                          {"has_uvs", cell(j.value("has_uvs", nlohmann::json()))}});
+            const nlohmann::json uv = j.value("uv", nlohmann::json::object());
+            std::vector<std::vector<std::string>> keys = {
+                {"id", cell(j["id"])},
+                {"name", cell(j["name"])},
+                {"triangles", cell(j.value("triangles", nlohmann::json()))},
+                {"vertices", cell(j.value("vertices", nlohmann::json()))},
+                {"joints", cell(j.value("joint_count", nlohmann::json()))},
+                {"has_uvs", cell(j.value("has_uvs", nlohmann::json()))}};
+            if (!uv.empty()) {
+                keys.push_back({"uv_usable", cell(uv.value("usable", nlohmann::json()))});
+                keys.push_back({"uv_used", percentCell(uv.value("used_fraction", nlohmann::json()))});
+                keys.push_back({"uv_overlap", percentCell(uv.value("overlap_fraction", nlohmann::json()))});
+                keys.push_back({"uv_islands", cell(uv.value("islands", nlohmann::json()))});
+                const auto missing = uv.value("missing", nlohmann::json::object());
+                keys.push_back({"uv_missing", cell(missing.value("triangles", nlohmann::json())) + " triangles"});
+                const auto outside = uv.value("out_of_range", nlohmann::json::object());
+                keys.push_back({"uv_out_of_range", cell(outside.value("vertices", nlohmann::json())) + " vertices"});
+            }
+            printTable({"KEY", "VALUE"}, keys);
             std::vector<std::vector<std::string>> clips;
             for (const auto& c : j.value("clips", nlohmann::json::array()))
                 clips.push_back({cell(c["name"]), cell(c["duration"])});
@@ -111,6 +166,7 @@ void addModelCommands(CLI::App& app, Context& ctx) {
                 std::cout << "\n";
                 printTable({"CLIP", "DURATION"}, clips);
             }
+            if (!uv.empty()) printUvDiagnosis(uv);
             return kExitOk;
         };
     });

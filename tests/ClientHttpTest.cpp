@@ -27,6 +27,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <thread>
 
 using namespace dermis::test;
@@ -164,6 +165,17 @@ std::vector<std::string> filesIn(const std::string& dir) {
     return names;
 }
 
+/// The value of `key` in a KEY / VALUE table ("" when no line starts with the key).
+std::string keyValue(const std::string& out, const std::string& key) {
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);) {
+        if (line.rfind(key + " ", 0) != 0) continue;
+        const std::size_t at = line.find_first_not_of(' ', key.size());
+        return at == std::string::npos ? "" : line.substr(at);
+    }
+    return "";
+}
+
 TEST_F(ClientHttpTest, HealthInfoModelsAndPatterns) {
     ClientRun health = dermis({"health"});
     EXPECT_EQ(health.code, 0) << health;
@@ -181,6 +193,12 @@ TEST_F(ClientHttpTest, HealthInfoModelsAndPatterns) {
     ClientRun show = dermis({"model", "show", "builtin:default"});
     ASSERT_EQ(show.code, 0) << show;
     EXPECT_NE(show.out.find("elbow_curl"), std::string::npos) << show;
+    // The UV diagnosis: unique UVs, and the density of the joints that drive triangles.
+    EXPECT_EQ(keyValue(show.out, "uv_usable"), "yes") << show;
+    EXPECT_EQ(keyValue(show.out, "uv_overlap"), "0.00%") << show;
+    EXPECT_EQ(keyValue(show.out, "uv_missing"), "0 triangles") << show;
+    EXPECT_NE(show.out.find("TEXELS/UNIT @1024"), std::string::npos) << show;
+    EXPECT_EQ(show.out.find("SHARES TEXELS WITH"), std::string::npos) << show;
 
     // Content-addressed: the same bytes twice give the same id.
     ClientRun up1 = dermis({"model", "upload", kRiggedFigure, "--name", "fig"});
@@ -192,6 +210,10 @@ TEST_F(ClientHttpTest, HealthInfoModelsAndPatterns) {
     EXPECT_EQ(up2.js()["id"], id);
     EXPECT_EQ(up2.js()["name"], "fig");
     EXPECT_NE(dermis({"model", "list"}).out.find(id), std::string::npos);
+    ClientRun figure = dermis({"model", "show", id});
+    ASSERT_EQ(figure.code, 0) << figure;
+    EXPECT_EQ(keyValue(figure.out, "uv_usable"), "no") << figure;
+    EXPECT_EQ(keyValue(figure.out, "uv_missing"), "256 triangles") << figure;
     ClientRun rm = dermis({"model", "rm", id});
     EXPECT_EQ(rm.code, 0) << rm;
     ClientRun rm2 = dermis({"model", "rm", id});

@@ -2,8 +2,14 @@
 // purpose-built scenes: a footprint hanging off a UV chart, two overlapping footprints on one
 // target, a θ range no clip reaches, a driver joint with no influence under the footprint, mirror
 // pairs made asymmetric; the default elbow crease gets none of these and the default set's left /
-// right pairs are symmetric. No GL, no HTTP.
+// right pairs are symmetric. The model's own UVs (LintUvTest): on the KayKit Barbarian's palette
+// atlas a right-elbow crease gets uv_overlap naming where it also shows (the left forearm, …) and
+// no longer a wrong no_influence; uv_layout auto says the maps go to a generated layout; creases
+// on every region of CesiumMan and the default character get none of these; RiggedFigure's UV
+// placements get no_uvs, its surface placements not. No GL, no HTTP.
 #include "core/lint.hpp"
+#include "core/uv_diagnosis.hpp"
+#include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
 
 #include "DefaultSceneFixture.hpp"
@@ -11,6 +17,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <optional>
 
 using namespace dermis;
 
@@ -242,6 +250,184 @@ TEST_F(LintTest, FindsAsymmetricMirrorPairs) {
     std::vector<Placement> off = moved;
     off[static_cast<std::size_t>(right)].enabled = false;
     EXPECT_TRUE(mirrorFindings(lint(off)).empty());
+}
+
+
+// --- the model's own UVs (SPEC §8 UV diagnosis): uv_overlap, no_uvs, no_influence on overlap ---
+
+const std::string kModels = std::string(DERMIS_SHARED_DIR) + "/models/";
+
+std::shared_ptr<const Model> loadShared(const std::string& path) {
+    auto m = loadGltfFile(path);
+    EXPECT_TRUE(m) << path << ": " << (m ? "" : m.error().message);
+    return m ? std::make_shared<const Model>(std::move(*m)) : nullptr;
+}
+
+/// A crease centred on the UV centroid of triangle `t` of part `part`, driven by `joint`.
+Placement creaseOn(const Model& m, std::size_t part, std::size_t t, const std::string& joint) {
+    const MeshPart& p = m.parts[part];
+    glm::dvec2 c(0.0);
+    for (int k = 0; k < 3; ++k) c += glm::dvec2(p.uvs[p.indices[3 * t + k]]) / 3.0;
+    Placement q;
+    q.id = "crease";
+    q.pattern = "crease";
+    q.joint = joint;
+    q.center = {c.x, c.y};
+    q.scale = {0.004, 0.004};
+    q.thetaMin = 0;
+    q.thetaMax = 90;
+    return q;
+}
+
+std::vector<LintFinding> findingsOf(const std::vector<LintFinding>& f, const std::string& code) {
+    std::vector<LintFinding> out;
+    for (const LintFinding& x : f)
+        if (x.code == code) out.push_back(x);
+    return out;
+}
+
+TEST(LintUvTest, TheBarbariansOverlappingTexelsAreNamedAndNoLongerFoolNoInfluence) {
+    auto model = loadShared(kModels + "KayKitBarbarian/Barbarian.glb");
+    ASSERT_TRUE(model);
+    const ModelDerived derived(model);
+    const Model& m = *model;
+    const int forearm = m.findJoint("lowerarm.r"), upper = m.findJoint("upperarm.r");
+    ASSERT_GE(forearm, 0);
+    // A right-elbow crease where the first triangle the UV index finds is another region's (the
+    // left arm comes first in the file): that triangle has no weight of the right arm, and lint
+    // said no_influence there, which was wrong.
+    const UvDiagnosis& d = derived.uvDiagnosis();
+    std::optional<Placement> crease;
+    for (std::size_t pi = 0; pi < m.parts.size() && !crease; ++pi) {
+        if (m.parts[pi].node != "Barbarian_ArmRight") continue;
+        for (std::size_t t = 0; t < m.parts[pi].indices.size() / 3 && !crease; ++t) {
+            const int r = d.triangleRegion[pi][t];
+            if (r < 0 || d.regions[static_cast<std::size_t>(r)].jointNode != forearm) continue;
+            const Placement c = creaseOn(m, pi, t, "lowerarm.r");
+            const auto first = derived.uvLookup().find({c.center[0], c.center[1]});
+            if (!first || derived.uvLookup().weightOf(*first, forearm) > 0.01f ||
+                derived.uvLookup().weightOf(*first, upper) > 0.01f)
+                continue;
+            crease = c;
+        }
+    }
+    ASSERT_TRUE(crease) << "no right forearm triangle under another region's";
+
+    Scene s;
+    s.model = "barbarian";
+    s.uvLayout = UvLayoutMode::Model;
+    s.placements = {*crease};
+    const auto f = lintScene(s, derived, PatternImages{});
+    EXPECT_TRUE(findingsOf(f, "no_influence").empty()) << f.size();
+    const auto overlap = findingsOf(f, "uv_overlap");
+    ASSERT_EQ(overlap.size(), 1u);
+    EXPECT_EQ(overlap[0].placement, 0);
+    EXPECT_EQ(overlap[0].severity, LintSeverity::Warning);
+    const std::string& said = overlap[0].message;
+    EXPECT_NE(said.find("the pattern also shows on"), std::string::npos) << said;
+    EXPECT_NE(said.find("Barbarian_ArmLeft (lowerarm.l)"), std::string::npos) << said; // the mirror twin
+    ASSERT_NE(said.find("share with"), std::string::npos) << said; // … its own regions
+    EXPECT_GT(said.find("Barbarian_ArmRight (lowerarm.r)"), said.find("share with")) << said;
+    EXPECT_EQ(said.find("Barbarian_ArmRight (lowerarm.r)"), said.rfind("Barbarian_ArmRight (lowerarm.r)")) << said;
+    EXPECT_NE(said.find("uv_layout \"generated\""), std::string::npos) << said;
+    // The overlapping texels do not cut the footprint into charts either.
+    EXPECT_TRUE(findingsOf(f, "across_seam").empty());
+    // Identical with the per-call overload (its own lookup and diagnosis).
+    const UvLookup fresh(m);
+    const auto g = lintScene(s, m, fresh, PatternImages{});
+    ASSERT_EQ(g.size(), f.size());
+    for (std::size_t k = 0; k < f.size(); ++k) EXPECT_EQ(g[k].message, f[k].message);
+
+    // uv_layout auto: the height maps go to a generated layout; lint says why, naming regions.
+    s.uvLayout = UvLayoutMode::Auto;
+    const auto autoFindings = lintScene(s, derived, PatternImages{});
+    const auto info = findingsOf(autoFindings, "uv_overlap");
+    ASSERT_EQ(info.size(), 1u);
+    EXPECT_EQ(info[0].placement, -1);
+    EXPECT_EQ(info[0].severity, LintSeverity::Info);
+    EXPECT_NE(info[0].message.find("shares texels with"), std::string::npos) << info[0].message;
+    EXPECT_NE(info[0].message.find("generated layout"), std::string::npos) << info[0].message;
+    // uv_layout generated: nothing about the model's UVs.
+    s.uvLayout = UvLayoutMode::Generated;
+    EXPECT_TRUE(findingsOf(lintScene(s, derived, PatternImages{}), "uv_overlap").empty());
+    // A scene without placements: no finding.
+    s.uvLayout = UvLayoutMode::Auto;
+    s.placements.clear();
+    EXPECT_TRUE(lintScene(s, derived, PatternImages{}).empty());
+}
+
+TEST(LintUvTest, CesiumManAndTheDefaultCharacterHaveNoUvFindings) {
+    for (const std::string& path :
+         {kModels + "CesiumMan/CesiumMan.glb", resolveModelPath("builtin:default", "", DERMIS_SOURCE_DIR)}) {
+        SCOPED_TRACE(path);
+        auto model = loadShared(path);
+        ASSERT_TRUE(model);
+        const ModelDerived derived(model);
+        const UvDiagnosis& d = derived.uvDiagnosis();
+        // A crease on the largest triangle of each driving joint's region, driven by that joint.
+        std::vector<Placement> creases;
+        for (std::size_t r = 0; r < d.regions.size(); ++r) {
+            const UvRegion& region = d.regions[r];
+            if (region.jointNode < 0) continue;
+            const MeshPart& p = model->parts[static_cast<std::size_t>(region.partIndex)];
+            std::size_t best = 0;
+            double bestArea = -1.0;
+            for (std::size_t t = 0; t < p.indices.size() / 3; ++t) {
+                if (d.triangleRegion[static_cast<std::size_t>(region.partIndex)][t] != static_cast<int>(r)) continue;
+                const glm::vec2 a = p.uvs[p.indices[3 * t]], b = p.uvs[p.indices[3 * t + 1]], c = p.uvs[p.indices[3 * t + 2]];
+                const double area = std::abs((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
+                if (area > bestArea) {
+                    bestArea = area;
+                    best = t;
+                }
+            }
+            Placement c = creaseOn(*model, static_cast<std::size_t>(region.partIndex), best, region.joint);
+            c.id = "crease_" + std::to_string(r);
+            creases.push_back(c);
+        }
+        ASSERT_GT(creases.size(), 10u);
+        for (UvLayoutMode mode : {UvLayoutMode::Auto, UvLayoutMode::Model}) {
+            Scene s;
+            s.uvLayout = mode;
+            s.placements = creases;
+            for (const LintFinding& x : lintScene(s, derived, PatternImages{}))
+                EXPECT_TRUE(x.code != "uv_overlap" && x.code != "no_uvs" && x.code != "no_influence")
+                    << x.code << " on " << x.placement << ": " << x.message;
+        }
+    }
+}
+
+TEST(LintUvTest, UvPlacementsOnAModelWithoutUvsAreNamedAndSurfacePlacementsAreNot) {
+    auto model = loadShared(kModels + "RiggedFigure/RiggedFigure.glb");
+    ASSERT_TRUE(model);
+    const ModelDerived derived(model);
+    Placement uv;
+    uv.id = "elbow";
+    uv.pattern = "crease";
+    uv.joint = derived.model().nodes[static_cast<std::size_t>(derived.model().joints.at(6))].name;
+    Placement surface = uv;
+    surface.id = "elbow_surface";
+    surface.projection = Projection::Surface;
+    Scene s;
+    s.placements = {uv, surface};
+    const auto f = lintScene(s, derived, PatternImages{});
+    const auto noUvs = findingsOf(f, "no_uvs");
+    ASSERT_EQ(noUvs.size(), 1u);
+    EXPECT_EQ(noUvs[0].placement, -1);
+    EXPECT_NE(noUvs[0].message.find("placement 'elbow' uses projection \"uv\""), std::string::npos) << noUvs[0].message;
+    EXPECT_EQ(noUvs[0].message.find("elbow_surface"), std::string::npos) << noUvs[0].message;
+    EXPECT_NE(noUvs[0].message.find("projection \"surface\""), std::string::npos) << noUvs[0].message;
+    // Nothing is measured in UVs the model does not have.
+    for (const char* code : {"off_chart", "across_seam", "no_influence", "overlap", "uv_overlap"})
+        EXPECT_TRUE(findingsOf(f, code).empty()) << code;
+    // Only surface placements: no no_uvs; a range no clip reaches is still found.
+    surface.thetaMin = 170;
+    surface.thetaMax = 179;
+    s.placements = {surface};
+    const auto g = lintScene(s, derived, PatternImages{});
+    EXPECT_TRUE(findingsOf(g, "no_uvs").empty());
+    EXPECT_EQ(findingsOf(g, "unreachable_range").size(), derived.model().clips.empty() ? 0u : 1u);
+    EXPECT_EQ(derived.uvDiagnosisBuilds(), 0); // no UV placement in UVs: no diagnosis needed
 }
 
 } // namespace

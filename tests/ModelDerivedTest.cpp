@@ -236,13 +236,11 @@ TEST(ModelDerivedTest, EachPieceIsBuiltOnFirstUseOnly) {
     EXPECT_EQ(d.uvLookupBuilds(), 1);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 0); // pick and lint never pay for the plane
     EXPECT_EQ(&d.uvLookup(), first);
-    // Lint without mirror pairs pays for neither the plane nor the rest skin.
+    // Lint of a scene without UV placements pays for neither the UV diagnosis, nor the plane,
+    // nor the rest skin.
     Scene scene;
-    scene.placements.push_back(Placement{});
-    scene.placements.back().id = "a";
-    scene.placements.back().pattern = "crease";
-    scene.placements.back().joint = d.model().nodes[static_cast<std::size_t>(d.model().joints.at(0))].name;
     (void)lintScene(scene, d, PatternImages{});
+    EXPECT_EQ(d.uvDiagnosisBuilds(), 0);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 0);
     EXPECT_EQ(d.restSkinBuilds(), 0);
     const SymmetryPlane* plane = &d.symmetryPlane();
@@ -253,6 +251,17 @@ TEST(ModelDerivedTest, EachPieceIsBuiltOnFirstUseOnly) {
     EXPECT_EQ(d.uvLookupBuilds(), 1);
     EXPECT_EQ(d.symmetryPlaneBuilds(), 1);
     EXPECT_EQ(d.restSkinBuilds(), 1);
+    // With a UV placement it reads the UV diagnosis (built once, from the same rest skin and
+    // plane), also on the next lint.
+    scene.placements.push_back(Placement{});
+    scene.placements.back().id = "a";
+    scene.placements.back().pattern = "crease";
+    scene.placements.back().joint = d.model().nodes[static_cast<std::size_t>(d.model().joints.at(0))].name;
+    (void)lintScene(scene, d, PatternImages{});
+    (void)lintScene(scene, d, PatternImages{});
+    EXPECT_EQ(d.uvDiagnosisBuilds(), 1);
+    EXPECT_EQ(d.restSkinBuilds(), 1);
+    EXPECT_EQ(d.symmetryPlaneBuilds(), 1);
     const ModelDerived empty(nullptr); // an empty model: nothing to find, nothing thrown
     EXPECT_FALSE(empty.uvLookup().find({0.5, 0.5}));
     EXPECT_EQ(empty.uvLookup().chartCount(), 0);

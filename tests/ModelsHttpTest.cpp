@@ -3,6 +3,10 @@
 // over loopback). It checks:
 //   * models: built-in details, .glb uploads of the shared models (CesiumMan, KayKit Barbarian,
 //     RiggedFigure without UVs), UV layouts as JSON and PNG, deletion (409 while a scene uses it);
+//   * the UV diagnosis in a model's details (`uv`, SPEC §8): the default character and CesiumMan
+//     usable without overlap, the Barbarian's palette atlas overlapping with its regions named
+//     (the hat shares texels with the body; left and right forearm mirrored), RiggedFigure
+//     without UVs (every triangle missing);
 //   * base-colour textures as PNG (CesiumMan's at its size and downsized; none on the default
 //     character or RiggedFigure: 404 no_texture);
 //   * a multipart .gltf with its external buffer, and multipart uploads that are refused (missing
@@ -74,6 +78,18 @@ TEST_F(ModelsHttpTest, BuiltinModelIsListedWithItsDetails) {
     EXPECT_TRUE(names.count("forearm.l") && names.count("spine_02") && names.count("root"));
     ASSERT_TRUE(m["clips"].is_array());
     EXPECT_EQ(m["clips"].size(), 7u);
+    // Its UV diagnosis: unique UVs, usable for the height maps.
+    const json& uv = m["uv"];
+    ASSERT_TRUE(uv.is_object()) << m;
+    EXPECT_EQ(uv["has_uvs"], true);
+    EXPECT_EQ(uv["usable"], true);
+    EXPECT_EQ(uv["overlap_fraction"], 0.0);
+    EXPECT_NEAR(uv["used_fraction"].get<double>(), 0.47, 0.02);
+    EXPECT_EQ(uv["resolution"], 1024);
+    EXPECT_TRUE(uv["sharing"].empty());
+    EXPECT_EQ(uv["summary"], "");
+    EXPECT_EQ(uv["missing"]["triangles"], 0);
+    EXPECT_EQ(uv["density"].size(), 49u); // the joints that drive triangles (not root, not index_03.l)
     for (const json& c : m["clips"]) {
         EXPECT_TRUE(c["name"].is_string());
         EXPECT_GT(c["duration"].get<double>(), 0.0) << c;
@@ -104,6 +120,9 @@ TEST_F(ModelsHttpTest, CesiumManUploadsInspectsAndDeletes) {
     EXPECT_TRUE(m["has_uvs"].get<bool>());
     EXPECT_EQ(m["triangles"], 4672);
     EXPECT_GE(m["clips"].size(), 1u);
+    EXPECT_EQ(m["uv"]["usable"], true) << m["uv"];
+    EXPECT_LT(m["uv"]["overlap_fraction"].get<double>(), 0.005);
+    EXPECT_TRUE(m["uv"]["mirrored_pairs"].empty());
 
     bool listed = false;
     for (const json all = h.get("/models").js(); const json& e : all["models"])
@@ -309,6 +328,29 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
     ASSERT_EQ(bm.status, 200);
     EXPECT_EQ(bm.js()["joints"].size(), 41u);
     EXPECT_GE(bm.js()["clips"].size(), 70u);
+    // A palette atlas: most used texels are shared, by regions named after part and joint.
+    const json uv = bm.js()["uv"];
+    EXPECT_EQ(uv["has_uvs"], true);
+    EXPECT_EQ(uv["usable"], false);
+    EXPECT_GT(uv["overlap_fraction"].get<double>(), 0.005);
+    EXPECT_NE(uv["summary"].get<std::string>().find("shares texels with"), std::string::npos) << uv["summary"];
+    bool hatWithBody = false;
+    for (const json& r : uv["sharing"])
+        if (r["region"] == "Barbarian_Hat (head)") {
+            EXPECT_EQ(r["joint"], "head");
+            EXPECT_GT(r["shared_texels"].get<int>(), 0);
+            for (const json& o : r["shares_with"])
+                hatWithBody = hatWithBody || o["region"].get<std::string>().rfind("Barbarian_Body (", 0) == 0;
+        }
+    EXPECT_TRUE(hatWithBody) << uv["sharing"];
+    bool forearms = false;
+    for (const json& p : uv["mirrored_pairs"])
+        forearms = forearms || p["regions"] == json({"Barbarian_ArmLeft (lowerarm.l)", "Barbarian_ArmRight (lowerarm.r)"});
+    EXPECT_TRUE(forearms) << uv["mirrored_pairs"];
+    bool density = false;
+    for (const json& j : uv["density"])
+        density = density || (j["joint"] == "lowerarm.l" && j["texels_per_unit"].get<double>() > 0);
+    EXPECT_TRUE(density) << uv["density"];
 
     // A scene on an uploaded model renders.
     json doc = {{"format", "dermis.scene/1"},
@@ -331,6 +373,12 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
     EXPECT_FALSE(fig.js()["has_uvs"].get<bool>());
     EXPECT_FALSE(fig.js()["has_texture"].get<bool>());
     EXPECT_EQ(fig.js()["joint_count"], 19);
+    const json figUv = h.get("/models/" + figId).js()["uv"];
+    EXPECT_EQ(figUv["has_uvs"], false);
+    EXPECT_EQ(figUv["usable"], false);
+    EXPECT_EQ(figUv["missing"]["triangles"], 256);
+    EXPECT_EQ(figUv["missing"]["parts"], 1);
+    EXPECT_EQ(figUv["used_fraction"], 0.0);
     expectError(h.get("/models/" + figId + "/uv-layout"), 422, "id");
     expectError(h.get("/models/" + figId + "/uv-layout?format=png"), 422, "id");
     json withPlacement = {{"format", "dermis.scene/1"},

@@ -1,6 +1,7 @@
 // Scene lint. See lint.hpp.
 #include "lint.hpp"
 
+#include "lint_uv.hpp"
 #include "mirror.hpp"
 #include "model_derived.hpp"
 
@@ -180,20 +181,37 @@ namespace {
 std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, const UvLookup& lookup,
                                        const PatternImages& images, const ModelDerived& derived) {
     std::vector<LintFinding> out;
-    if (!scene.placements.empty() && !model.hasUVs()) {
-        out.push_back({"no_uvs", LintSeverity::Warning, -1,
-                       "the model has no TEXCOORD_0: no placement can show"});
-        return out;
-    }
+    // UV placements are checked in the model's UVs (none without them: no_uvs says so).
+    const bool uvs = model.hasUVs();
+    auto checkedInUvs = [&](const Placement& p) { return uvs && p.enabled && p.projection == Projection::Uv; };
+    if (auto f = lintNoUvs(scene, model)) out.push_back(*f);
+    const bool anyInUvs = std::any_of(scene.placements.begin(), scene.placements.end(), checkedInUvs);
+    // The model's UV diagnosis (cached per model by `derived`), only for scenes that need it.
+    const UvDiagnosis* diagnosis = anyInUvs ? &derived.uvDiagnosis() : nullptr;
+    if (diagnosis)
+        if (auto f = lintModelUvOverlap(scene, *diagnosis)) out.push_back(*f);
     const std::vector<bool> reach = reachable(scene, model);
     std::vector<std::vector<glm::dvec2>> points(scene.placements.size());
     for (std::size_t i = 0; i < scene.placements.size(); ++i)
-        if (scene.placements[i].enabled) points[i] = samples(scene.placements[i], images);
+        if (checkedInUvs(scene.placements[i])) points[i] = samples(scene.placements[i], images);
 
     for (std::size_t i = 0; i < scene.placements.size(); ++i) {
         const Placement& p = scene.placements[i];
         if (!p.enabled) continue;
         const int idx = static_cast<int>(i);
+        auto lintRange = [&] {
+            if (!reach[i])
+                out.push_back({"unreachable_range", LintSeverity::Warning, idx,
+                               "no clip of the model brings joint '" + p.joint + "' into [" +
+                                   std::to_string(p.thetaMin) + ", " + std::to_string(p.thetaMax) +
+                                   "] degrees about its axis: the pattern never shows in a clip"});
+        };
+        if (!checkedInUvs(p)) {
+            // Not in the model's UVs (a surface placement, or a model without UVs): only the
+            // range is checked here.
+            lintRange();
+            continue;
+        }
         std::size_t off = 0;
         std::set<int> charts;
         float influence = 0.0f;
@@ -202,15 +220,31 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
         // parent joint's): a crease across the joint, or a muscle on the parent bone bulging as
         // the joint bends (the biceps on upper_arm, driven by the elbow, forearm).
         const int parent = joint >= 0 ? model.parentJoint(joint) : -1;
+        auto weightAt = [&](const UvLookup::Hit& hit) {
+            float w = 0.0f;
+            if (joint >= 0) w = std::max(w, lookup.weightOf(hit, joint));
+            if (parent >= 0) w = std::max(w, lookup.weightOf(hit, parent));
+            return w;
+        };
         for (glm::dvec2 uv : points[i]) {
-            const auto hit = lookup.find(uv);
-            if (!hit) {
+            // Where the atlas overlaps itself (palette swatches, mirrored islands) several
+            // triangles hold the point: the placement's is the one its joints weigh most (the
+            // first found was another region's, and no_influence was wrong there).
+            const auto hits = lookup.findAll(uv);
+            if (hits.empty()) {
                 ++off;
                 continue;
             }
-            charts.insert(hit->chart);
-            if (joint >= 0) influence = std::max(influence, lookup.weightOf(*hit, joint));
-            if (parent >= 0) influence = std::max(influence, lookup.weightOf(*hit, parent));
+            std::size_t best = 0;
+            float bestWeight = -1.0f;
+            for (std::size_t k = 0; k < hits.size(); ++k)
+                if (const float w = weightAt(hits[k]); w > bestWeight) {
+                    bestWeight = w;
+                    best = k;
+                }
+            charts.insert(hits[best].chart);
+            influence = std::max(influence, bestWeight);
+            if (influence < 0.01f && diagnosis && regionDrivenAt(*diagnosis, uv, joint, parent)) influence = 1.0f;
         }
         const std::size_t n = points[i].size();
         if (off > 0)
@@ -221,11 +255,7 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
             out.push_back({"across_seam", LintSeverity::Warning, idx,
                            "the footprint spans " + std::to_string(charts.size()) +
                                " UV charts: the pattern is cut at the seam"});
-        if (!reach[i])
-            out.push_back({"unreachable_range", LintSeverity::Warning, idx,
-                           "no clip of the model brings joint '" + p.joint + "' into [" +
-                               std::to_string(p.thetaMin) + ", " + std::to_string(p.thetaMax) +
-                               "] degrees about its axis: the pattern never shows in a clip"});
+        lintRange();
         if (joint >= 0 && n > off && influence < 0.01f)
             out.push_back({"no_influence", LintSeverity::Warning, idx,
                            "neither joint '" + p.joint + "' nor its parent has skin weight under "
@@ -237,7 +267,7 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
         std::string named;
         for (std::size_t j = i + 1; j < scene.placements.size(); ++j) {
             const Placement& q = scene.placements[j];
-            if (!q.enabled || q.target != p.target) continue;
+            if (!checkedInUvs(q) || q.target != p.target) continue;
             std::size_t shared = 0;
             for (glm::dvec2 uv : points[i])
                 if (covers(q, images, uv)) ++shared;
@@ -255,6 +285,8 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
                                std::string(toString(p.target)) + " map (share of this footprint): " + named +
                                (overlaps > kOverlapNames ? " and " + std::to_string(overlaps - kOverlapNames) + " more" : "") +
                                ": heights add up"});
+        if (diagnosis)
+            if (auto f = lintPlacementUvOverlap(scene, i, points[i], joint, parent, *diagnosis)) out.push_back(*f);
     }
     lintMirrorPairs(scene, model, lookup, derived, out);
     std::stable_sort(out.begin(), out.end(),

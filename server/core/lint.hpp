@@ -1,7 +1,16 @@
 // Dermis core — what may be wrong with a scene that still validates (SPEC §6 Lint): footprints
 // hanging off the UV charts (the pattern is lost there) or across a chart seam, footprints
 // overlapping on one target, θ ranges no clip reaches, driver joints with no skin influence under
-// their footprint, mirror pairs that are not symmetric.
+// their footprint, mirror pairs that are not symmetric; and, from the model's UV diagnosis (SPEC
+// §8, lint_uv.hpp), footprints on texels other regions of the body share (uv_overlap, naming
+// where the pattern also shows) and UV placements on a model without UVs (no_uvs).
+//
+// Placements with projection "surface" get only unreachable_range here (their footprint is on
+// the body, not in the model's UVs); so do UV placements on a model without UVs. Where the atlas
+// overlaps itself a footprint sample is held by several triangles: the placement's is the one its
+// driver joint (or that joint's parent) weighs most — its chart for across_seam, its weight for
+// no_influence (a region of the diagnosis driven by one of them also counts: palette atlases
+// collapse triangles below a texel, which the UV index cannot find).
 //
 // Mirror pairs: two enabled placements with the same pattern whose joints are mirror twins by
 // name (mirrorJointName: elbow.l / elbow.r; an intentionally different pattern is no pair), each
@@ -18,8 +27,8 @@
 // where its pattern is not flat (|L| > 0.02, when the image is given) count, so a transparent
 // border hanging off a chart is no finding. Clips are sampled at 30 fps. Disabled placements are
 // skipped. Pure; reads the model through `lookup` (which must index the same model). The
-// overload taking a ModelDerived reads the model's UV index, rest skin and symmetry plane from it
-// (built once per model) instead of computing the plane and the rest-pose skinning per call.
+// overload taking a ModelDerived reads the model's UV index, rest skin, symmetry plane and UV
+// diagnosis from it (built once per model) instead of computing them per call.
 #pragma once
 
 #include "bake.hpp"
@@ -42,7 +51,8 @@ inline constexpr double kMirrorAxisDegrees = 5.0;      ///< angle between the ax
 inline constexpr double kMirrorThetaDegrees = 0.5;     ///< θmin and θmax each
 
 struct LintFinding {
-    /// off_chart, across_seam, overlap, unreachable_range, no_influence, mirror_asymmetric, no_uvs
+    /// off_chart, across_seam, overlap, unreachable_range, no_influence, mirror_asymmetric, no_uvs,
+    /// uv_overlap
     std::string code;
     LintSeverity severity = LintSeverity::Warning;
     int placement = -1;   ///< index in Scene::placements (−1: the scene as a whole)
@@ -55,9 +65,11 @@ struct LintFinding {
 /// validation reports, not lint.
 std::vector<LintFinding> lintScene(const Scene& scene, const Model& model, const UvLookup& lookup,
                                    const PatternImages& images);
-/// The same findings, identical, on derived.model() with its cached UV index, rest skin and
-/// symmetry plane (the last two built on the first mirror pair only, if not built yet). Never
-/// fails either; the caller keeps `derived` alive for the call.
+/// The same findings, identical, on derived.model() with its cached UV index, rest skin,
+/// symmetry plane and UV diagnosis (built if not yet: the diagnosis — and with it the rest skin
+/// and plane — for a scene with an enabled UV placement on a model with UVs, the rest skin and
+/// plane on the first mirror pair). Never fails either; the caller keeps `derived` alive for the
+/// call.
 std::vector<LintFinding> lintScene(const Scene& scene, const ModelDerived& derived,
                                    const PatternImages& images);
 

@@ -35,7 +35,8 @@ struct Influence {
 /// attached to node N is stored as a one-influence skin: positions in rest world space and
 /// inverseBind = inverse(restWorld(N)), so skinning with the posed world matrix moves it rigidly.
 struct MeshPart {
-    std::string name;
+    std::string name;                     ///< the glTF mesh's name, else its node's ("#k" per primitive)
+    std::string node;                     ///< the name of the glTF node that instances the mesh ("" if none)
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals;       ///< unit; computed (area-weighted) when the file has none
     std::vector<glm::vec2> uvs;           ///< TEXCOORD_0; empty when the file has none

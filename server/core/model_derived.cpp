@@ -37,6 +37,14 @@ const SymmetryPlane& ModelDerived::symmetryPlane() const {
     return plane_;
 }
 
+const UvDiagnosis& ModelDerived::uvDiagnosis() const {
+    std::call_once(diagnosisOnce_, [this] {
+        diagnosis_ = diagnoseUvs(*model_, restSkin(), symmetryPlane());
+        diagnosisBuilds_.fetch_add(1);
+    });
+    return diagnosis_;
+}
+
 SuggestedDriver
 ModelDerived::suggestDriver(const std::vector<std::pair<int, float>>& joints) const {
     const Model& model = *model_;

@@ -1,7 +1,9 @@
 // Dermis core — data derived from one immutable model, built once and shared by every request that
 // reads it: the UV index (UvLookup: lint, pick by UV, mirror), the rest-pose skinning (RestSkin:
-// mirror, lint's mirror pairs, the symmetry plane), the rest pose's symmetry plane (mirror, lint)
-// and the joints' angle ranges over the clips (the picks' driver suggestion). Each piece
+// mirror, lint's mirror pairs, the symmetry plane), the rest pose's symmetry plane (mirror, lint),
+// the UV diagnosis (GET /models/{id}, lint's uv_overlap and no_influence, uv_layout auto) and the
+// joints' angle ranges over the clips (the picks' driver suggestion). The service keeps one per
+// model entry, and model ids are content addresses: the diagnosis is cached by content. Each piece
 // is built lazily, on its first use, at most once (std::call_once): a route pays only for what it
 // reads, and concurrent first uses wait for one build instead of each making its own.
 //
@@ -19,6 +21,7 @@
 #include "mirror.hpp"
 #include "model.hpp"
 #include "pick.hpp"
+#include "uv_diagnosis.hpp"
 #include "uv_lookup.hpp"
 
 #include <array>
@@ -52,6 +55,11 @@ public:
     /// restSkin() (which it builds if not yet built).
     const SymmetryPlane& symmetryPlane() const;
 
+    /// diagnoseUvs(model(), restSkin(), symmetryPlane()) at the default resolution (1024²),
+    /// computed on the first call (building the rest skin and plane if not yet built). Same
+    /// lifetime and retry rule as uvLookup().
+    const UvDiagnosis& uvDiagnosis() const;
+
     /// core suggestDriver(model(), joints), bit for bit, with the clips sampled once per model:
     /// the angle range of every skin joint about x, y and z over all clips at 15 fps (what that
     /// function samples per call) is computed on the first call that needs it. Joints that are
@@ -63,6 +71,7 @@ public:
     int restSkinBuilds() const { return restBuilds_.load(); }
     int symmetryPlaneBuilds() const { return planeBuilds_.load(); }
     int clipRangeBuilds() const { return rangesBuilds_.load(); }
+    int uvDiagnosisBuilds() const { return diagnosisBuilds_.load(); }
 
 private:
     std::shared_ptr<const Model> model_;
@@ -70,10 +79,13 @@ private:
     mutable std::unique_ptr<const UvLookup> lookup_;
     mutable RestSkin rest_;
     mutable SymmetryPlane plane_;
+    mutable std::once_flag diagnosisOnce_;
+    mutable UvDiagnosis diagnosis_;
     mutable std::once_flag rangesOnce_;
     mutable std::vector<std::array<AngleRange, 3>> ranges_; ///< by node; x, y, z
     mutable std::vector<bool> ranged_;                      ///< by node: a skin joint, in ranges_
-    mutable std::atomic<int> lookupBuilds_{0}, restBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0};
+    mutable std::atomic<int> lookupBuilds_{0}, restBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0},
+        diagnosisBuilds_{0};
 };
 
 class ModelDerivedSlot {

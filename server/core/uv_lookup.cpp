@@ -77,10 +77,11 @@ UvLookup::UvLookup(const Model& model, int cells) : model_(&model) {
     }
 }
 
-std::optional<UvLookup::Hit> UvLookup::find(glm::dvec2 uv) const {
+template <class Visit>
+void UvLookup::visit(glm::dvec2 uv, Visit&& onHit) const {
     if (!std::isfinite(uv.x) || !std::isfinite(uv.y) || uv.x < 0.0 || uv.y < 0.0 || uv.x > 1.0 ||
         uv.y > 1.0)
-        return std::nullopt;
+        return;
     const int cx = std::min(cells_ - 1, static_cast<int>(uv.x * cells_));
     const int cy = std::min(cells_ - 1, static_cast<int>(uv.y * cells_));
     constexpr double kEps = 1e-7;
@@ -92,9 +93,26 @@ std::optional<UvLookup::Hit> UvLookup::find(glm::dvec2 uv) const {
                                    glm::dvec2(p.uvs[p.indices[base + 1]]),
                                    glm::dvec2(p.uvs[p.indices[base + 2]]));
         if (!b || b->x < -kEps || b->y < -kEps || b->z < -kEps) continue;
-        return Hit{tri.part, tri.triangle, glm::vec3(*b), tri.chart};
+        if (!onHit(Hit{tri.part, tri.triangle, glm::vec3(*b), tri.chart})) return;
     }
-    return std::nullopt;
+}
+
+std::optional<UvLookup::Hit> UvLookup::find(glm::dvec2 uv) const {
+    std::optional<Hit> out;
+    visit(uv, [&](const Hit& h) {
+        out = h;
+        return false;
+    });
+    return out;
+}
+
+std::vector<UvLookup::Hit> UvLookup::findAll(glm::dvec2 uv) const {
+    std::vector<Hit> out;
+    visit(uv, [&](const Hit& h) {
+        out.push_back(h);
+        return true;
+    });
+    return out;
 }
 
 glm::vec3 UvLookup::position(const Hit& h) const {

@@ -6,7 +6,7 @@
 // tests the triangles of one cell exactly (barycentric coordinates, a small tolerance on the
 // edges). Charts are the connected components of triangles sharing vertex indices within a part
 // (glTF duplicates vertices along UV seams, so a chart is a piece of the atlas). Where the atlas
-// overlaps itself (palette textures) the first triangle found is returned.
+// overlaps itself (palette textures) find returns the first triangle found, findAll all of them.
 //
 // Pure; immutable after construction, so concurrent queries are safe. Holds a pointer to the
 // model: it must outlive the lookup. Positions are in glTF bind space (the rest mesh).
@@ -36,6 +36,10 @@ public:
 
     /// The triangle covering `uv`, or nullopt where no chart is (or uv is not finite).
     std::optional<Hit> find(glm::dvec2 uv) const;
+    /// Every triangle covering `uv`, in the order find() tries them (find() answers the first):
+    /// more than one where the atlas overlaps itself (palette swatches, mirrored islands) or on
+    /// a shared edge. Empty where find() answers nullopt. Zero-area triangles are never found.
+    std::vector<Hit> findAll(glm::dvec2 uv) const;
     /// The rest-mesh position at a hit (bind space).
     glm::vec3 position(const Hit& h) const;
     /// The skin weight of node `node` at a hit: the corners' weights blended barycentrically.
@@ -43,6 +47,9 @@ public:
     int chartCount() const { return chartCount_; }
 
 private:
+    /// Calls onHit(Hit) for each triangle covering uv, in grid order, until it returns false.
+    template <class Visit>
+    void visit(glm::dvec2 uv, Visit&& onHit) const;
     struct Tri {
         int part, triangle, chart;
     };

@@ -325,6 +325,7 @@ class Converter {
 
         MeshPart part;
         part.name = name;
+        part.node = g_.nodes[static_cast<std::size_t>(nodeIndex)].name;
         part.material = prim.material;
 
         // POSITION

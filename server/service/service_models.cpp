@@ -2,7 +2,9 @@
 // base-colour texture.
 #include "service/service_state.hpp"
 
+#include "core/model_derived.hpp"
 #include "core/preview.hpp"
+#include "core/uv_diagnosis.hpp"
 #include "io/frame_io.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/sha256.hpp"
@@ -57,6 +59,66 @@ json modelSummary(const ModelEntry& e) {
             {"has_uvs", e.model->hasUVs()},
             {"has_texture", e.model->dominantBaseColorImage() >= 0},
             {"bytes", e.bytes}};
+}
+
+/// At most this many regions each region's "shares_with" names (the rest are counted).
+constexpr std::size_t kSharesWithNames = 8;
+
+/// x rounded to 1/scale (scale a power of ten: the decimal digits print as they read).
+double roundedTo(double x, double scale) { return std::round(x * scale) / scale; }
+
+/// The `uv` member of GET /models/{id}: the model's UV diagnosis (SPEC §8, core uv_diagnosis).
+json uvSummary(const UvDiagnosis& d) {
+    json sharing = json::array();
+    std::vector<std::size_t> order;
+    for (std::size_t r = 0; r < d.regions.size(); ++r)
+        if (d.regions[r].sharedTexels > 0) order.push_back(r);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return d.regions[a].sharedTexels > d.regions[b].sharedTexels;
+    });
+    for (std::size_t r : order) {
+        const UvRegion& region = d.regions[r];
+        json with = json::array();
+        for (std::size_t k = 0; k < region.sharesWith.size() && k < kSharesWithNames; ++k)
+            with.push_back({{"region", d.regions[static_cast<std::size_t>(region.sharesWith[k].first)].name},
+                            {"texels", region.sharesWith[k].second}});
+        sharing.push_back({{"region", region.name},
+                           {"part", region.part},
+                           {"joint", region.joint.empty() ? json() : json(region.joint)},
+                           {"texels", region.texels},
+                           {"shared_texels", region.sharedTexels},
+                           {"folded_texels", region.foldedTexels},
+                           {"shares_with", std::move(with)},
+                           {"shares_with_more", region.sharesWith.size() > kSharesWithNames
+                                                    ? region.sharesWith.size() - kSharesWithNames
+                                                    : 0}});
+    }
+    json mirrored = json::array();
+    for (const UvMirroredPair& p : d.mirroredPairs)
+        mirrored.push_back({{"regions", {d.regions[static_cast<std::size_t>(p.regionA)].name,
+                                         d.regions[static_cast<std::size_t>(p.regionB)].name}},
+                            {"islands", p.islandPairs},
+                            {"triangles", {p.trianglesA, p.trianglesB}}});
+    json density = json::array();
+    for (const UvJointDensity& j : d.density)
+        density.push_back({{"joint", j.joint},
+                           {"triangles", j.triangles},
+                           {"texels_per_unit", roundedTo(j.texelsPerUnit, 10.0)}});
+    return {{"has_uvs", d.hasUVs},
+            {"usable", d.usable()},
+            {"resolution", d.resolution},
+            {"used_fraction", roundedTo(d.usedFraction, 1e5)},
+            {"overlap_fraction", roundedTo(d.overlapFraction, 1e5)},
+            {"used_texels", d.usedTexels},
+            {"overlap_texels", d.overlapTexels},
+            {"islands", d.islands},
+            {"triangles", d.triangles},
+            {"missing", {{"parts", d.partsWithoutUvs}, {"triangles", d.missingTriangles}}},
+            {"out_of_range", {{"vertices", d.outOfRangeVertices}, {"triangles", d.outOfRangeTriangles}}},
+            {"summary", d.describeSharing()},
+            {"sharing", std::move(sharing)},
+            {"mirrored_pairs", std::move(mirrored)},
+            {"density", std::move(density)}};
 }
 
 /// The content address of a .gltf with its files: the SHA-256 over the main file's name, then
@@ -176,11 +238,15 @@ Result<json> Service::State::addModelEntry(ModelEntry e,
 }
 
 Result<json> Service::getModel(const std::string& id) const {
-    std::shared_lock<std::shared_mutex> lock(state_->mutex);
-    auto it = state_->models.find(id);
-    if (it == state_->models.end()) return notFound("id", "no model \"" + id + "\"");
-    const Model& m = *it->second.model;
-    json out = modelSummary(it->second);
+    ModelEntry entry; // a copy (shared pointers): the diagnosis is built without the lock
+    {
+        std::shared_lock<std::shared_mutex> lock(state_->mutex);
+        auto it = state_->models.find(id);
+        if (it == state_->models.end()) return notFound("id", "no model \"" + id + "\"");
+        entry = it->second;
+    }
+    const Model& m = *entry.model;
+    json out = modelSummary(entry);
     json joints = json::array();
     for (int n : m.joints) {
         const Node& node = m.nodes[static_cast<std::size_t>(n)];
@@ -199,6 +265,10 @@ Result<json> Service::getModel(const std::string& id) const {
     out["joints"] = std::move(joints);
     out["clips"] = std::move(clips);
     out["vertices"] = vertices;
+    // Built once per model entry (ids are content addresses: cached by content), then shared
+    // with lint and the picks.
+    const auto derived = entry.derived ? entry.derived->get(entry.model) : std::make_shared<const ModelDerived>(entry.model);
+    out["uv"] = uvSummary(derived->uvDiagnosis());
     return out;
 }
 
