@@ -4,7 +4,8 @@
 //   (default 5 repetitions after one unmeasured run; models: the built-in default character and
 //   ../shared's CesiumMan, RiggedFigure and KayKit Barbarian, each also subdivided once (×4
 //   triangles, core subdivideModel), and the default character subdivided twice (×16, ≈ 69k
-//   triangles) — or the --model files given, as they are; --png writes DIR/layout-<model>.png,
+//   triangles) — or the --model files given, subdivided L times with --subdivide (×4^L triangles);
+//   --cone sets LayoutGenOptions::coneDegrees; --png writes DIR/layout-<model>.png,
 //   each chart filled in a colour of its own, 1024²)
 //
 // Per model: triangles, parts, the median and the smallest of the generation times (ms, the
@@ -144,11 +145,13 @@ Model subdivided(const Model& m, int levels) {
 } // namespace
 
 int main(int argc, char** argv) {
-    int repeat = 5;
+    int repeat = 5, levels = 0;
     std::vector<std::string> paths;
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
             repeat = std::max(1, std::atoi(argv[++i]));
+        } else if (std::strcmp(argv[i], "--subdivide") == 0 && i + 1 < argc) {
+            levels = std::atoi(argv[++i]);
         } else if (std::strcmp(argv[i], "--cone") == 0 && i + 1 < argc) {
             options.coneDegrees = std::atof(argv[++i]);
         } else if (std::strcmp(argv[i], "--png") == 0 && i + 1 < argc) {
@@ -156,14 +159,15 @@ int main(int argc, char** argv) {
         } else if (std::strcmp(argv[i], "--model") == 0 && i + 1 < argc) {
             paths.emplace_back(argv[++i]);
         } else {
-            std::cerr << "usage: dermis-layoutbench [--repeat N] [--cone DEGREES] [--png DIR] [--model PATH]…\n";
+            std::cerr << "usage: dermis-layoutbench [--repeat N] [--cone DEGREES] [--png DIR] [--model PATH [--subdivide L]]…\n";
             return 2;
         }
     }
     json results = json::array();
     if (!paths.empty()) {
         for (const std::string& p : paths)
-            results.push_back(benchModel(p, load(p), repeat));
+            results.push_back(benchModel(levels ? p + " ×" + std::to_string(1 << (2 * levels)) : p,
+                                         subdivided(load(p), levels), repeat));
     } else {
         const std::string shared = std::string(DERMIS_SHARED_DIR) + "/models/";
         const std::vector<std::pair<std::string, std::string>> models = {
