@@ -8,7 +8,9 @@
 // [0,1]², no flipped triangle, 0 texels of a 1024² map covered by two triangles, ≥ 4 free texels
 // (the default gutter) between texels touched by different charts and along the border, area
 // stretch and chart density near the layout's mean, byte-identical output for the same input.
-// Also where charts split (UV seams, creases) and the refusals. Loads glTF through io (no GL).
+// Also where charts split (UV seams, creases), a triangle soup that fits and one that cannot get
+// its gutters, another resolution and gutter, the core's LSCM and grid packing on their own, and
+// the refusals. Loads glTF through io (no GL).
 #include "core/layout_gen.hpp"
 #include "core/uv_flatten.hpp"
 #include "core/uv_pack.hpp"
@@ -435,7 +437,10 @@ TEST(LayoutGenTest, RefusesBadOptionsAndModels) {
     o.resolution = 16;
     EXPECT_EQ(field(o), "resolution");
     o = {};
-    o.gutterTexels = 0;
+    o.gutterTexels = 1;
+    EXPECT_EQ(field(o), "gutterTexels");
+    o = {};
+    o.gutterTexels = 65; // over resolution / 16
     EXPECT_EQ(field(o), "gutterTexels");
     o = {};
     o.coneDegrees = 90;
@@ -456,6 +461,34 @@ TEST(LayoutGenTest, RefusesBadOptionsAndModels) {
     bad.parts[0].indices.pop_back();
     EXPECT_FALSE(generateTextureLayout(bad));
     EXPECT_FALSE(generateTextureLayout(Model{}));
+}
+
+/// `n` separate triangles (a soup): every one its own chart.
+MeshPart soup(int n) {
+    MeshPart p;
+    for (int i = 0; i < n; ++i) {
+        const float x = static_cast<float>(i % 50), y = static_cast<float>(i / 50);
+        const auto b = static_cast<std::uint32_t>(p.positions.size());
+        p.positions.insert(p.positions.end(), {{x, y, 0}, {x + 0.5f, y, 0}, {x, y + 0.5f, 0.1f * static_cast<float>(i % 7)}});
+        p.indices.insert(p.indices.end(), {b, b + 1, b + 2});
+    }
+    return p;
+}
+
+TEST(LayoutGenTest, ASoupFitsUntilTheGuttersDoNot) {
+    // At 256² with 4-texel gutters a chart takes at least 5 × 5 texels: 2,540 fit at most.
+    LayoutGenOptions o;
+    o.resolution = 256;
+    auto fits = generateTextureLayoutWithReport(modelOf(soup(500)), o);
+    ASSERT_TRUE(fits) << fits.error().message;
+    EXPECT_EQ(fits->charts, 500u);
+    EXPECT_EQ(fits->check.overlapTexels, 0);
+    EXPECT_GE(fits->check.minGutterTexels, 4);
+    auto full = generateTextureLayout(modelOf(soup(3000)), o);
+    ASSERT_FALSE(full);
+    EXPECT_EQ(full.error().code, ErrorCode::Unsupported);
+    EXPECT_NE(full.error().message.find("3000 charts do not fit"), std::string::npos)
+        << full.error().message;
 }
 
 TEST(LayoutGenTest, OtherGutterAndResolution) {

@@ -26,8 +26,8 @@ Error invalid(const std::string& field, const std::string& what) {
 std::optional<Error> checkInput(const Model& model, const LayoutGenOptions& o) {
     if (o.resolution < 64 || o.resolution > 16384)
         return invalid("resolution", "must be in [64, 16384], got " + std::to_string(o.resolution));
-    if (o.gutterTexels < 1 || o.gutterTexels > o.resolution / 16)
-        return invalid("gutterTexels", "must be in [1, resolution/16], got " +
+    if (o.gutterTexels < 2 || o.gutterTexels > o.resolution / 16)
+        return invalid("gutterTexels", "must be in [2, resolution/16], got " +
                                            std::to_string(o.gutterTexels));
     if (!(o.creaseDegrees > 0 && o.creaseDegrees <= 180))
         return invalid("creaseDegrees", "must be in (0, 180]");

@@ -18,13 +18,18 @@
 //      (two seeds far apart, breadth-first) and each half retried — a single triangle always
 //      flattens;
 //   4. every chart at one density (texels per metre), turned to its smallest bounding box and
-//      packed on the texel grid (core/uv_pack.hpp skylinePackGrid) with gutterTexels free
-//      texels between charts and along the border, at the largest density that fits (bisection);
-//      degenerate triangles get one-texel cells of their own in a grid packed like a chart;
+//      packed on the texel grid with gutterTexels free texels between charts and along the
+//      border, at the largest density that fits (bisection): as boxes (core/uv_pack.hpp
+//      skylinePackGrid), then by their outlines (the rows each touches per column dropped onto a
+//      horizon, Lévy et al. 2002 §6) where that fits more; degenerate triangles get one-texel
+//      cells of their own in a lattice packed like a chart;
 //   5. verified (checkTextureLayout): UVs in [0,1], no flip, no texel of two charts, gutters.
 //
-// Pure (no GL, no I/O, no threads). Does not cache (the Service keeps layouts per model) and
-// does not orient charts by body direction (the default character's own atlas does).
+// Pure (no GL, no I/O, no threads, no state: safe to call from several threads). Bit-identical
+// output for the same model data and the same build (no FMA contraction on x86-64). Does not
+// cache (the Service keeps layouts per model) and does not orient charts by body direction (the
+// default character's own atlas does). Fails when the charts cannot all get their gutters
+// (roughly more than resolution² / (gutterTexels + 1)² charts: a triangle soup).
 #pragma once
 
 #include "model.hpp"
@@ -38,8 +43,9 @@ namespace dermis {
 
 struct LayoutGenOptions {
     int resolution = 1024;  ///< the map side the gutters are measured at, [64, 16384]
-    /// Free texels around each chart at `resolution`, between charts and along the border
-    /// ([1, resolution/16]; ≥ 2 for bilinear sampling; halves per mip level).
+    /// Free texels around each chart at `resolution`, between charts and along the border,
+    /// [2, resolution/16] (bilinear sampling needs 1 at the level sampled; halves per mip level:
+    /// 4 at 1024² keeps mip levels 0–2 apart).
     int gutterTexels = 4;
     double creaseDegrees = 75.0; ///< dihedral angle above which an edge is a chart boundary, (0, 180]
     /// A chart's triangle normals stay within this angle of its seed's and its running mean

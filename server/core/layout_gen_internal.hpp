@@ -7,7 +7,9 @@
 //   * layout_flatten.cpp: each chart flattened by LSCM and checked (no flip, no boundary crossing,
 //     bounded area stretch), split in two and retried where a check fails;
 //   * layout_pack.cpp: charts scaled to one texel density, turned to their smallest box, packed
-//     on the texel grid with gutters (degenerate triangles in a grid of one-texel cells).
+//     on the texel grid with gutters, as boxes and by outline (degenerate triangles in a lattice
+//     of one-texel cells);
+//   * layout_check.cpp: checkTextureLayout (public, layout_gen.hpp), the final verification.
 // Not included outside these files. Nothing here fails: every chart ends flattened (a single
 // triangle always is) and packing returns false only when nothing fits at any density.
 #pragma once
@@ -105,10 +107,10 @@ struct Packing {
     int degenerateColumns = 0;       ///< cells per row of that grid
 };
 
-/// Turns each chart to its smallest bounding box and packs all of them (and a grid of
+/// Turns each chart to its smallest bounding box and packs all of them (and a lattice of
 /// `degenerateCount` one-texel cells) into options.resolution² texels with options.gutterTexels
-/// free texels between charts and along the border, at the largest density found that fits.
-/// False when nothing fits (more charts than texels).
+/// free texels between charts and along the border, at the largest density found that fits
+/// (layout_pack.cpp says how). False when the charts do not fit at any density.
 bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCount,
                 const LayoutGenOptions& options, Packing& packing);
 

@@ -1,10 +1,14 @@
 // Dermis core — the generated layout's packing (layout_gen_internal.hpp): each chart turned to
-// its smallest bounding box (rotating calipers over its convex hull), mirrored to v-down, then
-// all of them packed on the texel grid (core/uv_pack.hpp skylinePackGrid) at one density, the
-// largest that fits (bisection). A chart of extent w×h texels takes floor(w)+1 × floor(h)+1
-// cells, centred in them, plus gutterTexels cells on its right and upper side; the packed area
-// starts gutterTexels cells from the border, so every chart has that many free texels on every
-// side.
+// its smallest bounding box (rotating calipers over its convex hull) and mirrored to v-down, then
+// packed on the texel grid at one density (texels per metre), the largest found by bisection:
+//   1. boxes (core/uv_pack.hpp skylinePackGrid): a chart of extent w×h texels takes
+//      floor(w + 0.05) + 1 × floor(h + 0.05) + 1 cells, centred in them, plus gutterTexels cells
+//      on its right and upper side, in a square that starts gutterTexels cells from the border;
+//   2. outlines (horizonPack, up to kMaxHorizonCharts charts): the rows each chart touches per
+//      column, dropped onto a horizon in any of four quarter turns, from the boxes' density up
+//      to 1.3 times it; kept when it reaches a higher density than the boxes.
+// Either way every chart has gutterTexels free texels on every side (closed texel squares, with a
+// margin for the float rounding of the final UVs).
 #include "layout_gen_internal.hpp"
 
 #include "uv_pack.hpp"
@@ -266,6 +270,10 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
     return true;
 }
 
+/// Above this many charts only boxes are packed (horizon packing costs charts × width × 4 per
+/// density tried; a model in thousands of pieces gains little from outlines).
+constexpr std::size_t kMaxHorizonCharts = 3000;
+
 } // namespace
 
 bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCount,
@@ -316,7 +324,7 @@ bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCoun
     glm::ivec2 gridAt(0), bestGridAt(0);
     int gridTurns = 0, bestGridTurns = 0;
     double horizonDensity = 0.0;
-    if (boxDensity > 0) {
+    if (boxDensity > 0 && charts.size() <= kMaxHorizonCharts) {
         double a = boxDensity, b = boxDensity * 1.3;
         if (horizonPack(charts, frames, gridCells, res, g, a, placed, gridAt, gridTurns)) {
             horizonDensity = a;
