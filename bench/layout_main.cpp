@@ -23,8 +23,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -41,7 +41,9 @@ using json = nlohmann::json;
 
 namespace {
 
-double round3(double v) { return std::round(v * 1000) / 1000; }
+double round3(double v) {
+    return std::round(v * 1000) / 1000;
+}
 
 /// A picture of the layout: each chart's triangles filled in a colour of its own (texel centres
 /// inside), on black.
@@ -60,8 +62,10 @@ void writePicture(const Model& model, const GeneratedLayout& g, const std::strin
                                          static_cast<std::uint8_t>(64 + ((h >> 16) & 127))};
             glm::dvec2 q[3];
             for (int i = 0; i < 3; ++i)
-                q[i] = glm::dvec2(pl.uvs[pl.indices[3 * t + static_cast<std::size_t>(i)]]) * double(n);
-            const glm::dvec2 lo = glm::min(q[0], glm::min(q[1], q[2])), hi = glm::max(q[0], glm::max(q[1], q[2]));
+                q[i] =
+                    glm::dvec2(pl.uvs[pl.indices[3 * t + static_cast<std::size_t>(i)]]) * double(n);
+            const glm::dvec2 lo = glm::min(q[0], glm::min(q[1], q[2])),
+                             hi = glm::max(q[0], glm::max(q[1], q[2]));
             for (int y = std::max(0, int(lo.y)); y <= std::min(n - 1, int(hi.y)); ++y)
                 for (int x = std::max(0, int(lo.x)); x <= std::min(n - 1, int(hi.x)); ++x) {
                     const glm::dvec2 p(x + 0.5, y + 0.5);
@@ -70,7 +74,9 @@ void writePicture(const Model& model, const GeneratedLayout& g, const std::strin
                         return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
                     };
                     if (side(0) > 0 || side(1) > 0 || side(2) > 0) continue;
-                    std::uint8_t* px = &img.rgba[(static_cast<std::size_t>(y) * n + static_cast<std::size_t>(x)) * 4];
+                    std::uint8_t* px =
+                        &img.rgba[(static_cast<std::size_t>(y) * n + static_cast<std::size_t>(x)) *
+                                  4];
                     px[0] = rgb[0];
                     px[1] = rgb[1];
                     px[2] = rgb[2];
@@ -81,7 +87,8 @@ void writePicture(const Model& model, const GeneratedLayout& g, const std::strin
     auto png = encodePng(img, false);
     if (png) {
         std::ofstream out(path, std::ios::binary);
-        out.write(reinterpret_cast<const char*>(png->data()), static_cast<std::streamsize>(png->size()));
+        out.write(reinterpret_cast<const char*>(png->data()),
+                  static_cast<std::streamsize>(png->size()));
     }
 }
 
@@ -104,11 +111,12 @@ json benchModel(const std::string& label, const Model& model, int repeat) {
         const double c0 = threadCpuMs();
         made = generateTextureLayoutWithReport(model, options);
         cpu.push_back(threadCpuMs() - c0);
-        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                         .count());
+        ms.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count());
     }
-    json out = {{"model", label}, {"triangles", model.triangleCount()},
-                {"parts", model.parts.size()}};
+    json out = {
+        {"model", label}, {"triangles", model.triangleCount()}, {"parts", model.parts.size()}};
     if (!made) {
         out["error"] = made.error().message;
         return out;
@@ -175,7 +183,8 @@ int main(int argc, char** argv) {
         } else if (std::strcmp(argv[i], "--model") == 0 && i + 1 < argc) {
             paths.emplace_back(argv[++i]);
         } else {
-            std::cerr << "usage: dermis-layoutbench [--repeat N] [--cone DEGREES] [--png DIR] [--model PATH [--subdivide L]]…\n";
+            std::cerr << "usage: dermis-layoutbench [--repeat N] [--cone DEGREES] [--png DIR] "
+                         "[--model PATH [--subdivide L]]…\n";
             return 2;
         }
     }
@@ -196,7 +205,8 @@ int main(int argc, char** argv) {
             const Model m = load(path);
             results.push_back(benchModel(label, m, repeat));
             results.push_back(benchModel(label + " ×4", subdivided(m, 1), repeat));
-            if (label == "default") results.push_back(benchModel(label + " ×16", subdivided(m, 2), repeat));
+            if (label == "default")
+                results.push_back(benchModel(label + " ×16", subdivided(m, 2), repeat));
         }
     }
     std::cout << json{{"layout", results}, {"repetitions", repeat}}.dump(2) << "\n";

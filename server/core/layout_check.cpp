@@ -86,15 +86,16 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
         });
         std::vector<std::uint32_t> point(pl.uvs.size());
         for (std::size_t i = 0; i < order.size(); ++i)
-            point[order[i]] = i > 0 && bits(order[i]) == bits(order[i - 1]) ? point[order[i - 1]]
-                                                                              : order[i];
+            point[order[i]] =
+                i > 0 && bits(order[i]) == bits(order[i - 1]) ? point[order[i - 1]] : order[i];
         std::vector<std::int64_t> firstTri(pl.uvs.size(), -1);
         for (std::size_t t = 0; t < nt; ++t) {
             Tri tri;
             bool ok = true, inside = true;
             for (int c = 0; c < 3; ++c) {
                 const std::uint32_t v = pl.indices[3 * t + static_cast<std::size_t>(c)];
-                if (v >= pl.uvs.size() || pl.source[v] != part.indices[3 * t + static_cast<std::size_t>(c)] ||
+                if (v >= pl.uvs.size() ||
+                    pl.source[v] != part.indices[3 * t + static_cast<std::size_t>(c)] ||
                     pl.source[v] >= part.positions.size()) {
                     ok = false;
                     break;
@@ -142,7 +143,8 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
         for (int c = 0; c < 3; ++c)
             q[c] = t.uv[c] * static_cast<double>(n);
         const bool solid = signedArea(q[0], q[1], q[2]) != 0;
-        const double ylo = std::min({q[0].y, q[1].y, q[2].y}), yhi = std::max({q[0].y, q[1].y, q[2].y});
+        const double ylo = std::min({q[0].y, q[1].y, q[2].y}),
+                     yhi = std::max({q[0].y, q[1].y, q[2].y});
         const int j0 = std::clamp(static_cast<int>(std::ceil(ylo)) - 1, 0, n - 1),
                   j1 = std::clamp(static_cast<int>(std::floor(yhi)), 0, n - 1);
         const int id = static_cast<int>(t.chart);
@@ -155,7 +157,8 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
                 if (a.y > b.y) std::swap(a, b);
                 if (b.y < j || a.y > j + 1) continue;
                 if (b.y > a.y) {
-                    for (double y : {std::clamp<double>(j, a.y, b.y), std::clamp<double>(j + 1, a.y, b.y)}) {
+                    for (double y :
+                         {std::clamp<double>(j, a.y, b.y), std::clamp<double>(j + 1, a.y, b.y)}) {
                         const double x = a.x + (b.x - a.x) * ((y - a.y) / (b.y - a.y));
                         xlo = std::min(xlo, x);
                         xhi = std::max(xhi, x);

@@ -29,11 +29,11 @@ namespace dermis::layout_detail {
 /// One part welded by position (bit-equal positions are one vertex), with per-triangle data and
 /// adjacency across inner edges.
 struct PartMesh {
-    std::vector<glm::dvec3> positions;   ///< welded vertices
-    std::vector<glm::uvec3> tris;        ///< welded triangles, in the part's triangle order
-    std::vector<glm::dvec3> normals;     ///< unit face normals (0 for degenerate triangles)
-    std::vector<double> areas;           ///< face areas
-    std::vector<char> degenerate;        ///< repeated welded vertex or (near-)zero area
+    std::vector<glm::dvec3> positions; ///< welded vertices
+    std::vector<glm::uvec3> tris;      ///< welded triangles, in the part's triangle order
+    std::vector<glm::dvec3> normals;   ///< unit face normals (0 for degenerate triangles)
+    std::vector<double> areas;         ///< face areas
+    std::vector<char> degenerate;      ///< repeated welded vertex or (near-)zero area
     /// adj[t][c]: triangle across edge (t[c], t[c+1]) when that edge is an inner edge (exactly
     /// two triangles, opposite directions, same UVs on both sides, dihedral ≤ crease, neither
     /// degenerate), else −1.
@@ -54,12 +54,12 @@ std::vector<std::vector<std::uint32_t>> growCharts(const PartMesh& mesh,
 /// A chart's triangles as a local mesh: corners united across inner edges between member
 /// triangles, so the chart's boundary and any non-manifold vertex split its vertices.
 struct LocalChart {
-    std::vector<std::uint32_t> tris;       ///< part triangle ids (ascending)
-    std::vector<std::uint32_t> welded;     ///< local vertex → welded vertex
-    std::vector<glm::uvec3> local;         ///< per member triangle, local vertices
+    std::vector<std::uint32_t> tris;                    ///< part triangle ids (ascending)
+    std::vector<std::uint32_t> welded;                  ///< local vertex → welded vertex
+    std::vector<glm::uvec3> local;                      ///< per member triangle, local vertices
     std::vector<std::array<std::uint32_t, 2>> boundary; ///< directed boundary edges (local)
-    int loops = 0;                         ///< boundary loops
-    int euler = 0;                         ///< V − E + F
+    int loops = 0;                                      ///< boundary loops
+    int euler = 0;                                      ///< V − E + F
     bool isDiskLike() const { return loops >= 1 && (2 - euler - loops) == 0; } ///< genus 0
 };
 
@@ -71,9 +71,8 @@ LocalChart buildLocalChart(const PartMesh& mesh, std::vector<std::uint32_t> tris
 /// piece of its first triangle and the rest; a connected one into two connected halves grown
 /// from two far-apart seeds (two-source Dijkstra over inner edges, centroid distances).
 /// Precondition: tris.size() ≥ 2. `member` as for buildLocalChart.
-std::array<std::vector<std::uint32_t>, 2> splitChart(const PartMesh& mesh,
-                                                     const std::vector<std::uint32_t>& tris,
-                                                     std::vector<int>& member);
+std::array<std::vector<std::uint32_t>, 2>
+splitChart(const PartMesh& mesh, const std::vector<std::uint32_t>& tris, std::vector<int>& member);
 
 // --- flattening (layout_flatten.cpp) ------------------------------------------------------------
 
@@ -102,9 +101,9 @@ struct Placement {
 };
 struct Packing {
     std::vector<Placement> charts;
-    double texelsPerMetre = 0.0;     ///< density at options.resolution
-    glm::ivec2 degenerateCell{0};    ///< lower corner (texels) of the degenerate grid
-    int degenerateColumns = 0;       ///< cells per row of that grid
+    double texelsPerMetre = 0.0;  ///< density at options.resolution
+    glm::ivec2 degenerateCell{0}; ///< lower corner (texels) of the degenerate grid
+    int degenerateColumns = 0;    ///< cells per row of that grid
 };
 
 /// Turns each chart to its smallest bounding box and packs all of them (and a lattice of

@@ -27,8 +27,9 @@ double cross2(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
 
 /// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear points.
 std::vector<glm::dvec2> hull(std::vector<glm::dvec2> p) {
-    std::sort(p.begin(), p.end(),
-              [](const glm::dvec2& a, const glm::dvec2& b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+    std::sort(p.begin(), p.end(), [](const glm::dvec2& a, const glm::dvec2& b) {
+        return a.x != b.x ? a.x < b.x : a.y < b.y;
+    });
     p.erase(std::unique(p.begin(), p.end()), p.end());
     if (p.size() < 3) return p;
     std::vector<glm::dvec2> h(2 * p.size());
@@ -138,14 +139,16 @@ Profile profileOf(const FlatChart& chart, const Placed& p, glm::ivec2 cells, dou
     pr.bottom.assign(static_cast<std::size_t>(cells.x), cells.y);
     pr.top.assign(static_cast<std::size_t>(cells.x), 0);
     for (const auto& e : chart.chart.boundary) {
-        glm::dvec2 u = p.origin + p.linear * chart.uv[e[0]], w = p.origin + p.linear * chart.uv[e[1]];
+        glm::dvec2 u = p.origin + p.linear * chart.uv[e[0]],
+                   w = p.origin + p.linear * chart.uv[e[1]];
         if (u.x > w.x) std::swap(u, w);
         const int i0 = std::max(static_cast<int>(std::ceil(u.x - eps)) - 1, 0),
                   i1 = std::min(static_cast<int>(std::floor(w.x + eps)), cells.x - 1);
         for (int i = i0; i <= i1; ++i) {
             double ylo, yhi;
             if (w.x > u.x) {
-                const double xa = std::clamp<double>(i, u.x, w.x), xb = std::clamp<double>(i + 1, u.x, w.x);
+                const double xa = std::clamp<double>(i, u.x, w.x),
+                             xb = std::clamp<double>(i + 1, u.x, w.x);
                 const double ya = u.y + (w.y - u.y) * ((xa - u.x) / (w.x - u.x)),
                              yb = u.y + (w.y - u.y) * ((xb - u.x) / (w.x - u.x));
                 ylo = std::min(ya, yb);
@@ -155,8 +158,10 @@ Profile profileOf(const FlatChart& chart, const Placed& p, glm::ivec2 cells, dou
                 yhi = std::max(u.y, w.y);
             }
             const auto col = static_cast<std::size_t>(i);
-            pr.bottom[col] = std::min(pr.bottom[col], std::max(static_cast<int>(std::ceil(ylo - eps)) - 1, 0));
-            pr.top[col] = std::max(pr.top[col], std::min(static_cast<int>(std::floor(yhi + eps)) + 1, cells.y));
+            pr.bottom[col] =
+                std::min(pr.bottom[col], std::max(static_cast<int>(std::ceil(ylo - eps)) - 1, 0));
+            pr.top[col] = std::max(pr.top[col],
+                                   std::min(static_cast<int>(std::floor(yhi + eps)) + 1, cells.y));
         }
     }
     return pr;
@@ -177,9 +182,10 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
     std::vector<std::size_t> order(n);
     for (std::size_t i = 0; i < n; ++i)
         order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
     constexpr int kEmpty = std::numeric_limits<int>::max() / 4; // bottom of an empty column
-    const double eps = std::max(1e-3, res * 2.5e-7);                // ≈ 4 float ulps of a UV
+    const double eps = std::max(1e-3, res * 2.5e-7);            // ≈ 4 float ulps of a UV
     std::vector<int> horizon(static_cast<std::size_t>(res), g);
     out.assign(charts.size(), Placed{});
     Profile profiles[4];
@@ -204,8 +210,10 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
             int height = 0;
             for (int i = 0; i < pr.cells.x; ++i) {
                 const auto col = static_cast<std::size_t>(i);
-                if (pr.bottom[col] >= pr.top[col]) pr.bottom[col] = kEmpty;
-                else height = std::max(height, pr.top[col]);
+                if (pr.bottom[col] >= pr.top[col])
+                    pr.bottom[col] = kEmpty;
+                else
+                    height = std::max(height, pr.top[col]);
             }
             const int* b = pr.bottom.data();
             int highestBottom = 0;
@@ -217,11 +225,14 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
             std::size_t head = 0;
             deque.clear();
             for (int x = 0; x < res; ++x) {
-                while (deque.size() > head && horizon[static_cast<std::size_t>(deque.back())] <= horizon[static_cast<std::size_t>(x)])
+                while (deque.size() > head && horizon[static_cast<std::size_t>(deque.back())] <=
+                                                  horizon[static_cast<std::size_t>(x)])
                     deque.pop_back();
                 deque.push_back(x);
                 if (deque[head] <= x - w) ++head;
-                if (x >= w - 1) windowMax[static_cast<std::size_t>(x - w + 1)] = horizon[static_cast<std::size_t>(deque[head])];
+                if (x >= w - 1)
+                    windowMax[static_cast<std::size_t>(x - w + 1)] =
+                        horizon[static_cast<std::size_t>(deque[head])];
             }
             for (int x = g; x + pr.cells.x <= res - g; ++x) {
                 // The chart rests at y = max(horizon − bottom); give up on x as soon as it would
@@ -257,7 +268,8 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
             if (pr.bottom[col] == kEmpty) continue;
             const int h = bestY + pr.top[col] + g;
             for (int j = std::max(bestX + i - g, 0); j <= std::min(bestX + i + g, res - 1); ++j)
-                horizon[static_cast<std::size_t>(j)] = std::max(horizon[static_cast<std::size_t>(j)], h);
+                horizon[static_cast<std::size_t>(j)] =
+                    std::max(horizon[static_cast<std::size_t>(j)], h);
         }
         if (isGrid) {
             degenerateAt = {bestX, bestY};
@@ -291,7 +303,8 @@ bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCoun
         rows = static_cast<int>((degenerateCount + static_cast<std::size_t>(cols) - 1) /
                                 static_cast<std::size_t>(cols));
     }
-    const glm::ivec2 gridCells = degenerateCount > 0 ? glm::ivec2(cols + 1, rows + 1) : glm::ivec2(0);
+    const glm::ivec2 gridCells =
+        degenerateCount > 0 ? glm::ivec2(cols + 1, rows + 1) : glm::ivec2(0);
 
     // 1. Boxes (skylinePackGrid): fast, a density every layout reaches.
     const int side = res - g; // boxes carry their gutter on the right and upper side
@@ -333,7 +346,8 @@ bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCoun
             bestGridTurns = gridTurns;
             for (int it = 0; it < 7; ++it) {
                 const double mid = 0.5 * (a + b);
-                if (horizonPack(charts, frames, gridCells, res, g, mid, placed, gridAt, gridTurns)) {
+                if (horizonPack(charts, frames, gridCells, res, g, mid, placed, gridAt,
+                                gridTurns)) {
                     a = mid;
                     horizonDensity = mid;
                     bestPlaced = placed;
@@ -389,10 +403,14 @@ glm::dvec2 degenerateUv(const Packing& packing, const LayoutGenOptions& options,
     const std::size_t r = cell / cols;
     const double shift = 0.5 * static_cast<double>(r % 2);
     glm::dvec2 p;
-    if (corner == 0) p = {i + shift, static_cast<double>(r)};
-    else if (corner == 1) p = {i + shift + 0.5, static_cast<double>(r + 1)};
-    else p = {i + shift + 1.0, static_cast<double>(r)};
-    return (glm::dvec2(packing.degenerateCell) + p + 0.25) / static_cast<double>(options.resolution);
+    if (corner == 0)
+        p = {i + shift, static_cast<double>(r)};
+    else if (corner == 1)
+        p = {i + shift + 0.5, static_cast<double>(r + 1)};
+    else
+        p = {i + shift + 1.0, static_cast<double>(r)};
+    return (glm::dvec2(packing.degenerateCell) + p + 0.25) /
+           static_cast<double>(options.resolution);
 }
 
 } // namespace dermis::layout_detail

@@ -203,8 +203,9 @@ MapSingularValues mapSingularValues(const glm::dvec3& p0, const glm::dvec3& p1,
 
 // --- Tutte + ARAP -------------------------------------------------------------------------------
 
-std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart, const std::vector<std::uint32_t>& boundary,
-                                    std::string& note, int iterations) {
+std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart,
+                                    const std::vector<std::uint32_t>& boundary, std::string& note,
+                                    int iterations) {
     const std::size_t nv = chart.positions.size();
     const std::vector<std::uint32_t>& loop = boundary;
     const std::vector<glm::dvec3>& P = chart.positions;
@@ -286,7 +287,8 @@ std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart, const std::vector<st
     std::vector<std::array<glm::dvec2, 3>> iso(nt); // isometric local triangle
     std::vector<std::array<double, 3>> cot(nt);     // cot of the angle opposite edge (i, i+1)
     for (std::size_t t = 0; t < nt; ++t) {
-        const glm::dvec3 a = P[chart.triangles[t][0]], b = P[chart.triangles[t][1]], c = P[chart.triangles[t][2]];
+        const glm::dvec3 a = P[chart.triangles[t][0]], b = P[chart.triangles[t][1]],
+                         c = P[chart.triangles[t][2]];
         const glm::dvec3 e1 = glm::normalize(b - a);
         const glm::dvec3 nrm = glm::normalize(glm::cross(b - a, c - a));
         const glm::dvec3 e2 = glm::cross(nrm, e1);

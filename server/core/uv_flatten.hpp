@@ -76,8 +76,9 @@ struct ChartMesh {
 /// iterations were kept. Fails (empty result, `note` says why) when the Tutte embedding already
 /// flips (it cannot for a disk, up to solver accuracy). Precondition: the chart is a disk (one
 /// boundary loop, χ = 1) without degenerate triangles. Up to `iterations` ARAP steps.
-std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart, const std::vector<std::uint32_t>& boundary,
-                                    std::string& note, int iterations = 150);
+std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart,
+                                    const std::vector<std::uint32_t>& boundary, std::string& note,
+                                    int iterations = 150);
 
 /// Least-squares conformal map of a chart with boundary: minimises Σ_T A_T·|∇v − R90 ∇u|² with
 /// chart vertices pins[0], pins[1] held at pinUv[0], pinUv[1] (the map is then unique for a

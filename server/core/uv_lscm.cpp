@@ -101,7 +101,8 @@ std::vector<glm::dvec2> flattenLscm(const ChartMesh& chart, const std::uint32_t 
             if (idx[t[a]] >= 0)
                 for (int b = 0; b < 3; ++b)
                     if (idx[t[b]] >= 0)
-                        nb[static_cast<std::size_t>(idx[t[a]])].push_back(static_cast<std::uint32_t>(idx[t[b]]));
+                        nb[static_cast<std::size_t>(idx[t[a]])].push_back(
+                            static_cast<std::uint32_t>(idx[t[b]]));
     SimilarityRows m;
     m.rowStart.assign(nf + 1, 0);
     for (std::size_t i = 0; i < nf; ++i) {
@@ -167,7 +168,8 @@ std::vector<glm::dvec2> flattenLscm(const ChartMesh& chart, const std::uint32_t 
     solve(m, inv, rhs, x, maxIter, tol);
     for (std::size_t v = 0; v < n; ++v)
         if (idx[v] >= 0)
-            uv[v] = {x[2 * static_cast<std::size_t>(idx[v])], x[2 * static_cast<std::size_t>(idx[v]) + 1]};
+            uv[v] = {x[2 * static_cast<std::size_t>(idx[v])],
+                     x[2 * static_cast<std::size_t>(idx[v]) + 1]};
     return uv;
 }
 
