@@ -454,6 +454,8 @@ TEST(LayoutGenTest, RefusesBadOptionsAndModels) {
     LayoutGenOptions o;
     o.resolution = 16;
     EXPECT_EQ(field(o), "resolution");
+    o.resolution = 2 * kMaxHeightmapSize;
+    EXPECT_EQ(field(o), "resolution");
     o = {};
     o.gutterTexels = 1;
     EXPECT_EQ(field(o), "gutterTexels");

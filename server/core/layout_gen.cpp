@@ -24,8 +24,9 @@ Error invalid(const std::string& field, const std::string& what) {
 }
 
 std::optional<Error> checkInput(const Model& model, const LayoutGenOptions& o) {
-    if (o.resolution < 64 || o.resolution > 16384)
-        return invalid("resolution", "must be in [64, 16384], got " + std::to_string(o.resolution));
+    if (o.resolution < 64 || o.resolution > kMaxHeightmapSize)
+        return invalid("resolution", "must be in [64, " + std::to_string(kMaxHeightmapSize) +
+                                         "], got " + std::to_string(o.resolution));
     if (o.gutterTexels < 2 || o.gutterTexels > o.resolution / 16)
         return invalid("gutterTexels",
                        "must be in [2, resolution/16], got " + std::to_string(o.gutterTexels));

@@ -32,6 +32,7 @@
 // (roughly more than resolution² / (gutterTexels + 1)² charts: a triangle soup).
 #pragma once
 
+#include "heightmap.hpp"
 #include "model.hpp"
 #include "result.hpp"
 #include "texture_layout.hpp"
@@ -42,7 +43,7 @@
 namespace dermis {
 
 struct LayoutGenOptions {
-    int resolution = 1024; ///< the map side the gutters are measured at, [64, 16384]
+    int resolution = 1024; ///< the map side the gutters are measured at, [64, kMaxHeightmapSize]
     /// Free texels around each chart at `resolution`, between charts and along the border,
     /// [2, resolution/16] (bilinear sampling needs 1 at the level sampled; halves per mip level:
     /// 4 at 1024² keeps mip levels 0–2 apart).
@@ -82,7 +83,8 @@ struct LayoutCheck {
 };
 
 /// Measures `layout` of `model` (SPEC §8 acceptance of a generated layout). Works on any layout,
-/// the model's own included. Preconditions: resolution in [1, 16384], gutterCap ≥ 0.
+/// the model's own included. Memory: 4 bytes a texel. Preconditions: resolution in
+/// [1, kMaxHeightmapSize], gutterCap ≥ 0.
 LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, int resolution,
                                int gutterCap);
 
