@@ -108,6 +108,11 @@ PartMesh buildPartMesh(const MeshPart& part, const LayoutGenOptions& options) {
         return part
             .indices[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>((c + 3) % 3)];
     };
+    auto uvSolid = [&](std::uint32_t t) {
+        const glm::dvec2 a(part.uvs[corner(t, 0)]), b(part.uvs[corner(t, 1)]),
+            c(part.uvs[corner(t, 2)]);
+        return (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y) != 0.0;
+    };
     for (std::size_t i = 0; i < edges.size();) {
         std::size_t j = i;
         while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi)
@@ -117,7 +122,9 @@ PartMesh buildPartMesh(const MeshPart& part, const LayoutGenOptions& options) {
             // e1 runs a→b at corners (c1, c1+1); an opposite e2 runs b→a at (c2, c2+1).
             const bool opposite = mesh.tris[e1.t][e1.c] == mesh.tris[e2.t][(e2.c + 1) % 3];
             bool inner = opposite && e1.t != e2.t;
-            if (inner && hasUVs)
+            // A UV seam counts where both sides are unwrapped (non-zero UV area): a face whose
+            // UVs collapse to a point or a line (a palette swatch) says nothing about seams.
+            if (inner && hasUVs && uvSolid(e1.t) && uvSolid(e2.t))
                 inner = part.uvs[corner(e1.t, e1.c)] == part.uvs[corner(e2.t, e2.c + 1)] &&
                         part.uvs[corner(e1.t, e1.c + 1)] == part.uvs[corner(e2.t, e2.c)];
             if (inner) inner = glm::dot(mesh.normals[e1.t], mesh.normals[e2.t]) >= cosCrease;

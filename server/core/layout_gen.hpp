@@ -6,7 +6,7 @@
 // How (README "Generated height-map layout"; layout_gen_internal.hpp has the steps):
 //   1. per part, vertices welded by bit-equal position; an edge is a chart boundary where it is a
 //      border, non-manifold or inconsistently oriented, where the model's own UVs differ on its
-//      two sides (a UV seam), where the dihedral angle exceeds creaseDegrees, or next to a
+//      two sides (a UV seam; only where both sides have a UV area, not a palette swatch), where the dihedral angle exceeds creaseDegrees, or next to a
 //      degenerate triangle (repeated vertex or area ≤ 1e-6 · longest edge²);
 //   2. charts grown best-first over the other edges, each triangle within coneDegrees of the
 //      chart's seed normal and of its running mean normal (so every chart is a height field

@@ -35,8 +35,8 @@ struct PartMesh {
     std::vector<double> areas;         ///< face areas
     std::vector<char> degenerate;      ///< repeated welded vertex or (near-)zero area
     /// adj[t][c]: triangle across edge (t[c], t[c+1]) when that edge is an inner edge (exactly
-    /// two triangles, opposite directions, same UVs on both sides, dihedral ≤ crease, neither
-    /// degenerate), else −1.
+    /// two triangles, opposite directions, same UVs on both sides where both have a UV area,
+    /// dihedral ≤ crease, neither degenerate), else −1.
     std::vector<std::array<int, 3>> adj;
 };
 
