@@ -415,6 +415,9 @@ TEST(LayoutGenTest, ChartsSplitAtTheModelsUvSeams) {
     EXPECT_EQ(expectGoodLayout(modelOf(p), "square, no seam").charts, 1u);
     p.uvs[4] = {0.5f, 0.5f};
     EXPECT_EQ(expectGoodLayout(modelOf(p), "square, UV seam").charts, 2u);
+    // A face whose UVs collapse to a point (a palette swatch) makes no seam.
+    p.uvs[3] = p.uvs[4] = p.uvs[5] = {0.5f, 0.5f};
+    EXPECT_EQ(expectGoodLayout(modelOf(p), "square, palette UVs").charts, 1u);
     // Without UVs, split vertices are welded by position: one chart.
     p.uvs.clear();
     EXPECT_EQ(expectGoodLayout(modelOf(p), "square, no UVs").charts, 1u);
