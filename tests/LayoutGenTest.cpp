@@ -423,6 +423,21 @@ TEST(LayoutGenTest, ChartsSplitAtTheModelsUvSeams) {
     EXPECT_EQ(expectGoodLayout(modelOf(p), "square, no UVs").charts, 1u);
 }
 
+TEST(LayoutGenTest, NonManifoldAndMisorientedEdgesAreChartBorders) {
+    // Three triangles on one edge (a fin), and a pair whose shared edge runs the same way in
+    // both (one of them flipped): each triangle its own chart; a single triangle on its own.
+    MeshPart p;
+    p.positions = {{0, 0, 0}, {1, 0, 0}, {0.5f, 1, 0}, {0.5f, -1, 0}, {0.5f, 0, 1},
+                   {3, 0, 0}, {4, 0, 0}, {3.5f, 1, 0}, {3.5f, -1, 0}};
+    p.indices = {0, 1, 2, 1, 0, 3, 0, 1, 4, 5, 6, 7, 5, 6, 8};
+    const GeneratedLayout g = expectGoodLayout(modelOf(p), "fin and misoriented pair");
+    EXPECT_EQ(g.charts, 5u);
+    MeshPart one;
+    one.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    one.indices = {0, 1, 2};
+    EXPECT_EQ(expectGoodLayout(modelOf(one), "one triangle").charts, 1u);
+}
+
 TEST(LayoutGenTest, DefaultCharacter) {
     const Model m = loadModel(resolveModelPath("builtin:default", "", DERMIS_SOURCE_DIR));
     const GeneratedLayout g = expectGoodLayout(m, "default character");

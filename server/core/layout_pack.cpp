@@ -57,7 +57,7 @@ struct Frame {
 Frame frameOf(const std::vector<glm::dvec2>& uv) {
     const std::vector<glm::dvec2> h = hull(uv);
     glm::dvec2 dir(1, 0);
-    double best = -1;
+    double best = -1, bestSide = 0;
     for (std::size_t i = 0; i < h.size(); ++i) {
         const glm::dvec2 e = h[(i + 1) % h.size()] - h[i];
         const double len = glm::length(e);
@@ -69,8 +69,12 @@ Frame frameOf(const std::vector<glm::dvec2>& uv) {
             lo = glm::min(lo, q);
             hi = glm::max(hi, q);
         }
+        // Smallest area; within 0.1 % of it, the smaller longest side (a right triangle sits on
+        // a leg, not on its hypotenuse).
         const double area = (hi.x - lo.x) * (hi.y - lo.y);
-        if (best < 0 || area < best) best = area, dir = d;
+        const double side = std::max(hi.x - lo.x, hi.y - lo.y);
+        if (best < 0 || area < best * (1 - 1e-3) || (area <= best * (1 + 1e-3) && side < bestSide))
+            best = std::min(best < 0 ? area : best, area), bestSide = side, dir = d;
     }
     Frame f;
     // Rotation taking dir to +x, then v = −y (front faces read clockwise in (u, v-down) terms).
