@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace dermis {
@@ -55,14 +56,12 @@ Result<GeneratedLayout> attempt(const Model& model, const LayoutGenOptions& opti
                                 const std::vector<std::vector<char>>& forced,
                                 std::vector<std::pair<std::size_t, std::uint32_t>>& collapsed) {
     GeneratedLayout out;
-    std::vector<PartMesh> meshes(model.parts.size());
     std::vector<FlatChart> charts;
     std::vector<std::pair<std::size_t, std::uint32_t>> degenerate; // (part, triangle)
     int splits = 0;
     for (std::size_t k = 0; k < model.parts.size(); ++k) {
         if (model.parts[k].indices.empty()) continue;
-        meshes[k] = buildPartMesh(model.parts[k], options);
-        PartMesh& mesh = meshes[k];
+        PartMesh mesh = buildPartMesh(model.parts[k], options);
         for (std::size_t t = 0; t < forced[k].size(); ++t)
             if (forced[k][t] && !mesh.degenerate[t]) {
                 mesh.degenerate[t] = 1;
