@@ -46,8 +46,11 @@ PartMesh buildPartMesh(const MeshPart& part, const LayoutGenOptions& options);
 
 /// Charts grown over inner edges: best-first by normal deviation (with a small distance term for
 /// compact charts), every triangle within options.coneDegrees of both the seed's normal and the
-/// chart's running area-weighted normal. Seeds in triangle order. Degenerate triangles are in no
-/// chart. Returns chart triangle lists, each sorted ascending.
+/// chart's running area-weighted normal; seeds in triangle order. Then borders smoothed (a
+/// triangle with two neighbours in another chart whose cone it fits joins it; up to 8 passes) and
+/// charts under a tenth of the mean chart area merged into the neighbour they share most edges
+/// with whose cone all their triangles fit (smallest first). Degenerate triangles are in no
+/// chart. Returns chart triangle lists, each sorted ascending, in order of first triangle.
 std::vector<std::vector<std::uint32_t>> growCharts(const PartMesh& mesh,
                                                    const LayoutGenOptions& options);
 
