@@ -10,7 +10,7 @@ export CCACHE_BASEDIR ?= $(CURDIR)
 export CCACHE_NOHASHDIR ?= 1
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-asan fuzz run offline bench loadbench authorbench patterns character clean format
+.PHONY: all deps build test test-asan fuzz run offline bench loadbench authorbench layoutbench patterns character clean format
 
 all: build
 
@@ -66,6 +66,9 @@ loadbench: build
 
 authorbench: build
 	$(BUILD)/bench/dermis-authorbench $(BENCH_ARGS)
+
+layoutbench: build
+	$(BUILD)/bench/dermis-layoutbench $(BENCH_ARGS)
 
 # Regenerates the built-in pattern library (patterns/*.png, manifest.json, contact sheet).
 patterns: build

@@ -8,7 +8,9 @@
 // [0,1]², no flipped triangle, 0 texels of a 1024² map covered by two triangles, ≥ 4 free texels
 // (the default gutter) between texels touched by different charts and along the border, area
 // stretch and chart density near the layout's mean, byte-identical output for the same input.
-// Also where charts split (UV seams, creases) and the refusals. Loads glTF through io (no GL).
+// Also where charts split (UV seams, creases), a triangle soup that fits and one that cannot get
+// its gutters, another resolution and gutter, the core's LSCM and grid packing on their own, and
+// the refusals. Loads glTF through io (no GL).
 #include "core/layout_gen.hpp"
 #include "core/uv_flatten.hpp"
 #include "core/uv_pack.hpp"
@@ -75,7 +77,8 @@ void faceOutward(MeshPart& p, const glm::vec3& centre, bool radialOnly) {
                         c = p.positions[p.indices[t + 2]];
         glm::vec3 out = (a + b + c) / 3.0f - centre;
         if (radialOnly) out.y = 0;
-        if (glm::dot(glm::cross(b - a, c - a), out) < 0) std::swap(p.indices[t + 1], p.indices[t + 2]);
+        if (glm::dot(glm::cross(b - a, c - a), out) < 0)
+            std::swap(p.indices[t + 1], p.indices[t + 2]);
     }
 }
 
@@ -88,9 +91,12 @@ MeshPart cylinder(bool split) {
         for (int s = 0; s < cols; ++s) {
             const double a = 2 * kPi * s / seg;
             p.positions.emplace_back(0.1 * std::cos(a), 0.5 * r / rings, 0.1 * std::sin(a));
-            if (split) p.uvs.emplace_back(static_cast<float>(s) / seg, static_cast<float>(r) / rings);
+            if (split)
+                p.uvs.emplace_back(static_cast<float>(s) / seg, static_cast<float>(r) / rings);
         }
-    auto v = [&](int r, int s) { return static_cast<std::uint32_t>(r * cols + (split ? s : s % seg)); };
+    auto v = [&](int r, int s) {
+        return static_cast<std::uint32_t>(r * cols + (split ? s : s % seg));
+    };
     for (int r = 0; r < rings; ++r)
         for (int s = 0; s < seg; ++s)
             p.indices.insert(p.indices.end(), {v(r, s), v(r + 1, s), v(r, s + 1), v(r, s + 1),
@@ -117,10 +123,13 @@ MeshPart sphere(bool split) {
             row.push_back(static_cast<std::uint32_t>(p.positions.size()));
             p.positions.emplace_back(0.3 * std::sin(th) * std::cos(a), 0.3 * std::cos(th),
                                      0.3 * std::sin(th) * std::sin(a));
-            if (split) p.uvs.emplace_back((s + (pole ? 0.5f : 0.0f)) / seg, static_cast<float>(r) / rings);
+            if (split)
+                p.uvs.emplace_back((s + (pole ? 0.5f : 0.0f)) / seg, static_cast<float>(r) / rings);
         }
     }
-    auto v = [&](int r, int s) { return id[static_cast<std::size_t>(r)][static_cast<std::size_t>(s)]; };
+    auto v = [&](int r, int s) {
+        return id[static_cast<std::size_t>(r)][static_cast<std::size_t>(s)];
+    };
     for (int r = 0; r < rings; ++r)
         for (int s = 0; s < seg; ++s) {
             if (r > 0) p.indices.insert(p.indices.end(), {v(r, s), v(r, s + 1), v(r + 1, s)});
@@ -145,12 +154,13 @@ MeshPart gridWithDegenerates() {
                                                v(i + 1, j + 1), v(i, j + 1)});
     p.indices.insert(p.indices.end(), {v(2, 2), v(2, 2), v(3, 3)}); // repeated vertex
     const auto mid = static_cast<std::uint32_t>(p.positions.size());
-    p.positions.emplace_back(0.5f / n, 0.0f, 0.0f); // on the edge v(0,0)–v(1,0)
+    p.positions.emplace_back(0.5f / n, 0.0f, 0.0f);             // on the edge v(0,0)–v(1,0)
     p.indices.insert(p.indices.end(), {v(0, 0), mid, v(1, 0)}); // zero area
     return p;
 }
 
-// --- the test's own checks -------------------------------------------------------------------------
+// --- the test's own checks
+// -------------------------------------------------------------------------
 
 struct UvTri {
     glm::dvec2 q[3]; ///< texel units at kRes
@@ -219,7 +229,8 @@ std::vector<UvTri> collect(const Model& model, const TextureLayout& layout, std:
 
 /// Texels a segment passes through (grid walk, both ends included).
 template <class F> void walkSegment(glm::dvec2 a, glm::dvec2 b, F&& mark) {
-    const int steps = 4 * static_cast<int>(std::ceil(std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)))) + 1;
+    const int steps =
+        4 * static_cast<int>(std::ceil(std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)))) + 1;
     for (int s = 0; s <= steps; ++s) {
         const glm::dvec2 p = a + (b - a) * (static_cast<double>(s) / steps);
         mark(static_cast<int>(std::floor(p.x)), static_cast<int>(std::floor(p.y)));
@@ -256,13 +267,16 @@ RasterFigures raster(const std::vector<UvTri>& tris) {
             walkSegment(t.q[e], t.q[(e + 1) % 3], [&](int i, int j) { touch(i, j, t.chart); });
         const glm::dvec2 lo = glm::min(t.q[0], glm::min(t.q[1], t.q[2])),
                          hi = glm::max(t.q[0], glm::max(t.q[1], t.q[2]));
-        for (int j = std::max(0, static_cast<int>(lo.y)); j <= std::min(kRes - 1, static_cast<int>(hi.y)); ++j)
-            for (int i = std::max(0, static_cast<int>(lo.x)); i <= std::min(kRes - 1, static_cast<int>(hi.x)); ++i) {
+        for (int j = std::max(0, static_cast<int>(lo.y));
+             j <= std::min(kRes - 1, static_cast<int>(hi.y)); ++j)
+            for (int i = std::max(0, static_cast<int>(lo.x));
+                 i <= std::min(kRes - 1, static_cast<int>(hi.x)); ++i) {
                 const glm::dvec2 c(i + 0.5, j + 0.5);
                 // Clockwise triangles: the centre is inside when every edge sees it on its right.
                 if (signedArea(t.q[0], t.q[1], c) < 0 && signedArea(t.q[1], t.q[2], c) < 0 &&
                     signedArea(t.q[2], t.q[0], c) < 0) {
-                    std::uint8_t& n = count[static_cast<std::size_t>(j) * kRes + static_cast<std::size_t>(i)];
+                    std::uint8_t& n =
+                        count[static_cast<std::size_t>(j) * kRes + static_cast<std::size_t>(i)];
                     if (n == 1) ++f.overlap;
                     if (n == 0) ++f.used;
                     n = static_cast<std::uint8_t>(std::min(n + 1, 2));
@@ -273,14 +287,17 @@ RasterFigures raster(const std::vector<UvTri>& tris) {
     if (twoCharts) f.gutter = 0;
     for (int j = 0; j < kRes && f.gutter > 0; ++j)
         for (int i = 0; i < kRes; ++i) {
-            const std::int64_t o = owner[static_cast<std::size_t>(j) * kRes + static_cast<std::size_t>(i)];
+            const std::int64_t o =
+                owner[static_cast<std::size_t>(j) * kRes + static_cast<std::size_t>(i)];
             if (o < 0) continue;
             for (int dj = -f.gutter; dj <= f.gutter; ++dj)
                 for (int di = -f.gutter; di <= f.gutter; ++di) {
                     const int x = i + di, y = j + dj;
                     if (x < 0 || y < 0 || x >= kRes || y >= kRes) continue;
-                    const std::int64_t p = owner[static_cast<std::size_t>(y) * kRes + static_cast<std::size_t>(x)];
-                    if (p >= 0 && p != o) f.gutter = std::min(f.gutter, std::max(std::abs(di), std::abs(dj)) - 1);
+                    const std::int64_t p =
+                        owner[static_cast<std::size_t>(y) * kRes + static_cast<std::size_t>(x)];
+                    if (p >= 0 && p != o)
+                        f.gutter = std::min(f.gutter, std::max(std::abs(di), std::abs(dj)) - 1);
                 }
         }
     return f;
@@ -300,7 +317,8 @@ GeneratedLayout expectGoodLayout(const Model& model, const std::string& what) {
             EXPECT_EQ(x.source, y.source) << what << " part " << k;
             EXPECT_EQ(x.indices, y.indices) << what << " part " << k;
             EXPECT_TRUE(x.uvs.size() == y.uvs.size() &&
-                        std::memcmp(x.uvs.data(), y.uvs.data(), x.uvs.size() * sizeof(glm::vec2)) == 0)
+                        std::memcmp(x.uvs.data(), y.uvs.data(), x.uvs.size() * sizeof(glm::vec2)) ==
+                            0)
                 << what << " part " << k << ": UVs differ between runs";
         }
     }
@@ -342,7 +360,8 @@ GeneratedLayout expectGoodLayout(const Model& model, const std::string& what) {
     EXPECT_NEAR(c.areaStretch, stretch / weight, 1e-6) << what;
     for (std::size_t k = 0; k < charts; ++k)
         if (c3[k] > 1e-4 * s3)
-            EXPECT_NEAR(std::sqrt(cuv[k] / c3[k] / (suv / s3)), 1.0, 0.02) << what << " chart " << k;
+            EXPECT_NEAR(std::sqrt(cuv[k] / c3[k] / (suv / s3)), 1.0, 0.02)
+                << what << " chart " << k;
     EXPECT_GT(c.usedFraction, 0.3) << what;
     return std::move(*a);
 }
@@ -353,7 +372,8 @@ Model loadModel(const std::string& path) {
     return m ? std::move(*m) : Model{};
 }
 
-// --- tests ------------------------------------------------------------------------------------------
+// --- tests
+// ------------------------------------------------------------------------------------------
 
 TEST(LayoutGenTest, CubeWeldedAndSplitGetOneChartPerFace) {
     const GeneratedLayout welded = expectGoodLayout(modelOf(cube(false)), "welded cube");
@@ -395,9 +415,27 @@ TEST(LayoutGenTest, ChartsSplitAtTheModelsUvSeams) {
     EXPECT_EQ(expectGoodLayout(modelOf(p), "square, no seam").charts, 1u);
     p.uvs[4] = {0.5f, 0.5f};
     EXPECT_EQ(expectGoodLayout(modelOf(p), "square, UV seam").charts, 2u);
+    // A face whose UVs collapse to a point (a palette swatch) makes no seam.
+    p.uvs[3] = p.uvs[4] = p.uvs[5] = {0.5f, 0.5f};
+    EXPECT_EQ(expectGoodLayout(modelOf(p), "square, palette UVs").charts, 1u);
     // Without UVs, split vertices are welded by position: one chart.
     p.uvs.clear();
     EXPECT_EQ(expectGoodLayout(modelOf(p), "square, no UVs").charts, 1u);
+}
+
+TEST(LayoutGenTest, NonManifoldAndMisorientedEdgesAreChartBorders) {
+    // Three triangles on one edge (a fin), and a pair whose shared edge runs the same way in
+    // both (one of them flipped): each triangle its own chart; a single triangle on its own.
+    MeshPart p;
+    p.positions = {{0, 0, 0}, {1, 0, 0}, {0.5f, 1, 0}, {0.5f, -1, 0}, {0.5f, 0, 1},
+                   {3, 0, 0}, {4, 0, 0}, {3.5f, 1, 0}, {3.5f, -1, 0}};
+    p.indices = {0, 1, 2, 1, 0, 3, 0, 1, 4, 5, 6, 7, 5, 6, 8};
+    const GeneratedLayout g = expectGoodLayout(modelOf(p), "fin and misoriented pair");
+    EXPECT_EQ(g.charts, 5u);
+    MeshPart one;
+    one.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    one.indices = {0, 1, 2};
+    EXPECT_EQ(expectGoodLayout(modelOf(one), "one triangle").charts, 1u);
 }
 
 TEST(LayoutGenTest, DefaultCharacter) {
@@ -434,8 +472,13 @@ TEST(LayoutGenTest, RefusesBadOptionsAndModels) {
     LayoutGenOptions o;
     o.resolution = 16;
     EXPECT_EQ(field(o), "resolution");
+    o.resolution = 2 * kMaxHeightmapSize;
+    EXPECT_EQ(field(o), "resolution");
     o = {};
-    o.gutterTexels = 0;
+    o.gutterTexels = 1;
+    EXPECT_EQ(field(o), "gutterTexels");
+    o = {};
+    o.gutterTexels = 65; // over resolution / 16
     EXPECT_EQ(field(o), "gutterTexels");
     o = {};
     o.coneDegrees = 90;
@@ -456,6 +499,36 @@ TEST(LayoutGenTest, RefusesBadOptionsAndModels) {
     bad.parts[0].indices.pop_back();
     EXPECT_FALSE(generateTextureLayout(bad));
     EXPECT_FALSE(generateTextureLayout(Model{}));
+}
+
+/// `n` separate triangles (a soup): every one its own chart.
+MeshPart soup(int n) {
+    MeshPart p;
+    for (int i = 0; i < n; ++i) {
+        const float x = static_cast<float>(i % 50), y = static_cast<float>(i / 50);
+        const auto b = static_cast<std::uint32_t>(p.positions.size());
+        p.positions.insert(
+            p.positions.end(),
+            {{x, y, 0}, {x + 0.5f, y, 0}, {x, y + 0.5f, 0.1f * static_cast<float>(i % 7)}});
+        p.indices.insert(p.indices.end(), {b, b + 1, b + 2});
+    }
+    return p;
+}
+
+TEST(LayoutGenTest, ASoupFitsUntilTheGuttersDoNot) {
+    // At 256² with 4-texel gutters a chart takes at least 5 × 5 texels: 2,540 fit at most.
+    LayoutGenOptions o;
+    o.resolution = 256;
+    auto fits = generateTextureLayoutWithReport(modelOf(soup(500)), o);
+    ASSERT_TRUE(fits) << fits.error().message;
+    EXPECT_EQ(fits->charts, 500u);
+    EXPECT_EQ(fits->check.overlapTexels, 0);
+    EXPECT_GE(fits->check.minGutterTexels, 4);
+    auto full = generateTextureLayout(modelOf(soup(3000)), o);
+    ASSERT_FALSE(full);
+    EXPECT_EQ(full.error().code, ErrorCode::Unsupported);
+    EXPECT_NE(full.error().message.find("3000 charts do not fit"), std::string::npos)
+        << full.error().message;
 }
 
 TEST(LayoutGenTest, OtherGutterAndResolution) {

@@ -65,14 +65,15 @@ PartMesh buildPartMesh(const MeshPart& part, const LayoutGenOptions& options) {
     for (std::size_t t = 0; t < nt; ++t) {
         glm::uvec3 tri;
         for (int c = 0; c < 3; ++c)
-            tri[c] = static_cast<std::uint32_t>(weldedOf[rep[part.indices[3 * t + static_cast<std::size_t>(c)]]]);
+            tri[c] = static_cast<std::uint32_t>(
+                weldedOf[rep[part.indices[3 * t + static_cast<std::size_t>(c)]]]);
         mesh.tris[t] = tri;
         const glm::dvec3 a = mesh.positions[tri[0]], b = mesh.positions[tri[1]],
                          c = mesh.positions[tri[2]];
         const glm::dvec3 n = glm::cross(b - a, c - a);
         const double twice = glm::length(n);
-        const double longest = std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b),
-                                         glm::dot(a - c, a - c)});
+        const double longest =
+            std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
         mesh.areas[t] = std::isfinite(twice) ? 0.5 * twice : 0.0;
         if (tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0] ||
             !(0.5 * twice > 1e-6 * longest) || !std::isfinite(twice)) {
@@ -104,7 +105,13 @@ PartMesh buildPartMesh(const MeshPart& part, const LayoutGenOptions& options) {
     const bool hasUVs = part.uvs.size() >= nv;
     const double cosCrease = std::cos(options.creaseDegrees * kDegToRad);
     auto corner = [&](std::uint32_t t, int c) {
-        return part.indices[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>((c + 3) % 3)];
+        return part
+            .indices[3 * static_cast<std::size_t>(t) + static_cast<std::size_t>((c + 3) % 3)];
+    };
+    auto uvSolid = [&](std::uint32_t t) {
+        const glm::dvec2 a(part.uvs[corner(t, 0)]), b(part.uvs[corner(t, 1)]),
+            c(part.uvs[corner(t, 2)]);
+        return (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y) != 0.0;
     };
     for (std::size_t i = 0; i < edges.size();) {
         std::size_t j = i;
@@ -115,7 +122,9 @@ PartMesh buildPartMesh(const MeshPart& part, const LayoutGenOptions& options) {
             // e1 runs a→b at corners (c1, c1+1); an opposite e2 runs b→a at (c2, c2+1).
             const bool opposite = mesh.tris[e1.t][e1.c] == mesh.tris[e2.t][(e2.c + 1) % 3];
             bool inner = opposite && e1.t != e2.t;
-            if (inner && hasUVs)
+            // A UV seam counts where both sides are unwrapped (non-zero UV area): a face whose
+            // UVs collapse to a point or a line (a palette swatch) says nothing about seams.
+            if (inner && hasUVs && uvSolid(e1.t) && uvSolid(e2.t))
                 inner = part.uvs[corner(e1.t, e1.c)] == part.uvs[corner(e2.t, e2.c + 1)] &&
                         part.uvs[corner(e1.t, e1.c + 1)] == part.uvs[corner(e2.t, e2.c)];
             if (inner) inner = glm::dot(mesh.normals[e1.t], mesh.normals[e2.t]) >= cosCrease;
@@ -205,7 +214,8 @@ std::vector<std::vector<std::uint32_t>> growCharts(const PartMesh& mesh,
                 if (same >= 2) other = lo;
             }
             if (other < 0 || !fits(t, static_cast<std::size_t>(other))) continue;
-            const auto from = static_cast<std::size_t>(label[t]), to = static_cast<std::size_t>(other);
+            const auto from = static_cast<std::size_t>(label[t]),
+                       to = static_cast<std::size_t>(other);
             sums[from] -= mesh.normals[t] * mesh.areas[t];
             areas[from] -= mesh.areas[t];
             sums[to] += mesh.normals[t] * mesh.areas[t];
@@ -219,7 +229,8 @@ std::vector<std::vector<std::uint32_t>> growCharts(const PartMesh& mesh,
     // inner edges with, smallest first, when every triangle fits that neighbour's cone.
     std::vector<std::vector<std::uint32_t>> members(nc);
     for (std::size_t t = 0; t < nt; ++t)
-        if (label[t] >= 0) members[static_cast<std::size_t>(label[t])].push_back(static_cast<std::uint32_t>(t));
+        if (label[t] >= 0)
+            members[static_cast<std::size_t>(label[t])].push_back(static_cast<std::uint32_t>(t));
     double partArea = 0;
     std::size_t live = 0;
     for (std::size_t c = 0; c < nc; ++c)
@@ -240,7 +251,8 @@ std::vector<std::vector<std::uint32_t>> growCharts(const PartMesh& mesh,
                 const int o = mesh.adj[t][static_cast<std::size_t>(e)];
                 if (o < 0 || label[static_cast<std::size_t>(o)] == static_cast<int>(c)) continue;
                 const int lo = label[static_cast<std::size_t>(o)];
-                auto it = std::find_if(shared.begin(), shared.end(), [&](const auto& x) { return x.first == lo; });
+                auto it = std::find_if(shared.begin(), shared.end(),
+                                       [&](const auto& x) { return x.first == lo; });
                 if (it == shared.end())
                     shared.push_back({lo, 1});
                 else
@@ -312,8 +324,10 @@ LocalChart buildLocalChart(const PartMesh& mesh, std::vector<std::uint32_t> tris
             for (std::uint32_t oc = 0; oc < 3; ++oc)
                 if (ot[static_cast<int>(oc)] == a) {
                     // o runs b→a: a is at oc, b at oc − 1.
-                    unite(static_cast<std::uint32_t>(3 * i) + static_cast<std::uint32_t>(c), 3 * oi + oc);
-                    unite(static_cast<std::uint32_t>(3 * i) + static_cast<std::uint32_t>((c + 1) % 3),
+                    unite(static_cast<std::uint32_t>(3 * i) + static_cast<std::uint32_t>(c),
+                          3 * oi + oc);
+                    unite(static_cast<std::uint32_t>(3 * i) +
+                              static_cast<std::uint32_t>((c + 1) % 3),
                           3 * oi + (oc + 2) % 3);
                 }
         }
@@ -322,7 +336,8 @@ LocalChart buildLocalChart(const PartMesh& mesh, std::vector<std::uint32_t> tris
     lc.local.resize(n);
     for (std::size_t i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) {
-            const std::uint32_t r = find(static_cast<std::uint32_t>(3 * i) + static_cast<std::uint32_t>(c));
+            const std::uint32_t r =
+                find(static_cast<std::uint32_t>(3 * i) + static_cast<std::uint32_t>(c));
             if (idOf[r] < 0) {
                 idOf[r] = static_cast<std::int64_t>(lc.welded.size());
                 lc.welded.push_back(mesh.tris[lc.tris[i]][c]);
@@ -364,9 +379,8 @@ LocalChart buildLocalChart(const PartMesh& mesh, std::vector<std::uint32_t> tris
     return lc;
 }
 
-std::array<std::vector<std::uint32_t>, 2> splitChart(const PartMesh& mesh,
-                                                     const std::vector<std::uint32_t>& tris,
-                                                     std::vector<int>& member) {
+std::array<std::vector<std::uint32_t>, 2>
+splitChart(const PartMesh& mesh, const std::vector<std::uint32_t>& tris, std::vector<int>& member) {
     std::array<std::vector<std::uint32_t>, 2> halves;
     auto finish = [&]() {
         for (std::uint32_t t : tris)

@@ -7,7 +7,6 @@
 #include "uv_flatten.hpp"
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -21,28 +20,52 @@ struct Tri {
     std::size_t chart = 0; ///< union-find root first, then dense chart index
 };
 
-/// One pass of a 3×3 min (or max) filter, separable, in place (scratch reused).
-void filter3(std::vector<int>& a, int n, bool isMin, std::vector<int>& tmp) {
-    tmp.resize(a.size());
-    auto pick = [isMin](int x, int y) { return isMin ? std::min(x, y) : std::max(x, y); };
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const std::size_t at = static_cast<std::size_t>(j) * static_cast<std::size_t>(n) +
-                                   static_cast<std::size_t>(i);
-            int v = a[at];
-            if (i > 0) v = pick(v, a[at - 1]);
-            if (i + 1 < n) v = pick(v, a[at + 1]);
-            tmp[at] = v;
+/// Calls f(row offset, i0, i1, c0, c1) for every texel row j of an n×n map that triangle t
+/// reaches: [i0, i1] the closed texel squares of the row it touches (its x range over the strip
+/// [j, j+1]: its corners inside, its edges' crossings of the strip's sides), [c0, c1] the texel
+/// centres of the row inside it, edges included (empty, c0 > c1, for a zero-area triangle).
+template <class F> void forRows(const Tri& t, int n, F&& f) {
+    glm::dvec2 q[3];
+    for (int c = 0; c < 3; ++c)
+        q[c] = t.uv[c] * static_cast<double>(n);
+    const bool solid = signedArea(q[0], q[1], q[2]) != 0;
+    const double ylo = std::min({q[0].y, q[1].y, q[2].y}), yhi = std::max({q[0].y, q[1].y, q[2].y});
+    const int j0 = std::clamp(static_cast<int>(std::ceil(ylo)) - 1, 0, n - 1),
+              j1 = std::clamp(static_cast<int>(std::floor(yhi)), 0, n - 1);
+    for (int j = j0; j <= j1; ++j) {
+        double xlo = 1e300, xhi = -1e300, clo = 1e300, chi = -1e300;
+        for (int e = 0; e < 3; ++e) {
+            glm::dvec2 a = q[e], b = q[(e + 1) % 3];
+            if (a.y > b.y) std::swap(a, b);
+            if (b.y < j || a.y > j + 1) continue;
+            if (b.y > a.y) {
+                for (double y :
+                     {std::clamp<double>(j, a.y, b.y), std::clamp<double>(j + 1, a.y, b.y)}) {
+                    const double x = a.x + (b.x - a.x) * ((y - a.y) / (b.y - a.y));
+                    xlo = std::min(xlo, x);
+                    xhi = std::max(xhi, x);
+                }
+                const double yc = j + 0.5;
+                if (a.y <= yc && yc <= b.y) { // crossing of the centre line
+                    const double x = a.x + (b.x - a.x) * ((yc - a.y) / (b.y - a.y));
+                    clo = std::min(clo, x);
+                    chi = std::max(chi, x);
+                }
+            } else {
+                xlo = std::min({xlo, a.x, b.x});
+                xhi = std::max({xhi, a.x, b.x});
+            }
         }
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const std::size_t at = static_cast<std::size_t>(j) * static_cast<std::size_t>(n) +
-                                   static_cast<std::size_t>(i);
-            int v = tmp[at];
-            if (j > 0) v = pick(v, tmp[at - static_cast<std::size_t>(n)]);
-            if (j + 1 < n) v = pick(v, tmp[at + static_cast<std::size_t>(n)]);
-            a[at] = v;
+        if (xlo > xhi) continue;
+        const int i0 = std::clamp(static_cast<int>(std::ceil(xlo)) - 1, 0, n - 1),
+                  i1 = std::clamp(static_cast<int>(std::floor(xhi)), 0, n - 1);
+        int c0 = 1, c1 = 0;
+        if (solid && clo <= chi) {
+            c0 = std::max(static_cast<int>(std::ceil(clo - 0.5)), 0);
+            c1 = std::min(static_cast<int>(std::floor(chi - 0.5)), n - 1);
         }
+        f(static_cast<std::size_t>(j) * static_cast<std::size_t>(n), i0, i1, c0, c1);
+    }
 }
 
 } // namespace
@@ -86,15 +109,16 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
         });
         std::vector<std::uint32_t> point(pl.uvs.size());
         for (std::size_t i = 0; i < order.size(); ++i)
-            point[order[i]] = i > 0 && bits(order[i]) == bits(order[i - 1]) ? point[order[i - 1]]
-                                                                              : order[i];
+            point[order[i]] =
+                i > 0 && bits(order[i]) == bits(order[i - 1]) ? point[order[i - 1]] : order[i];
         std::vector<std::int64_t> firstTri(pl.uvs.size(), -1);
         for (std::size_t t = 0; t < nt; ++t) {
             Tri tri;
             bool ok = true, inside = true;
             for (int c = 0; c < 3; ++c) {
                 const std::uint32_t v = pl.indices[3 * t + static_cast<std::size_t>(c)];
-                if (v >= pl.uvs.size() || pl.source[v] != part.indices[3 * t + static_cast<std::size_t>(c)] ||
+                if (v >= pl.uvs.size() ||
+                    pl.source[v] != part.indices[3 * t + static_cast<std::size_t>(c)] ||
                     pl.source[v] >= part.positions.size()) {
                     ok = false;
                     break;
@@ -133,99 +157,76 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
         tris[i].chart = static_cast<std::size_t>(dense[r]);
     }
 
-    // Rasters: centre owner (−1 none) with an overlap flag, touched owner (−1 none, −2 two).
+    // Two rasters in one buffer of chart ids (−1 none, −2 two charts): texel centres covered
+    // (used, overlapping), then closed texel squares touched (the gutters).
     const std::size_t texels = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
-    std::vector<int> centre(texels, -1), touched(texels, -1);
-    std::vector<char> overlap(texels, 0);
-    for (const Tri& t : tris) {
-        glm::dvec2 q[3];
-        for (int c = 0; c < 3; ++c)
-            q[c] = t.uv[c] * static_cast<double>(n);
-        const bool solid = signedArea(q[0], q[1], q[2]) != 0;
-        const double ylo = std::min({q[0].y, q[1].y, q[2].y}), yhi = std::max({q[0].y, q[1].y, q[2].y});
-        const int j0 = std::clamp(static_cast<int>(std::ceil(ylo)) - 1, 0, n - 1),
-                  j1 = std::clamp(static_cast<int>(std::floor(yhi)), 0, n - 1);
-        const int id = static_cast<int>(t.chart);
-        for (int j = j0; j <= j1; ++j) {
-            // Closed texel squares of row j touched: the triangle's x range over the strip
-            // [j, j+1] (its corners inside, its edges' crossings of the strip's sides).
-            double xlo = 1e300, xhi = -1e300, clo = 1e300, chi = -1e300;
-            for (int e = 0; e < 3; ++e) {
-                glm::dvec2 a = q[e], b = q[(e + 1) % 3];
-                if (a.y > b.y) std::swap(a, b);
-                if (b.y < j || a.y > j + 1) continue;
-                if (b.y > a.y) {
-                    for (double y : {std::clamp<double>(j, a.y, b.y), std::clamp<double>(j + 1, a.y, b.y)}) {
-                        const double x = a.x + (b.x - a.x) * ((y - a.y) / (b.y - a.y));
-                        xlo = std::min(xlo, x);
-                        xhi = std::max(xhi, x);
-                    }
-                    const double yc = j + 0.5;
-                    if (a.y <= yc && yc <= b.y) { // crossing of the centre line
-                        const double x = a.x + (b.x - a.x) * ((yc - a.y) / (b.y - a.y));
-                        clo = std::min(clo, x);
-                        chi = std::max(chi, x);
+    std::vector<int> owner(texels, -1);
+    auto claim = [&](std::size_t at, int id) {
+        int& o = owner[at];
+        if (o == -1) {
+            o = id;
+            return 1;
+        }
+        if (o != id && o != -2) {
+            o = -2;
+            return 2;
+        }
+        return 0;
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+        for (const Tri& t : tris)
+            forRows(t, n, [&](std::size_t row, int i0, int i1, int c0, int c1) {
+                if (pass == 0) {
+                    for (int i = c0; i <= c1; ++i) {
+                        const int r =
+                            claim(row + static_cast<std::size_t>(i), static_cast<int>(t.chart));
+                        check.usedTexels += r == 1;
+                        check.overlapTexels += r == 2;
                     }
                 } else {
-                    xlo = std::min({xlo, a.x, b.x});
-                    xhi = std::max({xhi, a.x, b.x});
+                    for (int i = i0; i <= i1; ++i)
+                        claim(row + static_cast<std::size_t>(i), static_cast<int>(t.chart));
                 }
-            }
-            if (xlo > xhi) continue;
-            const int i0 = std::clamp(static_cast<int>(std::ceil(xlo)) - 1, 0, n - 1),
-                      i1 = std::clamp(static_cast<int>(std::floor(xhi)), 0, n - 1);
-            const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(n);
-            for (int i = i0; i <= i1; ++i) {
-                int& o = touched[row + static_cast<std::size_t>(i)];
-                if (o == -1)
-                    o = id;
-                else if (o != id)
-                    o = -2;
-            }
-            if (!solid || clo > chi) continue;
-            // Texel centres of row j inside (edges included).
-            const int c0 = std::max(static_cast<int>(std::ceil(clo - 0.5)), 0),
-                      c1 = std::min(static_cast<int>(std::floor(chi - 0.5)), n - 1);
-            for (int i = c0; i <= c1; ++i) {
-                int& o = centre[row + static_cast<std::size_t>(i)];
-                if (o == -1)
-                    o = id;
-                else if (o != id)
-                    overlap[row + static_cast<std::size_t>(i)] = 1;
-            }
-        }
-    }
-    for (std::size_t at = 0; at < texels; ++at) {
-        check.usedTexels += centre[at] >= 0;
-        check.overlapTexels += overlap[at];
+            });
+        if (pass == 0) std::fill(owner.begin(), owner.end(), -1);
     }
     check.usedFraction = static_cast<double>(check.usedTexels) / static_cast<double>(texels);
 
-    // Gutters: the border, then the smallest Chebyshev radius r at which another chart's touched
-    // texel appears (min/max chart id filters grown one ring at a time): r − 1 free texels.
+    // Gutters: the border; then, from every touched texel on its chart's edge (an 8-neighbour
+    // elsewhere: the nearest texel of another chart is always seen from one), the nearest touched
+    // texel of another chart within the best gap so far (Chebyshev distance d: d − 1 free texels).
     int gutter = std::max(gutterCap, 0);
-    bool any = false, twice = false;
-    std::vector<int> mn(texels), mx(texels), tmp;
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const std::size_t at = static_cast<std::size_t>(j) * static_cast<std::size_t>(n) +
-                                   static_cast<std::size_t>(i);
-            mn[at] = touched[at] >= 0 ? touched[at] : INT_MAX;
-            mx[at] = touched[at] >= 0 ? touched[at] : -1;
-            if (touched[at] == -1) continue;
-            any = true;
-            twice = twice || touched[at] == -2;
+    auto at = [n](int i, int j) {
+        return static_cast<std::size_t>(j) * static_cast<std::size_t>(n) +
+               static_cast<std::size_t>(i);
+    };
+    for (int j = 0; j < n && gutter > 0; ++j)
+        for (int i = 0; i < n && gutter > 0; ++i) {
+            const int id = owner[at(i, j)];
+            if (id == -1) continue;
+            if (id == -2) {
+                gutter = 0;
+                break;
+            }
             gutter = std::min({gutter, i, j, n - 1 - i, n - 1 - j});
+            bool edge = false;
+            for (int dj = -1; dj <= 1 && !edge; ++dj)
+                for (int di = -1; di <= 1 && !edge; ++di)
+                    edge =
+                        owner[at(std::clamp(i + di, 0, n - 1), std::clamp(j + dj, 0, n - 1))] != id;
+            if (!edge) continue;
+            for (int dj = -gutter; dj <= gutter; ++dj) {
+                const int y = j + dj;
+                if (y < 0 || y >= n) continue;
+                for (int di = -gutter; di <= gutter; ++di) {
+                    const int x = i + di;
+                    if (x < 0 || x >= n) continue;
+                    const int o = owner[at(x, y)];
+                    if (o != -1 && o != id)
+                        gutter = std::min(gutter, std::max(std::abs(di), std::abs(dj)) - 1);
+                }
+            }
         }
-    if (twice) gutter = 0;
-    for (int r = 1; any && r <= gutter; ++r) {
-        filter3(mn, n, true, tmp);
-        filter3(mx, n, false, tmp);
-        bool conflict = false;
-        for (std::size_t at = 0; at < texels && !conflict; ++at)
-            conflict = touched[at] >= 0 && (mn[at] < touched[at] || mx[at] > touched[at]);
-        if (conflict) gutter = r - 1;
-    }
     check.minGutterTexels = gutter;
 
     // Distortion against the layout's mean density.

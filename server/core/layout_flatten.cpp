@@ -36,8 +36,9 @@ bool boundaryCrosses(const LocalChart& lc, const std::vector<glm::dvec2>& uv) {
         lo[i] = std::min(uv[lc.boundary[i][0]].x, uv[lc.boundary[i][1]].x);
         hi[i] = std::max(uv[lc.boundary[i][0]].x, uv[lc.boundary[i][1]].x);
     }
-    std::sort(order.begin(), order.end(),
-              [&](std::uint32_t a, std::uint32_t b) { return lo[a] != lo[b] ? lo[a] < lo[b] : a < b; });
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return lo[a] != lo[b] ? lo[a] < lo[b] : a < b;
+    });
     for (std::size_t i = 0; i < n; ++i) {
         const auto& e = lc.boundary[order[i]];
         const glm::dvec2 a = uv[e[0]], b = uv[e[1]];
@@ -100,10 +101,10 @@ bool flattenOne(const PartMesh& mesh, const LocalChart& lc, const LayoutGenOptio
     if (!(sl > 0) || !(area > 0)) return false;
     const glm::dvec3 n = sum / sl;
     // A basis of the mean plane, counter-clockwise seen from the normal's side.
-    const glm::dvec3 axis = std::abs(n.x) <= std::abs(n.y) && std::abs(n.x) <= std::abs(n.z)
-                                ? glm::dvec3(1, 0, 0)
-                                : (std::abs(n.y) <= std::abs(n.z) ? glm::dvec3(0, 1, 0)
-                                                                  : glm::dvec3(0, 0, 1));
+    const glm::dvec3 axis =
+        std::abs(n.x) <= std::abs(n.y) && std::abs(n.x) <= std::abs(n.z)
+            ? glm::dvec3(1, 0, 0)
+            : (std::abs(n.y) <= std::abs(n.z) ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1));
     const glm::dvec3 e1 = glm::normalize(glm::cross(axis, n)), e2 = glm::cross(n, e1);
     std::vector<glm::dvec2> proj(nv);
     glm::dvec2 mean(0);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace dermis {
@@ -24,11 +25,12 @@ Error invalid(const std::string& field, const std::string& what) {
 }
 
 std::optional<Error> checkInput(const Model& model, const LayoutGenOptions& o) {
-    if (o.resolution < 64 || o.resolution > 16384)
-        return invalid("resolution", "must be in [64, 16384], got " + std::to_string(o.resolution));
-    if (o.gutterTexels < 1 || o.gutterTexels > o.resolution / 16)
-        return invalid("gutterTexels", "must be in [1, resolution/16], got " +
-                                           std::to_string(o.gutterTexels));
+    if (o.resolution < 64 || o.resolution > kMaxHeightmapSize)
+        return invalid("resolution", "must be in [64, " + std::to_string(kMaxHeightmapSize) +
+                                         "], got " + std::to_string(o.resolution));
+    if (o.gutterTexels < 2 || o.gutterTexels > o.resolution / 16)
+        return invalid("gutterTexels",
+                       "must be in [2, resolution/16], got " + std::to_string(o.gutterTexels));
     if (!(o.creaseDegrees > 0 && o.creaseDegrees <= 180))
         return invalid("creaseDegrees", "must be in (0, 180]");
     if (!(o.coneDegrees > 0 && o.coneDegrees <= 85))
@@ -54,14 +56,12 @@ Result<GeneratedLayout> attempt(const Model& model, const LayoutGenOptions& opti
                                 const std::vector<std::vector<char>>& forced,
                                 std::vector<std::pair<std::size_t, std::uint32_t>>& collapsed) {
     GeneratedLayout out;
-    std::vector<PartMesh> meshes(model.parts.size());
     std::vector<FlatChart> charts;
     std::vector<std::pair<std::size_t, std::uint32_t>> degenerate; // (part, triangle)
     int splits = 0;
     for (std::size_t k = 0; k < model.parts.size(); ++k) {
         if (model.parts[k].indices.empty()) continue;
-        meshes[k] = buildPartMesh(model.parts[k], options);
-        PartMesh& mesh = meshes[k];
+        PartMesh mesh = buildPartMesh(model.parts[k], options);
         for (std::size_t t = 0; t < forced[k].size(); ++t)
             if (forced[k][t] && !mesh.degenerate[t]) {
                 mesh.degenerate[t] = 1;
@@ -75,7 +75,8 @@ Result<GeneratedLayout> attempt(const Model& model, const LayoutGenOptions& opti
             }
         for (std::size_t t = 0; t < mesh.tris.size(); ++t)
             if (mesh.degenerate[t]) degenerate.push_back({k, static_cast<std::uint32_t>(t)});
-        flattenCharts(mesh, static_cast<int>(k), growCharts(mesh, options), options, charts, splits);
+        flattenCharts(mesh, static_cast<int>(k), growCharts(mesh, options), options, charts,
+                      splits);
     }
     Packing packing;
     if (!packCharts(charts, degenerate.size(), options, packing))
@@ -105,10 +106,12 @@ Result<GeneratedLayout> attempt(const Model& model, const LayoutGenOptions& opti
     }
     out.chartOf.resize(model.parts.size());
     for (std::size_t k = 0; k < model.parts.size(); ++k)
-        out.chartOf[k].assign(model.parts[k].indices.size() / 3, static_cast<std::uint32_t>(charts.size()));
+        out.chartOf[k].assign(model.parts[k].indices.size() / 3,
+                              static_cast<std::uint32_t>(charts.size()));
     for (std::size_t c = 0; c < charts.size(); ++c)
         for (std::uint32_t t : charts[c].chart.tris)
-            out.chartOf[static_cast<std::size_t>(charts[c].part)][t] = static_cast<std::uint32_t>(c);
+            out.chartOf[static_cast<std::size_t>(charts[c].part)][t] =
+                static_cast<std::uint32_t>(c);
     for (std::size_t d = 0; d < degenerate.size(); ++d) {
         const auto [k, t] = degenerate[d];
         for (int j = 0; j < 3; ++j) {
@@ -183,10 +186,14 @@ Result<GeneratedLayout> generateTextureLayoutWithReport(const Model& model,
         g.check = checkTextureLayout(model, g.layout, options.resolution, options.gutterTexels);
         const LayoutCheck& c = g.check;
         std::string failed;
-        if (c.malformed) failed = std::to_string(c.malformed) + " malformed triangles";
-        else if (c.outside) failed = std::to_string(c.outside) + " triangles outside [0,1]²";
-        else if (c.flipped) failed = std::to_string(c.flipped) + " flipped triangles";
-        else if (c.overlapTexels) failed = std::to_string(c.overlapTexels) + " overlapping texels";
+        if (c.malformed)
+            failed = std::to_string(c.malformed) + " malformed triangles";
+        else if (c.outside)
+            failed = std::to_string(c.outside) + " triangles outside [0,1]²";
+        else if (c.flipped)
+            failed = std::to_string(c.flipped) + " flipped triangles";
+        else if (c.overlapTexels)
+            failed = std::to_string(c.overlapTexels) + " overlapping texels";
         else if (c.minGutterTexels < options.gutterTexels)
             failed = "a gutter of " + std::to_string(c.minGutterTexels) + " texels";
         if (!failed.empty())

@@ -7,7 +7,9 @@
 //   * layout_flatten.cpp: each chart flattened by LSCM and checked (no flip, no boundary crossing,
 //     bounded area stretch), split in two and retried where a check fails;
 //   * layout_pack.cpp: charts scaled to one texel density, turned to their smallest box, packed
-//     on the texel grid with gutters (degenerate triangles in a grid of one-texel cells).
+//     on the texel grid with gutters, as boxes and by outline (degenerate triangles in a lattice
+//     of one-texel cells);
+//   * layout_check.cpp: checkTextureLayout (public, layout_gen.hpp), the final verification.
 // Not included outside these files. Nothing here fails: every chart ends flattened (a single
 // triangle always is) and packing returns false only when nothing fits at any density.
 #pragma once
@@ -27,14 +29,14 @@ namespace dermis::layout_detail {
 /// One part welded by position (bit-equal positions are one vertex), with per-triangle data and
 /// adjacency across inner edges.
 struct PartMesh {
-    std::vector<glm::dvec3> positions;   ///< welded vertices
-    std::vector<glm::uvec3> tris;        ///< welded triangles, in the part's triangle order
-    std::vector<glm::dvec3> normals;     ///< unit face normals (0 for degenerate triangles)
-    std::vector<double> areas;           ///< face areas
-    std::vector<char> degenerate;        ///< repeated welded vertex or (near-)zero area
+    std::vector<glm::dvec3> positions; ///< welded vertices
+    std::vector<glm::uvec3> tris;      ///< welded triangles, in the part's triangle order
+    std::vector<glm::dvec3> normals;   ///< unit face normals (0 for degenerate triangles)
+    std::vector<double> areas;         ///< face areas
+    std::vector<char> degenerate;      ///< repeated welded vertex or (near-)zero area
     /// adj[t][c]: triangle across edge (t[c], t[c+1]) when that edge is an inner edge (exactly
-    /// two triangles, opposite directions, same UVs on both sides, dihedral ≤ crease, neither
-    /// degenerate), else −1.
+    /// two triangles, opposite directions, same UVs on both sides where both have a UV area,
+    /// dihedral ≤ crease, neither degenerate), else −1.
     std::vector<std::array<int, 3>> adj;
 };
 
@@ -44,20 +46,23 @@ PartMesh buildPartMesh(const MeshPart& part, const LayoutGenOptions& options);
 
 /// Charts grown over inner edges: best-first by normal deviation (with a small distance term for
 /// compact charts), every triangle within options.coneDegrees of both the seed's normal and the
-/// chart's running area-weighted normal. Seeds in triangle order. Degenerate triangles are in no
-/// chart. Returns chart triangle lists, each sorted ascending.
+/// chart's running area-weighted normal; seeds in triangle order. Then borders smoothed (a
+/// triangle with two neighbours in another chart whose cone it fits joins it; up to 8 passes) and
+/// charts under a tenth of the mean chart area merged into the neighbour they share most edges
+/// with whose cone all their triangles fit (smallest first). Degenerate triangles are in no
+/// chart. Returns chart triangle lists, each sorted ascending, in order of first triangle.
 std::vector<std::vector<std::uint32_t>> growCharts(const PartMesh& mesh,
                                                    const LayoutGenOptions& options);
 
 /// A chart's triangles as a local mesh: corners united across inner edges between member
 /// triangles, so the chart's boundary and any non-manifold vertex split its vertices.
 struct LocalChart {
-    std::vector<std::uint32_t> tris;       ///< part triangle ids (ascending)
-    std::vector<std::uint32_t> welded;     ///< local vertex → welded vertex
-    std::vector<glm::uvec3> local;         ///< per member triangle, local vertices
+    std::vector<std::uint32_t> tris;                    ///< part triangle ids (ascending)
+    std::vector<std::uint32_t> welded;                  ///< local vertex → welded vertex
+    std::vector<glm::uvec3> local;                      ///< per member triangle, local vertices
     std::vector<std::array<std::uint32_t, 2>> boundary; ///< directed boundary edges (local)
-    int loops = 0;                         ///< boundary loops
-    int euler = 0;                         ///< V − E + F
+    int loops = 0;                                      ///< boundary loops
+    int euler = 0;                                      ///< V − E + F
     bool isDiskLike() const { return loops >= 1 && (2 - euler - loops) == 0; } ///< genus 0
 };
 
@@ -69,9 +74,8 @@ LocalChart buildLocalChart(const PartMesh& mesh, std::vector<std::uint32_t> tris
 /// piece of its first triangle and the rest; a connected one into two connected halves grown
 /// from two far-apart seeds (two-source Dijkstra over inner edges, centroid distances).
 /// Precondition: tris.size() ≥ 2. `member` as for buildLocalChart.
-std::array<std::vector<std::uint32_t>, 2> splitChart(const PartMesh& mesh,
-                                                     const std::vector<std::uint32_t>& tris,
-                                                     std::vector<int>& member);
+std::array<std::vector<std::uint32_t>, 2>
+splitChart(const PartMesh& mesh, const std::vector<std::uint32_t>& tris, std::vector<int>& member);
 
 // --- flattening (layout_flatten.cpp) ------------------------------------------------------------
 
@@ -100,15 +104,15 @@ struct Placement {
 };
 struct Packing {
     std::vector<Placement> charts;
-    double texelsPerMetre = 0.0;     ///< density at options.resolution
-    glm::ivec2 degenerateCell{0};    ///< lower corner (texels) of the degenerate grid
-    int degenerateColumns = 0;       ///< cells per row of that grid
+    double texelsPerMetre = 0.0;  ///< density at options.resolution
+    glm::ivec2 degenerateCell{0}; ///< lower corner (texels) of the degenerate grid
+    int degenerateColumns = 0;    ///< cells per row of that grid
 };
 
-/// Turns each chart to its smallest bounding box and packs all of them (and a grid of
+/// Turns each chart to its smallest bounding box and packs all of them (and a lattice of
 /// `degenerateCount` one-texel cells) into options.resolution² texels with options.gutterTexels
-/// free texels between charts and along the border, at the largest density found that fits.
-/// False when nothing fits (more charts than texels).
+/// free texels between charts and along the border, at the largest density found that fits
+/// (layout_pack.cpp says how). False when the charts do not fit at any density.
 bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCount,
                 const LayoutGenOptions& options, Packing& packing);
 

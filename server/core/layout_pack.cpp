@@ -1,10 +1,14 @@
 // Dermis core — the generated layout's packing (layout_gen_internal.hpp): each chart turned to
-// its smallest bounding box (rotating calipers over its convex hull), mirrored to v-down, then
-// all of them packed on the texel grid (core/uv_pack.hpp skylinePackGrid) at one density, the
-// largest that fits (bisection). A chart of extent w×h texels takes floor(w)+1 × floor(h)+1
-// cells, centred in them, plus gutterTexels cells on its right and upper side; the packed area
-// starts gutterTexels cells from the border, so every chart has that many free texels on every
-// side.
+// its smallest bounding box (rotating calipers over its convex hull) and mirrored to v-down, then
+// packed on the texel grid at one density (texels per metre), the largest found by bisection:
+//   1. boxes (core/uv_pack.hpp skylinePackGrid): a chart of extent w×h texels takes
+//      floor(w + 0.05) + 1 × floor(h + 0.05) + 1 cells, centred in them, plus gutterTexels cells
+//      on its right and upper side, in a square that starts gutterTexels cells from the border;
+//   2. outlines (horizonPack, up to kMaxHorizonCharts charts): the rows each chart touches per
+//      column, dropped onto a horizon in any of four quarter turns, from the boxes' density up
+//      to 1.3 times it; kept when it reaches a higher density than the boxes.
+// Either way every chart has gutterTexels free texels on every side (closed texel squares, with a
+// margin for the float rounding of the final UVs).
 #include "layout_gen_internal.hpp"
 
 #include "uv_pack.hpp"
@@ -23,8 +27,9 @@ double cross2(const glm::dvec2& o, const glm::dvec2& a, const glm::dvec2& b) {
 
 /// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear points.
 std::vector<glm::dvec2> hull(std::vector<glm::dvec2> p) {
-    std::sort(p.begin(), p.end(),
-              [](const glm::dvec2& a, const glm::dvec2& b) { return a.x != b.x ? a.x < b.x : a.y < b.y; });
+    std::sort(p.begin(), p.end(), [](const glm::dvec2& a, const glm::dvec2& b) {
+        return a.x != b.x ? a.x < b.x : a.y < b.y;
+    });
     p.erase(std::unique(p.begin(), p.end()), p.end());
     if (p.size() < 3) return p;
     std::vector<glm::dvec2> h(2 * p.size());
@@ -52,7 +57,7 @@ struct Frame {
 Frame frameOf(const std::vector<glm::dvec2>& uv) {
     const std::vector<glm::dvec2> h = hull(uv);
     glm::dvec2 dir(1, 0);
-    double best = -1;
+    double best = -1, bestSide = 0;
     for (std::size_t i = 0; i < h.size(); ++i) {
         const glm::dvec2 e = h[(i + 1) % h.size()] - h[i];
         const double len = glm::length(e);
@@ -64,8 +69,12 @@ Frame frameOf(const std::vector<glm::dvec2>& uv) {
             lo = glm::min(lo, q);
             hi = glm::max(hi, q);
         }
+        // Smallest area; within 0.1 % of it, the smaller longest side (a right triangle sits on
+        // a leg, not on its hypotenuse).
         const double area = (hi.x - lo.x) * (hi.y - lo.y);
-        if (best < 0 || area < best) best = area, dir = d;
+        const double side = std::max(hi.x - lo.x, hi.y - lo.y);
+        if (best < 0 || area < best * (1 - 1e-3) || (area <= best * (1 + 1e-3) && side < bestSide))
+            best = std::min(best < 0 ? area : best, area), bestSide = side, dir = d;
     }
     Frame f;
     // Rotation taking dir to +x, then v = −y (front faces read clockwise in (u, v-down) terms).
@@ -134,14 +143,16 @@ Profile profileOf(const FlatChart& chart, const Placed& p, glm::ivec2 cells, dou
     pr.bottom.assign(static_cast<std::size_t>(cells.x), cells.y);
     pr.top.assign(static_cast<std::size_t>(cells.x), 0);
     for (const auto& e : chart.chart.boundary) {
-        glm::dvec2 u = p.origin + p.linear * chart.uv[e[0]], w = p.origin + p.linear * chart.uv[e[1]];
+        glm::dvec2 u = p.origin + p.linear * chart.uv[e[0]],
+                   w = p.origin + p.linear * chart.uv[e[1]];
         if (u.x > w.x) std::swap(u, w);
         const int i0 = std::max(static_cast<int>(std::ceil(u.x - eps)) - 1, 0),
                   i1 = std::min(static_cast<int>(std::floor(w.x + eps)), cells.x - 1);
         for (int i = i0; i <= i1; ++i) {
             double ylo, yhi;
             if (w.x > u.x) {
-                const double xa = std::clamp<double>(i, u.x, w.x), xb = std::clamp<double>(i + 1, u.x, w.x);
+                const double xa = std::clamp<double>(i, u.x, w.x),
+                             xb = std::clamp<double>(i + 1, u.x, w.x);
                 const double ya = u.y + (w.y - u.y) * ((xa - u.x) / (w.x - u.x)),
                              yb = u.y + (w.y - u.y) * ((xb - u.x) / (w.x - u.x));
                 ylo = std::min(ya, yb);
@@ -151,8 +162,10 @@ Profile profileOf(const FlatChart& chart, const Placed& p, glm::ivec2 cells, dou
                 yhi = std::max(u.y, w.y);
             }
             const auto col = static_cast<std::size_t>(i);
-            pr.bottom[col] = std::min(pr.bottom[col], std::max(static_cast<int>(std::ceil(ylo - eps)) - 1, 0));
-            pr.top[col] = std::max(pr.top[col], std::min(static_cast<int>(std::floor(yhi + eps)) + 1, cells.y));
+            pr.bottom[col] =
+                std::min(pr.bottom[col], std::max(static_cast<int>(std::ceil(ylo - eps)) - 1, 0));
+            pr.top[col] = std::max(pr.top[col],
+                                   std::min(static_cast<int>(std::floor(yhi + eps)) + 1, cells.y));
         }
     }
     return pr;
@@ -173,9 +186,10 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
     std::vector<std::size_t> order(n);
     for (std::size_t i = 0; i < n; ++i)
         order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return size[a] > size[b]; });
     constexpr int kEmpty = std::numeric_limits<int>::max() / 4; // bottom of an empty column
-    const double eps = std::max(1e-3, res * 2.5e-7);                // ≈ 4 float ulps of a UV
+    const double eps = std::max(1e-3, res * 2.5e-7);            // ≈ 4 float ulps of a UV
     std::vector<int> horizon(static_cast<std::size_t>(res), g);
     out.assign(charts.size(), Placed{});
     Profile profiles[4];
@@ -200,8 +214,10 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
             int height = 0;
             for (int i = 0; i < pr.cells.x; ++i) {
                 const auto col = static_cast<std::size_t>(i);
-                if (pr.bottom[col] >= pr.top[col]) pr.bottom[col] = kEmpty;
-                else height = std::max(height, pr.top[col]);
+                if (pr.bottom[col] >= pr.top[col])
+                    pr.bottom[col] = kEmpty;
+                else
+                    height = std::max(height, pr.top[col]);
             }
             const int* b = pr.bottom.data();
             int highestBottom = 0;
@@ -213,11 +229,14 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
             std::size_t head = 0;
             deque.clear();
             for (int x = 0; x < res; ++x) {
-                while (deque.size() > head && horizon[static_cast<std::size_t>(deque.back())] <= horizon[static_cast<std::size_t>(x)])
+                while (deque.size() > head && horizon[static_cast<std::size_t>(deque.back())] <=
+                                                  horizon[static_cast<std::size_t>(x)])
                     deque.pop_back();
                 deque.push_back(x);
                 if (deque[head] <= x - w) ++head;
-                if (x >= w - 1) windowMax[static_cast<std::size_t>(x - w + 1)] = horizon[static_cast<std::size_t>(deque[head])];
+                if (x >= w - 1)
+                    windowMax[static_cast<std::size_t>(x - w + 1)] =
+                        horizon[static_cast<std::size_t>(deque[head])];
             }
             for (int x = g; x + pr.cells.x <= res - g; ++x) {
                 // The chart rests at y = max(horizon − bottom); give up on x as soon as it would
@@ -253,7 +272,8 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
             if (pr.bottom[col] == kEmpty) continue;
             const int h = bestY + pr.top[col] + g;
             for (int j = std::max(bestX + i - g, 0); j <= std::min(bestX + i + g, res - 1); ++j)
-                horizon[static_cast<std::size_t>(j)] = std::max(horizon[static_cast<std::size_t>(j)], h);
+                horizon[static_cast<std::size_t>(j)] =
+                    std::max(horizon[static_cast<std::size_t>(j)], h);
         }
         if (isGrid) {
             degenerateAt = {bestX, bestY};
@@ -265,6 +285,10 @@ bool horizonPack(const std::vector<FlatChart>& charts, const std::vector<Frame>&
     }
     return true;
 }
+
+/// Above this many charts only boxes are packed (horizon packing costs charts × width × 4 per
+/// density tried; a model in thousands of pieces gains little from outlines).
+constexpr std::size_t kMaxHorizonCharts = 3000;
 
 } // namespace
 
@@ -283,7 +307,8 @@ bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCoun
         rows = static_cast<int>((degenerateCount + static_cast<std::size_t>(cols) - 1) /
                                 static_cast<std::size_t>(cols));
     }
-    const glm::ivec2 gridCells = degenerateCount > 0 ? glm::ivec2(cols + 1, rows + 1) : glm::ivec2(0);
+    const glm::ivec2 gridCells =
+        degenerateCount > 0 ? glm::ivec2(cols + 1, rows + 1) : glm::ivec2(0);
 
     // 1. Boxes (skylinePackGrid): fast, a density every layout reaches.
     const int side = res - g; // boxes carry their gutter on the right and upper side
@@ -316,7 +341,7 @@ bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCoun
     glm::ivec2 gridAt(0), bestGridAt(0);
     int gridTurns = 0, bestGridTurns = 0;
     double horizonDensity = 0.0;
-    if (boxDensity > 0) {
+    if (boxDensity > 0 && charts.size() <= kMaxHorizonCharts) {
         double a = boxDensity, b = boxDensity * 1.3;
         if (horizonPack(charts, frames, gridCells, res, g, a, placed, gridAt, gridTurns)) {
             horizonDensity = a;
@@ -325,7 +350,8 @@ bool packCharts(const std::vector<FlatChart>& charts, std::size_t degenerateCoun
             bestGridTurns = gridTurns;
             for (int it = 0; it < 7; ++it) {
                 const double mid = 0.5 * (a + b);
-                if (horizonPack(charts, frames, gridCells, res, g, mid, placed, gridAt, gridTurns)) {
+                if (horizonPack(charts, frames, gridCells, res, g, mid, placed, gridAt,
+                                gridTurns)) {
                     a = mid;
                     horizonDensity = mid;
                     bestPlaced = placed;
@@ -381,10 +407,14 @@ glm::dvec2 degenerateUv(const Packing& packing, const LayoutGenOptions& options,
     const std::size_t r = cell / cols;
     const double shift = 0.5 * static_cast<double>(r % 2);
     glm::dvec2 p;
-    if (corner == 0) p = {i + shift, static_cast<double>(r)};
-    else if (corner == 1) p = {i + shift + 0.5, static_cast<double>(r + 1)};
-    else p = {i + shift + 1.0, static_cast<double>(r)};
-    return (glm::dvec2(packing.degenerateCell) + p + 0.25) / static_cast<double>(options.resolution);
+    if (corner == 0)
+        p = {i + shift, static_cast<double>(r)};
+    else if (corner == 1)
+        p = {i + shift + 0.5, static_cast<double>(r + 1)};
+    else
+        p = {i + shift + 1.0, static_cast<double>(r)};
+    return (glm::dvec2(packing.degenerateCell) + p + 0.25) /
+           static_cast<double>(options.resolution);
 }
 
 } // namespace dermis::layout_detail

@@ -84,51 +84,6 @@ void conjugateGradient(const SparseMatrix& a, const std::vector<double>& b, std:
     }
 }
 
-int jacobiConjugateGradient(const SparseMatrix& a, const std::vector<double>& b,
-                            std::vector<double>& x, int maxIter, double tol) {
-    const auto n = static_cast<std::size_t>(a.n);
-    std::vector<double> inv(n, 1.0), r(n), z(n), p(n), ap(n);
-    for (int row = 0; row < a.n; ++row)
-        for (int k = a.rowStart[static_cast<std::size_t>(row)];
-             k < a.rowStart[static_cast<std::size_t>(row) + 1]; ++k)
-            if (a.col[static_cast<std::size_t>(k)] == row && a.val[static_cast<std::size_t>(k)] > 0)
-                inv[static_cast<std::size_t>(row)] = 1.0 / a.val[static_cast<std::size_t>(k)];
-    a.mul(x, ap);
-    double bb = 0, rz = 0, rr = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        r[i] = b[i] - ap[i];
-        z[i] = inv[i] * r[i];
-        bb += b[i] * b[i];
-        rz += r[i] * z[i];
-        rr += r[i] * r[i];
-    }
-    p = z;
-    if (bb == 0) bb = 1;
-    int it = 0;
-    for (; it < maxIter && rr > tol * tol * bb; ++it) {
-        a.mul(p, ap);
-        double pap = 0;
-        for (std::size_t i = 0; i < n; ++i)
-            pap += p[i] * ap[i];
-        if (!(pap > 0)) break;
-        const double alpha = rz / pap;
-        double rz2 = 0;
-        rr = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * ap[i];
-            z[i] = inv[i] * r[i];
-            rz2 += r[i] * z[i];
-            rr += r[i] * r[i];
-        }
-        const double beta = rz2 / rz;
-        rz = rz2;
-        for (std::size_t i = 0; i < n; ++i)
-            p[i] = z[i] + beta * p[i];
-    }
-    return it;
-}
-
 namespace {
 
 bool segmentsCross(const glm::dvec2& p1, const glm::dvec2& p2, const glm::dvec2& q1,
@@ -203,8 +158,9 @@ MapSingularValues mapSingularValues(const glm::dvec3& p0, const glm::dvec3& p1,
 
 // --- Tutte + ARAP -------------------------------------------------------------------------------
 
-std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart, const std::vector<std::uint32_t>& boundary,
-                                    std::string& note, int iterations) {
+std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart,
+                                    const std::vector<std::uint32_t>& boundary, std::string& note,
+                                    int iterations) {
     const std::size_t nv = chart.positions.size();
     const std::vector<std::uint32_t>& loop = boundary;
     const std::vector<glm::dvec3>& P = chart.positions;
@@ -286,7 +242,8 @@ std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart, const std::vector<st
     std::vector<std::array<glm::dvec2, 3>> iso(nt); // isometric local triangle
     std::vector<std::array<double, 3>> cot(nt);     // cot of the angle opposite edge (i, i+1)
     for (std::size_t t = 0; t < nt; ++t) {
-        const glm::dvec3 a = P[chart.triangles[t][0]], b = P[chart.triangles[t][1]], c = P[chart.triangles[t][2]];
+        const glm::dvec3 a = P[chart.triangles[t][0]], b = P[chart.triangles[t][1]],
+                         c = P[chart.triangles[t][2]];
         const glm::dvec3 e1 = glm::normalize(b - a);
         const glm::dvec3 nrm = glm::normalize(glm::cross(b - a, c - a));
         const glm::dvec3 e2 = glm::cross(nrm, e1);

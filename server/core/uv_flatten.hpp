@@ -1,8 +1,8 @@
 // Dermis core — flattening surface charts into the plane, and how much a flattening distorts:
 //   * signedArea, mapSingularValues / conformalDistortion: the measures (a UV triangle's
 //     orientation; σ_max, σ_min of the linear map surface triangle → UV triangle);
-//   * SparseMatrix, conjugateGradient, jacobiConjugateGradient: the sparse symmetric positive
-//     definite solver both flatteners use (no external linear-algebra library);
+//   * SparseMatrix, conjugateGradient: the sparse symmetric positive definite solver of the disk
+//     flattening (no external linear-algebra library; LSCM has its own, for its 2×2 blocks);
 //   * flattenDisk: Tutte embedding on a circle, then as-rigid-as-possible local/global iterations
 //     (Liu et al. 2008, "A Local/Global Approach to Mesh Parameterization") with flip-free
 //     backtracking — bijective, for a disk with one boundary loop (the default character's atlas,
@@ -58,11 +58,6 @@ struct SparseMatrix {
 void conjugateGradient(const SparseMatrix& a, const std::vector<double>& b, std::vector<double>& x,
                        int maxIter = 4000, double tol = 1e-12);
 
-/// Conjugate gradients with a Jacobi (diagonal) preconditioner, same contract as
-/// conjugateGradient. Returns the iterations run. Precondition: a positive diagonal.
-int jacobiConjugateGradient(const SparseMatrix& a, const std::vector<double>& b,
-                            std::vector<double>& x, int maxIter, double tol);
-
 /// A chart to flatten: its own vertices and triangles (counter-clockwise seen from outside: the
 /// flattenings keep that orientation, positive signed areas).
 struct ChartMesh {
@@ -76,8 +71,9 @@ struct ChartMesh {
 /// iterations were kept. Fails (empty result, `note` says why) when the Tutte embedding already
 /// flips (it cannot for a disk, up to solver accuracy). Precondition: the chart is a disk (one
 /// boundary loop, χ = 1) without degenerate triangles. Up to `iterations` ARAP steps.
-std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart, const std::vector<std::uint32_t>& boundary,
-                                    std::string& note, int iterations = 150);
+std::vector<glm::dvec2> flattenDisk(const ChartMesh& chart,
+                                    const std::vector<std::uint32_t>& boundary, std::string& note,
+                                    int iterations = 150);
 
 /// Least-squares conformal map of a chart with boundary: minimises Σ_T A_T·|∇v − R90 ∇u|² with
 /// chart vertices pins[0], pins[1] held at pinUv[0], pinUv[1] (the map is then unique for a

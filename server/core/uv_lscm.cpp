@@ -2,15 +2,82 @@
 // 2002). Per triangle T with isometric corners p_j and edges e_j = p_{j+2} − p_{j+1} (opposite
 // corner j), ∇f = (1/2A) Σ_j f_j R90(e_j), so the Cauchy–Riemann residual of (u, v) is
 // r = ∇v − R90 ∇u = (1/2A) Σ_j (u_j e_j + v_j R90 e_j) and the energy A·|r|² is the quadratic
-// form (1/4A) |Σ_j (u_j e_j + v_j R90 e_j)|²: blocks [e_a·e_b, −e_a×e_b; e_a×e_b, e_a·e_b]/4A.
-// The free vertices' normal equations are assembled straight into compressed rows (pattern from
-// the vertex neighbourhoods) and solved by Jacobi-preconditioned conjugate gradients.
+// form (1/4A) |Σ_j (u_j e_j + v_j R90 e_j)|²: 2×2 blocks [e_a·e_b, −e_a×e_b; e_a×e_b, e_a·e_b]/4A
+// between vertices a and b — a similarity each, i.e. one complex number d + i·c acting on
+// u + i·v, so the system is Hermitian of the free vertices' count. Its rows are assembled
+// straight from the vertex neighbourhoods and solved by Jacobi-preconditioned conjugate
+// gradients (the diagonal blocks are real: c = 0).
 #include "uv_flatten.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace dermis {
+namespace {
+
+/// Rows of 2×2 similarity blocks [d, −c; c, d], columns sorted within a row.
+struct SimilarityRows {
+    std::vector<std::size_t> rowStart;
+    std::vector<std::uint32_t> col;
+    std::vector<double> d, c;
+
+    /// y = A·x, x and y interleaved (u, v) per row.
+    void mul(const std::vector<double>& x, std::vector<double>& y) const {
+        const std::size_t rows = rowStart.size() - 1;
+        for (std::size_t r = 0; r < rows; ++r) {
+            double yu = 0, yv = 0;
+            for (std::size_t k = rowStart[r]; k < rowStart[r + 1]; ++k) {
+                const double xu = x[2 * col[k]], xv = x[2 * col[k] + 1];
+                yu += d[k] * xu - c[k] * xv;
+                yv += c[k] * xu + d[k] * xv;
+            }
+            y[2 * r] = yu;
+            y[2 * r + 1] = yv;
+        }
+    }
+};
+
+/// Jacobi-preconditioned conjugate gradients on SimilarityRows (x holds the initial guess;
+/// `inv` the inverse of each row's diagonal).
+void solve(const SimilarityRows& a, const std::vector<double>& inv, const std::vector<double>& b,
+           std::vector<double>& x, int maxIter, double tol) {
+    const std::size_t n = x.size();
+    std::vector<double> r(n), z(n), p(n), ap(n);
+    a.mul(x, ap);
+    double bb = 0, rz = 0, rr = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        r[i] = b[i] - ap[i];
+        z[i] = r[i] * inv[i / 2];
+        bb += b[i] * b[i];
+        rz += r[i] * z[i];
+        rr += r[i] * r[i];
+    }
+    p = z;
+    if (bb == 0) bb = 1;
+    for (int it = 0; it < maxIter && rr > tol * tol * bb; ++it) {
+        a.mul(p, ap);
+        double pap = 0;
+        for (std::size_t i = 0; i < n; ++i)
+            pap += p[i] * ap[i];
+        if (!(pap > 0)) break;
+        const double alpha = rz / pap;
+        double rz2 = 0;
+        rr = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * ap[i];
+            z[i] = r[i] * inv[i / 2];
+            rz2 += r[i] * z[i];
+            rr += r[i] * r[i];
+        }
+        const double beta = rz2 / rz;
+        rz = rz2;
+        for (std::size_t i = 0; i < n; ++i)
+            p[i] = z[i] + beta * p[i];
+    }
+}
+
+} // namespace
 
 std::vector<glm::dvec2> flattenLscm(const ChartMesh& chart, const std::uint32_t pins[2],
                                     const glm::dvec2 pinUv[2], std::vector<glm::dvec2> initial,
@@ -18,59 +85,44 @@ std::vector<glm::dvec2> flattenLscm(const ChartMesh& chart, const std::uint32_t 
     const std::size_t n = chart.positions.size();
     if (n < 3 || pins[0] == pins[1] || pins[0] >= n || pins[1] >= n || initial.size() != n)
         return {};
-    std::vector<int> idx(n, -1);
-    int nf = 0;
+    std::vector<std::int64_t> idx(n, -1);
+    std::size_t nf = 0;
     for (std::size_t v = 0; v < n; ++v)
-        if (v != pins[0] && v != pins[1]) idx[v] = nf++;
+        if (v != pins[0] && v != pins[1]) idx[v] = static_cast<std::int64_t>(nf++);
     std::vector<glm::dvec2> uv = std::move(initial);
     uv[pins[0]] = pinUv[0];
     uv[pins[1]] = pinUv[1];
     if (nf == 0) return uv;
 
-    // Row pattern: a free vertex's free neighbours (itself included), sorted; the u-row and the
-    // v-row of a vertex share it, the u columns first.
-    std::vector<std::vector<std::uint32_t>> nb(n);
+    // Row pattern: a free vertex's free neighbours (itself included), sorted.
+    std::vector<std::vector<std::uint32_t>> nb(nf);
     for (const glm::uvec3& t : chart.triangles)
         for (int a = 0; a < 3; ++a)
             if (idx[t[a]] >= 0)
                 for (int b = 0; b < 3; ++b)
-                    if (idx[t[b]] >= 0) nb[t[a]].push_back(static_cast<std::uint32_t>(idx[t[b]]));
-    for (auto& l : nb) {
+                    if (idx[t[b]] >= 0)
+                        nb[static_cast<std::size_t>(idx[t[a]])].push_back(
+                            static_cast<std::uint32_t>(idx[t[b]]));
+    SimilarityRows m;
+    m.rowStart.assign(nf + 1, 0);
+    for (std::size_t i = 0; i < nf; ++i) {
+        auto& l = nb[i];
         std::sort(l.begin(), l.end());
         l.erase(std::unique(l.begin(), l.end()), l.end());
+        m.rowStart[i + 1] = m.rowStart[i] + l.size();
     }
-    SparseMatrix m;
-    m.n = 2 * nf;
-    m.rowStart.assign(static_cast<std::size_t>(m.n) + 1, 0);
-    std::vector<std::size_t> rowOfVertex(static_cast<std::size_t>(nf));
-    for (std::size_t v = 0; v < n; ++v)
-        if (idx[v] >= 0) rowOfVertex[static_cast<std::size_t>(idx[v])] = v;
-    for (int c = 0; c < 2; ++c)
-        for (int i = 0; i < nf; ++i) {
-            const std::size_t row = static_cast<std::size_t>(c * nf + i);
-            m.rowStart[row + 1] =
-                m.rowStart[row] + 2 * static_cast<int>(nb[rowOfVertex[static_cast<std::size_t>(i)]].size());
-        }
-    m.col.resize(static_cast<std::size_t>(m.rowStart.back()));
-    m.val.assign(m.col.size(), 0.0);
-    for (int c = 0; c < 2; ++c)
-        for (int i = 0; i < nf; ++i) {
-            const auto& l = nb[rowOfVertex[static_cast<std::size_t>(i)]];
-            auto at = static_cast<std::size_t>(m.rowStart[static_cast<std::size_t>(c * nf + i)]);
-            for (std::uint32_t j : l)
-                m.col[at++] = static_cast<int>(j);
-            for (std::uint32_t j : l)
-                m.col[at++] = nf + static_cast<int>(j);
-        }
-    // Adds `value` at (row, column) of the pattern.
-    auto add = [&](int row, int column, double value) {
-        const auto b = m.col.begin() + m.rowStart[static_cast<std::size_t>(row)];
-        const auto e = m.col.begin() + m.rowStart[static_cast<std::size_t>(row) + 1];
-        const auto it = std::lower_bound(b, e, column);
-        m.val[static_cast<std::size_t>(it - m.col.begin())] += value;
+    m.col.reserve(m.rowStart.back());
+    for (const auto& l : nb)
+        m.col.insert(m.col.end(), l.begin(), l.end());
+    m.d.assign(m.col.size(), 0.0);
+    m.c.assign(m.col.size(), 0.0);
+    auto slot = [&](std::size_t row, std::uint32_t column) {
+        const auto b = m.col.begin() + static_cast<std::ptrdiff_t>(m.rowStart[row]);
+        const auto e = m.col.begin() + static_cast<std::ptrdiff_t>(m.rowStart[row + 1]);
+        return static_cast<std::size_t>(std::lower_bound(b, e, column) - m.col.begin());
     };
 
-    std::vector<double> rhs(static_cast<std::size_t>(m.n), 0.0);
+    std::vector<double> rhs(2 * nf, 0.0);
     for (const glm::uvec3& t : chart.triangles) {
         const glm::dvec3 a = chart.positions[t[0]], b = chart.positions[t[1]],
                          c = chart.positions[t[2]];
@@ -85,35 +137,39 @@ std::vector<glm::dvec2> flattenLscm(const ChartMesh& chart, const std::uint32_t 
         const double w = 1.0 / (2.0 * len * p[2].y); // 1 / 4A
         const glm::dvec2 e[3] = {p[2] - p[1], p[0] - p[2], p[1] - p[0]};
         for (int i = 0; i < 3; ++i) {
-            const int fi = idx[t[i]];
-            if (fi < 0) continue;
+            if (idx[t[i]] < 0) continue;
+            const auto fi = static_cast<std::size_t>(idx[t[i]]);
             for (int j = 0; j < 3; ++j) {
                 const double dot = w * glm::dot(e[i], e[j]);
                 const double cross = w * (e[i].x * e[j].y - e[i].y * e[j].x);
-                const int fj = idx[t[j]];
-                if (fj >= 0) {
-                    add(fi, fj, dot);
-                    add(fi, nf + fj, -cross);
-                    add(nf + fi, fj, cross);
-                    add(nf + fi, nf + fj, dot);
+                if (idx[t[j]] >= 0) {
+                    const std::size_t k = slot(fi, static_cast<std::uint32_t>(idx[t[j]]));
+                    m.d[k] += dot;
+                    m.c[k] += cross;
                 } else {
                     const glm::dvec2 q = uv[t[j]];
-                    rhs[static_cast<std::size_t>(fi)] -= dot * q.x - cross * q.y;
-                    rhs[static_cast<std::size_t>(nf + fi)] -= cross * q.x + dot * q.y;
+                    rhs[2 * fi] -= dot * q.x - cross * q.y;
+                    rhs[2 * fi + 1] -= cross * q.x + dot * q.y;
                 }
             }
         }
     }
-    std::vector<double> x(static_cast<std::size_t>(m.n));
+    std::vector<double> inv(nf, 1.0);
+    for (std::size_t i = 0; i < nf; ++i) {
+        const std::size_t k = slot(i, static_cast<std::uint32_t>(i));
+        if (m.d[k] > 0) inv[i] = 1.0 / m.d[k];
+    }
+    std::vector<double> x(2 * nf);
     for (std::size_t v = 0; v < n; ++v)
         if (idx[v] >= 0) {
-            x[static_cast<std::size_t>(idx[v])] = uv[v].x;
-            x[static_cast<std::size_t>(nf + idx[v])] = uv[v].y;
+            x[2 * static_cast<std::size_t>(idx[v])] = uv[v].x;
+            x[2 * static_cast<std::size_t>(idx[v]) + 1] = uv[v].y;
         }
-    jacobiConjugateGradient(m, rhs, x, maxIter, tol);
+    solve(m, inv, rhs, x, maxIter, tol);
     for (std::size_t v = 0; v < n; ++v)
         if (idx[v] >= 0)
-            uv[v] = {x[static_cast<std::size_t>(idx[v])], x[static_cast<std::size_t>(nf + idx[v])]};
+            uv[v] = {x[2 * static_cast<std::size_t>(idx[v])],
+                     x[2 * static_cast<std::size_t>(idx[v]) + 1]};
     return uv;
 }
 
