@@ -473,3 +473,27 @@ TEST_F(SurfacePlacementGLTest, ASurfacePlacementChangesTheFrameOnlyNearItsAnchor
     EXPECT_LE(std::max(std::abs(c.x0 - px->x), std::abs(c.x1 - px->x)), reach);
     EXPECT_LE(std::max(std::abs(c.y0 - px->y), std::abs(c.y1 - px->y)), reach);
 }
+
+TEST_F(SurfacePlacementGLTest, AFrameDependsOnItsInputsOnlyAfterCpuBakedMaps) {
+    // The default scene's 18 placements are baked by the CPU on a software rasterizer
+    // (RendererOptions::softwareCpuBakeCoverage); the frame without placements after it must be
+    // the frame without placements rendered cold (a stale-texture issue of llvmpipe, height_pass).
+    Scene on = loaded_->scene;
+    on.render.size = {128, 128};
+    on.render.msaa = 1;
+    Scene off = on;
+    for (Placement& p : off.placements) p.enabled = false;
+    auto render = [&](const Scene& s) -> Image8 {
+        auto f = makeSceneFrame(s, model_, loaded_->images, nullptr);
+        EXPECT_TRUE(f);
+        if (!f) return {};
+        auto r = gl().renderFrame(f->request);
+        EXPECT_TRUE(r);
+        return r ? r->image : Image8{};
+    };
+    const Image8 cold = render(off);
+    const Image8 deformed = render(on);
+    const Image8 after = render(off);
+    EXPECT_GT(meanAbsDiff(cold, deformed), 0.0);
+    EXPECT_EQ(meanAbsDiff(cold, after), 0.0);
+}

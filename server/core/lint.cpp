@@ -1,6 +1,7 @@
 // Scene lint. See lint.hpp.
 #include "lint.hpp"
 
+#include "lint_surface.hpp"
 #include "lint_uv.hpp"
 #include "mirror.hpp"
 #include "model_derived.hpp"
@@ -114,7 +115,8 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
         std::vector<std::size_t> candidates;
         for (std::size_t j = 0; j < n; ++j) {
             const Placement& q = scene.placements[j];
-            if (j != i && !paired[j] && q.enabled && q.pattern == p.pattern && q.joint == twinJoint)
+            if (j != i && !paired[j] && q.enabled && q.pattern == p.pattern && q.joint == twinJoint &&
+                q.projection == p.projection)
                 candidates.push_back(j);
         }
         if (candidates.empty()) continue;
@@ -122,9 +124,14 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
         if (!m) continue; // a centre on no chart: off_chart says so
         std::size_t best = candidates.front();
         double bestTexels = std::numeric_limits<double>::infinity();
+        const bool surface = p.projection == Projection::Surface;
+        // Surface placements (SPEC §8): anchor distance in units of kMirrorAnchorFraction ·
+        // max(size), so that 1 is the twin threshold as kMirrorCenterTexels is for centres.
+        const double anchorUnit = kMirrorAnchorFraction * std::max(m->size[0], m->size[1]);
         for (std::size_t j : candidates) {
             const Placement& q = scene.placements[j];
-            const double d = std::hypot((q.center[0] - m->center[0]) * texW, (q.center[1] - m->center[1]) * texH);
+            const double d = surface ? kMirrorCenterTexels * surfaceAnchorDistance(q, *m) / anchorUnit
+                                     : std::hypot((q.center[0] - m->center[0]) * texW, (q.center[1] - m->center[1]) * texH);
             if (d < bestTexels) {
                 bestTexels = d;
                 best = j;
@@ -134,7 +141,18 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
         const Placement& q = scene.placements[best];
 
         std::vector<std::string> what;
-        if (bestTexels > kMirrorCenterTexels)
+        if (surface) {
+            const auto& a = m->anchor.position;
+            if (bestTexels > kMirrorCenterTexels)
+                what.push_back("its anchor is " + num(surfaceAnchorDistance(q, *m), 4) +
+                               " model units from where '" + p.id + "' mirrors to (" + num(a[0], 4) +
+                               ", " + num(a[1], 4) + ", " + num(a[2], 4) + ")");
+            const double dw = std::abs(q.size[0] / m->size[0] - 1.0), dh = std::abs(q.size[1] / m->size[1] - 1.0);
+            if (std::max(dw, dh) > kMirrorScaleFraction || halfTurnDistance(q.rotation, m->rotation) > kMirrorRotationDegrees)
+                what.push_back("its size (" + num(q.size[0], 3) + " x " + num(q.size[1], 3) + ", rotation " +
+                               num(q.rotation, 1) + ") is not the mirrored one (" + num(m->size[0], 3) + " x " +
+                               num(m->size[1], 3) + ", rotation " + num(m->rotation, 1) + ")");
+        } else if (bestTexels > kMirrorCenterTexels)
             what.push_back("its centre (" + num(q.center[0], 4) + ", " + num(q.center[1], 4) + ") is " +
                            num(bestTexels, 1) + " texels from where '" + p.id + "' mirrors to (" +
                            num(m->center[0], 4) + ", " + num(m->center[1], 4) + ")");
@@ -143,7 +161,7 @@ void lintMirrorPairs(const Scene& scene, const Model& model, const UvLookup& loo
         // (the reflection itself for a pattern symmetric about its v axis, like a crease).
         const double turn = halfTurnDistance(q.rotation, m->rotation);
         const double du = std::abs(q.scale[0] / m->scale[0] - 1.0), dv = std::abs(q.scale[1] / m->scale[1] - 1.0);
-        if (turn > kMirrorRotationDegrees || std::max(du, dv) > kMirrorScaleFraction)
+        if (!surface && (turn > kMirrorRotationDegrees || std::max(du, dv) > kMirrorScaleFraction))
             what.push_back("its footprint (scale " + num(q.scale[0], 3) + " x " + num(q.scale[1], 3) +
                            ", rotation " + num(q.rotation, 1) + ") is not the mirrored one (scale " +
                            num(m->scale[0], 3) + " x " + num(m->scale[1], 3) + ", rotation " +
@@ -181,37 +199,52 @@ namespace {
 std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, const UvLookup& lookup,
                                        const PatternImages& images, const ModelDerived& derived) {
     std::vector<LintFinding> out;
-    // UV placements are checked in the model's UVs (none without them: no_uvs says so).
+    // Surface placements (SPEC §8) need no UVs of the model's own; UV placements do.
+    const bool anySurface = std::any_of(scene.placements.begin(), scene.placements.end(),
+                                        [](const Placement& p) { return p.projection == Projection::Surface; });
+    const bool anyUv = std::any_of(scene.placements.begin(), scene.placements.end(),
+                                   [](const Placement& p) { return p.projection == Projection::Uv; });
     const bool uvs = model.hasUVs();
-    auto checkedInUvs = [&](const Placement& p) { return uvs && p.enabled && p.projection == Projection::Uv; };
     if (auto f = lintNoUvs(scene, model)) out.push_back(*f);
-    const bool anyInUvs = std::any_of(scene.placements.begin(), scene.placements.end(), checkedInUvs);
-    // The model's UV diagnosis (cached per model by `derived`), only for scenes that need it.
+    if (anyUv && !uvs && !anySurface) return out;
+    // The model's UV diagnosis (cached per model by `derived`), only for scenes with UV placements
+    // checked in the model's UVs.
+    const bool anyInUvs = uvs && std::any_of(scene.placements.begin(), scene.placements.end(), [](const Placement& p) {
+        return p.enabled && p.projection == Projection::Uv;
+    });
     const UvDiagnosis* diagnosis = anyInUvs ? &derived.uvDiagnosis() : nullptr;
     if (diagnosis)
         if (auto f = lintModelUvOverlap(scene, *diagnosis)) out.push_back(*f);
     const std::vector<bool> reach = reachable(scene, model);
     std::vector<std::vector<glm::dvec2>> points(scene.placements.size());
-    for (std::size_t i = 0; i < scene.placements.size(); ++i)
-        if (checkedInUvs(scene.placements[i])) points[i] = samples(scene.placements[i], images);
+    // Skin samples: a surface placement's covered vertices; a UV placement's grid samples on the
+    // surface (only needed to compare with surface placements).
+    std::vector<std::vector<lint_detail::SkinSample>> skins(scene.placements.size());
+    for (std::size_t i = 0; i < scene.placements.size(); ++i) {
+        const Placement& p = scene.placements[i];
+        if (!p.enabled) continue;
+        if (p.projection == Projection::Surface) {
+            skins[i] = lint_detail::surfaceSamples(p, model, images, kFlat);
+        } else if (uvs) {
+            points[i] = samples(p, images);
+            if (anySurface)
+                for (glm::dvec2 uv : points[i]) skins[i].push_back(lint_detail::uvSample(model, lookup, uv));
+        }
+    }
+    // Whether placement q covers sample k of placement i.
+    auto coveredBy = [&](const Placement& q, std::size_t i, std::size_t k) {
+        if (q.projection == Projection::Surface) return lint_detail::surfaceCovers(q, images, kFlat, skins[i][k]);
+        if (scene.placements[i].projection == Projection::Surface)
+            return skins[i][k].hasUv && covers(q, images, skins[i][k].uv);
+        return covers(q, images, points[i][k]);
+    };
 
     for (std::size_t i = 0; i < scene.placements.size(); ++i) {
         const Placement& p = scene.placements[i];
         if (!p.enabled) continue;
+        if (p.projection == Projection::Uv && !uvs) continue; // no_uvs said it
         const int idx = static_cast<int>(i);
-        auto lintRange = [&] {
-            if (!reach[i])
-                out.push_back({"unreachable_range", LintSeverity::Warning, idx,
-                               "no clip of the model brings joint '" + p.joint + "' into [" +
-                                   std::to_string(p.thetaMin) + ", " + std::to_string(p.thetaMax) +
-                                   "] degrees about its axis: the pattern never shows in a clip"});
-        };
-        if (!checkedInUvs(p)) {
-            // Not in the model's UVs (a surface placement, or a model without UVs): only the
-            // range is checked here.
-            lintRange();
-            continue;
-        }
+        const bool surface = p.projection == Projection::Surface;
         std::size_t off = 0;
         std::set<int> charts;
         float influence = 0.0f;
@@ -246,7 +279,30 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
             influence = std::max(influence, bestWeight);
             if (influence < 0.01f && diagnosis && regionDrivenAt(*diagnosis, uv, joint, parent)) influence = 1.0f;
         }
-        const std::size_t n = points[i].size();
+        std::size_t n = points[i].size();
+        if (surface) { // seamless by construction: no off_chart / across_seam; off_surface instead
+            std::vector<lint_detail::SkinSample> under = skins[i];
+            if (under.empty()) {
+                lint_detail::SkinSample nearest;
+                const auto d = lint_detail::anchorToSurface(p, model, &nearest);
+                if (!d || *d > p.depthOrDefault())
+                    out.push_back({"off_surface", LintSeverity::Warning, idx,
+                                   "the anchor lies " + (d ? num(*d, 4) : std::string("far")) +
+                                       " model units from the rest mesh, beyond the decal's depth (" +
+                                       num(p.depthOrDefault(), 4) + "): the pattern reaches no skin"});
+                else
+                    under.push_back(nearest); // a decal smaller than the mesh's vertex spacing
+            }
+            for (const lint_detail::SkinSample& sk : under) {
+                influence = std::max(influence, lint_detail::vertexWeight(model, sk, joint));
+                influence = std::max(influence, lint_detail::vertexWeight(model, sk, parent));
+            }
+            n = skins[i].size();
+            if (!under.empty() && joint >= 0 && influence < 0.01f)
+                out.push_back({"no_influence", LintSeverity::Warning, idx,
+                               "neither joint '" + p.joint + "' nor its parent has skin weight under "
+                               "the decal: the skin there does not bend with that joint"});
+        }
         if (off > 0)
             out.push_back({"off_chart", LintSeverity::Warning, idx,
                            percent(off, n) + " of the footprint's pattern lies outside the UV charts: "
@@ -255,8 +311,12 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
             out.push_back({"across_seam", LintSeverity::Warning, idx,
                            "the footprint spans " + std::to_string(charts.size()) +
                                " UV charts: the pattern is cut at the seam"});
-        lintRange();
-        if (joint >= 0 && n > off && influence < 0.01f)
+        if (!reach[i])
+            out.push_back({"unreachable_range", LintSeverity::Warning, idx,
+                           "no clip of the model brings joint '" + p.joint + "' into [" +
+                               std::to_string(p.thetaMin) + ", " + std::to_string(p.thetaMax) +
+                               "] degrees about its axis: the pattern never shows in a clip"});
+        if (!surface && joint >= 0 && n > off && influence < 0.01f)
             out.push_back({"no_influence", LintSeverity::Warning, idx,
                            "neither joint '" + p.joint + "' nor its parent has skin weight under "
                            "the footprint: the skin there does not bend with that joint"});
@@ -267,10 +327,13 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
         std::string named;
         for (std::size_t j = i + 1; j < scene.placements.size(); ++j) {
             const Placement& q = scene.placements[j];
-            if (!checkedInUvs(q) || q.target != p.target) continue;
+            if (!q.enabled || q.target != p.target) continue;
+            if (q.projection == Projection::Uv && !uvs) continue;
             std::size_t shared = 0;
-            for (glm::dvec2 uv : points[i])
-                if (covers(q, images, uv)) ++shared;
+            const bool viaSurface = surface || q.projection == Projection::Surface;
+            const std::size_t count = viaSurface ? skins[i].size() : points[i].size();
+            for (std::size_t k = 0; k < count; ++k)
+                if (coveredBy(q, i, k)) ++shared;
             if (shared == 0) continue;
             if (++overlaps <= kOverlapNames)
                 named += std::string(named.empty() ? "" : ", ") + "'" + q.id + "' (" + percent(shared, n) + ")";
@@ -285,7 +348,7 @@ std::vector<LintFinding> lintSceneWith(const Scene& scene, const Model& model, c
                                std::string(toString(p.target)) + " map (share of this footprint): " + named +
                                (overlaps > kOverlapNames ? " and " + std::to_string(overlaps - kOverlapNames) + " more" : "") +
                                ": heights add up"});
-        if (diagnosis)
+        if (diagnosis && !surface)
             if (auto f = lintPlacementUvOverlap(scene, i, points[i], joint, parent, *diagnosis)) out.push_back(*f);
     }
     lintMirrorPairs(scene, model, lookup, derived, out);

@@ -23,6 +23,14 @@
 // the negated θ range count as the same driver), θ range (kMirrorThetaDegrees), and h / model /
 // target / response (equal). Unpaired placements are no finding.
 //
+// Surface placements (SPEC §8) are seamless and need no UVs: instead of off_chart / across_seam
+// they may get off_surface (no vertex of the rest mesh within the decal's depth of the anchor);
+// no_influence reads the skin weights of the mesh vertices the decal reaches (the anchor's
+// nearest vertex when it reaches none); overlaps with any placement are counted on those
+// vertices (a UV placement's samples are put on the surface through the UV index); mirror pairs
+// compare anchors (kMirrorAnchorFraction of the size), size and rotation. On a model without
+// UVs only UV placements are reported (no_uvs, once).
+//
 // Each placement's footprint is sampled on a 12×12 grid of pattern coordinates; only samples
 // where its pattern is not flat (|L| > 0.02, when the image is given) count, so a transparent
 // border hanging off a chart is no finding. Clips are sampled at 30 fps. Disabled placements are
@@ -51,8 +59,8 @@ inline constexpr double kMirrorAxisDegrees = 5.0;      ///< angle between the ax
 inline constexpr double kMirrorThetaDegrees = 0.5;     ///< θmin and θmax each
 
 struct LintFinding {
-    /// off_chart, across_seam, overlap, unreachable_range, no_influence, mirror_asymmetric, no_uvs,
-    /// uv_overlap
+    /// off_chart, across_seam, off_surface, overlap, unreachable_range, no_influence,
+    /// mirror_asymmetric, no_uvs, uv_overlap
     std::string code;
     LintSeverity severity = LintSeverity::Warning;
     int placement = -1;   ///< index in Scene::placements (−1: the scene as a whole)

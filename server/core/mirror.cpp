@@ -281,12 +281,25 @@ int findMirrorTwin(const Scene& scene, const Placement& twin) {
     const double w = scene.heightmapSize[0], h = scene.heightmapSize[1];
     for (std::size_t k = 0; k < scene.placements.size(); ++k) {
         const Placement& q = scene.placements[k];
-        if (q.joint != twin.joint || q.pattern != twin.pattern || q.target != twin.target) continue;
+        if (q.joint != twin.joint || q.pattern != twin.pattern || q.target != twin.target ||
+            q.projection != twin.projection)
+            continue;
+        if (twin.projection == Projection::Surface) {
+            if (surfaceAnchorDistance(q, twin) <= kMirrorAnchorFraction * std::max(twin.size[0], twin.size[1]))
+                return static_cast<int>(k);
+            continue;
+        }
         if (std::hypot((q.center[0] - twin.center[0]) * w, (q.center[1] - twin.center[1]) * h) <=
             kMirrorCenterTexels)
             return static_cast<int>(k);
     }
     return -1;
+}
+
+double surfaceAnchorDistance(const Placement& a, const Placement& b) {
+    const auto& p = a.anchor.position;
+    const auto& q = b.anchor.position;
+    return std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) + (p[2] - q[2]) * (p[2] - q[2]));
 }
 
 namespace {
@@ -339,13 +352,15 @@ glm::vec3 mirrorAxis(const Model& model, int j, int t, const glm::vec3& axis, in
 
 Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
                                   const SymmetryPlane& plane) {
-    if (!model.hasUVs()) return mirrorPlacement(p, model, lookup, plane, RestSkin{});
+    if (!model.hasUVs() && p.projection == Projection::Uv)
+        return mirrorPlacement(p, model, lookup, plane, RestSkin{});
     return mirrorPlacement(p, model, lookup, plane, restSkin(model));
 }
 
 Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
                                   const SymmetryPlane& plane, const RestSkin& restSkin) {
     const char* where = "dermis::mirrorPlacement";
+    if (p.projection == Projection::Surface) return mirrorSurfacePlacement(p, model, plane, restSkin);
     if (!model.hasUVs()) return makeError(ErrorCode::Unsupported, where, "/uvs", "the model has no UVs");
     const std::vector<SkinnedPart>& rest = restSkin.parts;
     Footprint fp;
@@ -376,6 +391,13 @@ Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const 
                          std::clamp(p.scale[1] * lv / ov, 1e-4, kMaxPlacementScaleForMirror)};
         }
     }
+    if (auto st = mirrorDriver(p, model, plane, restSkin, out); !st) return st.error();
+    return out;
+}
+
+Status mirrorDriver(const Placement& p, const Model& model, const SymmetryPlane& plane,
+                    const RestSkin& restSkin, Placement& out) {
+    const char* where = "dermis::mirrorPlacement";
     // Joint: by name, else by reflected rest position.
     const std::vector<glm::mat4>& world = restSkin.world;
     const auto inWorld = [&](int n) { return n >= 0 && static_cast<std::size_t>(n) < world.size(); };
@@ -417,6 +439,145 @@ Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const 
             out.axisName = std::string(1, static_cast<char>('x' + k));
             out.axis = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
         }
+    return Ok{};
+}
+
+} // namespace dermis
+
+// --- surface placements (SPEC §8) -----------------------------------------------------------------
+
+namespace dermis {
+
+namespace {
+
+/// A point on a part's triangle: part, first index of the triangle in `indices`, barycentrics.
+struct SurfacePoint {
+    std::size_t part = 0, base = 0;
+    glm::dvec3 bary{1, 0, 0};
+};
+
+/// The surface point of `m`'s triangles (with positions `positions[part]`) nearest to q.
+std::optional<SurfacePoint> nearestSurfacePoint(const Model& m,
+                                                const std::vector<const std::vector<glm::vec3>*>& positions,
+                                                glm::dvec3 q) {
+    double best = std::numeric_limits<double>::max();
+    std::optional<SurfacePoint> out;
+    for (std::size_t pi = 0; pi < m.parts.size() && pi < positions.size(); ++pi) {
+        const MeshPart& p = m.parts[pi];
+        const auto& pos = *positions[pi];
+        for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+            const std::uint32_t i[3] = {p.indices[t], p.indices[t + 1], p.indices[t + 2]};
+            if (i[0] >= pos.size() || i[1] >= pos.size() || i[2] >= pos.size() ||
+                i[0] >= p.positions.size() || i[1] >= p.positions.size() || i[2] >= p.positions.size())
+                continue;
+            const glm::dvec3 a(pos[i[0]]), b(pos[i[1]]), c(pos[i[2]]);
+            const glm::dvec3 w = closestBary(q, a, b, c);
+            const double d = glm::length(w.x * a + w.y * b + w.z * c - q);
+            if (d < best) {
+                best = d;
+                out = SurfacePoint{pi, t, w};
+            }
+        }
+    }
+    return out;
+}
+
+/// The rest skinning at surface point `sp` (bind space → rest world): Σ over the triangle's
+/// corners and their influences of bary · weight · world(node) · inverseBind.
+glm::dmat4 restSkinningAt(const Model& m, const RestSkin& rest, const SurfacePoint& sp) {
+    const MeshPart& p = m.parts[sp.part];
+    glm::dmat4 sum(0.0);
+    double total = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        const std::uint32_t v = p.indices[sp.base + static_cast<std::size_t>(c)];
+        const bool weighted = v < p.joints.size() && v < p.weights.size();
+        for (int k = 0; k < (weighted ? 4 : 1); ++k) {
+            const std::size_t inf = weighted ? p.joints[v][k] : 0;
+            const double w = sp.bary[c] * (weighted ? p.weights[v][k] : 1.0);
+            if (!(w > 0.0) || inf >= p.influences.size()) continue;
+            const int node = p.influences[inf].node;
+            const glm::dmat4 world = node >= 0 && static_cast<std::size_t>(node) < rest.world.size()
+                                         ? glm::dmat4(rest.world[static_cast<std::size_t>(node)])
+                                         : glm::dmat4(1.0);
+            sum += w * (world * glm::dmat4(p.influences[inf].inverseBind));
+            total += w;
+        }
+    }
+    return total > 0.0 ? sum / total : glm::dmat4(1.0);
+}
+
+glm::dvec3 reflectD(glm::dvec3 p, const SymmetryPlane& s) {
+    p[s.axis] = 2.0 * s.offset - p[s.axis];
+    return p;
+}
+
+glm::dvec3 reflectDir(glm::dvec3 d, int axis) {
+    d[axis] = -d[axis];
+    return d;
+}
+
+} // namespace
+
+Result<Placement> mirrorSurfacePlacement(const Placement& p, const Model& model,
+                                         const SymmetryPlane& plane, const RestSkin& rest) {
+    const char* where = "dermis::mirrorPlacement";
+    std::vector<const std::vector<glm::vec3>*> bind, world;
+    for (std::size_t pi = 0; pi < model.parts.size(); ++pi) {
+        bind.push_back(&model.parts[pi].positions);
+        if (pi < rest.parts.size()) world.push_back(&rest.parts[pi].positions);
+    }
+    const glm::dvec3 c(p.anchor.position[0], p.anchor.position[1], p.anchor.position[2]);
+    const glm::dvec3 n(p.anchor.normal[0], p.anchor.normal[1], p.anchor.normal[2]);
+    const glm::dvec3 t(p.anchor.tangent[0], p.anchor.tangent[1], p.anchor.tangent[2]);
+    const auto at = nearestSurfacePoint(model, bind, c);
+    if (!at || world.size() != model.parts.size())
+        return makeError(ErrorCode::InvalidArgument, where, "anchor", "the model has no surface to mirror the anchor on");
+    // Into rest world space, through the skinning where the anchor sits.
+    const glm::dmat4 toWorld = restSkinningAt(model, rest, *at);
+    const glm::dmat3 lin(toWorld);
+    const glm::dvec3 cw = glm::dvec3(toWorld * glm::dvec4(c, 1.0));
+    const glm::dvec3 nw = glm::normalize(glm::transpose(glm::inverse(lin)) * n);
+    // The pattern's effective axes (rotation applied), as the bake uses them (bake.cpp).
+    const double rot = glm::radians(p.rotation);
+    const glm::dvec3 te = std::cos(rot) * t + std::sin(rot) * glm::cross(n, t);
+    glm::dvec3 tw = lin * te;
+    tw = glm::normalize(tw - glm::dot(tw, nw) * nw);
+    const glm::dvec3 bw = glm::cross(nw, tw);
+    // Reflected, then onto the rest surface nearest to the reflected point.
+    const glm::dvec3 target = reflectD(cw, plane);
+    const auto twin = nearestSurfacePoint(model, world, target);
+    if (!twin) return makeError(ErrorCode::InvalidArgument, where, "anchor", "the model has no surface to mirror the anchor on");
+    const MeshPart& tp = model.parts[twin->part];
+    glm::dvec3 c2(0.0);
+    for (int k = 0; k < 3; ++k) c2 += twin->bary[k] * glm::dvec3(tp.positions[tp.indices[twin->base + static_cast<std::size_t>(k)]]);
+    const glm::dvec3 n2w = reflectDir(nw, plane.axis);
+    // Keep the axis that lies more within the plane as the mirror image has it; turn the other.
+    glm::dvec3 t2w;
+    if (std::abs(tw[plane.axis]) <= std::abs(bw[plane.axis])) {
+        t2w = reflectDir(tw, plane.axis);                // u as mirrored; v = n × u turns
+    } else {
+        const glm::dvec3 b2w = reflectDir(bw, plane.axis); // v as mirrored; u turns
+        t2w = glm::cross(b2w, n2w);                       // so that n × u = v
+    }
+    // Back to bind space through the skinning at the twin point.
+    const glm::dmat4 toWorld2 = restSkinningAt(model, rest, *twin);
+    const glm::dmat3 lin2(toWorld2), inv2 = glm::inverse(lin2);
+    glm::dvec3 n2 = glm::normalize(glm::transpose(lin2) * n2w);
+    glm::dvec3 te2 = inv2 * t2w;
+    te2 = te2 - glm::dot(te2, n2) * n2;
+    if (!(glm::length(te2) > 1e-12) || !std::isfinite(n2.x))
+        return makeError(ErrorCode::InvalidArgument, where, "anchor", "the mirrored anchor frame is degenerate");
+    te2 = glm::normalize(te2);
+    // The same `rotation` on the twin: its tangent is the effective axis turned back by it.
+    const glm::dvec3 t2 = glm::normalize(std::cos(rot) * te2 - std::sin(rot) * glm::cross(n2, te2));
+    const auto rounded = [](double x) { return std::abs(x) < 1e-12 ? 0.0 : std::round(x * 1e9) / 1e9; };
+    Placement out = p;
+    out.id.clear();
+    out.label = mirrorLabel(p.label);
+    out.anchor.position = {rounded(c2.x), rounded(c2.y), rounded(c2.z)};
+    out.anchor.normal = {n2.x, n2.y, n2.z};
+    out.anchor.tangent = {t2.x, t2.y, t2.z};
+    if (auto st = mirrorDriver(p, model, plane, rest, out); !st) return st.error();
     return out;
 }
 

@@ -90,15 +90,24 @@ std::string mirrorLabel(const std::string& label);
 /// and still be its twin: the mirror route's duplicate check and lint's mirror pairs.
 inline constexpr double kMirrorCenterTexels = 4.0;
 
+/// How far (a fraction of the twin's larger size) a surface placement's anchor may be from where
+/// another's mirrors to and still be its twin (SPEC §8; the UV analogue is kMirrorCenterTexels).
+inline constexpr double kMirrorAnchorFraction = 0.1;
+
 /// The index in `scene.placements` of a placement that already is `twin` — the mirror image
-/// mirrorPlacement made of some placement: the same joint, pattern and target and a centre
-/// within kMirrorCenterTexels of the scene's height map (`heightmapSize`) of twin's — or −1.
+/// mirrorPlacement made of some placement: the same joint, pattern, target and projection, and a
+/// centre within kMirrorCenterTexels of the scene's height map (`heightmapSize`) of twin's — for
+/// surface placements an anchor within kMirrorAnchorFraction · max(size) of twin's — or −1.
 /// Compares the patterns as named (resolve aliases in both first). The first such, in order.
 int findMirrorTwin(const Scene& scene, const Placement& twin);
 
-/// The mirror twin of `p` (id left empty for the caller). Fails: Unsupported ("/uvs") without
-/// UVs; NotFound ("center") when the footprint centre is on no UV chart; NotFound ("joint") when
-/// the joint has no twin by name or position.
+/// Distance between two placements' anchor positions (bind space, model units).
+double surfaceAnchorDistance(const Placement& a, const Placement& b);
+
+/// The mirror twin of `p` (id left empty for the caller). A surface placement (SPEC §8) goes to
+/// mirrorSurfacePlacement (no UVs needed). Fails: Unsupported ("/uvs") without UVs; NotFound
+/// ("center") when the footprint centre is on no UV chart; NotFound ("joint") when the joint has
+/// no twin by name or position.
 Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
                                   const SymmetryPlane& plane);
 /// The same, bit for bit, without the per-call rest-pose skinning: `rest` must be
@@ -106,6 +115,26 @@ Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const 
 /// RestSkin with fewer nodes or parts than the model is read only within its bounds).
 Result<Placement> mirrorPlacement(const Placement& p, const Model& model, const UvLookup& lookup,
                                   const SymmetryPlane& plane, const RestSkin& rest);
+
+/// The driver part of mirrorPlacement into `out`: the twin joint (by name, else by reflected
+/// rest position) and the mirrored axis (see the header comment). Fails like mirrorPlacement
+/// ("joint", "axis").
+Status mirrorDriver(const Placement& p, const Model& model, const SymmetryPlane& plane,
+                    const RestSkin& rest, Placement& out);
+
+/// The mirror twin of surface placement `p` (SPEC §8): the anchor taken to
+/// rest world space through the skinning at its nearest bind-space surface point, reflected
+/// across the plane, snapped to the nearest rest surface point and taken back to bind space
+/// through the skinning there; the normal reflected likewise. A reflection cannot flip an image,
+/// so one of the pattern's axes keeps its direction relative to the body (as a mirror image
+/// would) and the other is turned: the one that lies more within the symmetry plane is kept
+/// (up/down, front/back stay), the one across it (towards/away from the plane) is turned — the
+/// twin looks like the original carried across, not upside down. `rotation`, size, depth, the
+/// driver's range and the rest are kept (joint and axis mirrored as for UV placements); the UV
+/// footprint members are kept as they are. Fails: InvalidArgument ("anchor") on a model without
+/// triangles near the anchor; like mirrorDriver.
+Result<Placement> mirrorSurfacePlacement(const Placement& p, const Model& model,
+                                         const SymmetryPlane& plane, const RestSkin& rest);
 
 /// The reflection of a local rotation delta for the twin joint, for tests and tools: given the
 /// rest world rotations Q_j, Q_t and a delta Δ of joint j (pose = rest·Δ), the twin's delta Δ'

@@ -89,6 +89,43 @@ ModelDerived::suggestDriver(const std::vector<std::pair<int, float>>& joints) co
     return chooseDriver(model, joints, ranges);
 }
 
+const std::shared_ptr<const TextureLayout>& ModelDerived::modelLayout() const {
+    std::call_once(layoutOnce_, [this] {
+        layout_ = std::make_shared<const TextureLayout>(modelTextureLayout(*model_));
+    });
+    return layout_;
+}
+
+std::shared_ptr<const RestSurfaceMap>
+ModelDerived::restSurface(const std::shared_ptr<const TextureLayout>& given, int width, int height) const {
+    const std::shared_ptr<const TextureLayout> layout = given ? given : modelLayout();
+    auto find = [&]() -> std::shared_ptr<const RestSurfaceMap> {
+        for (auto it = restCache_.begin(); it != restCache_.end(); ++it)
+            if (it->layout.lock() == layout && it->width == width && it->height == height) {
+                RestEntry e = *it;
+                restCache_.erase(it);
+                restCache_.insert(restCache_.begin(), e); // most recently used first
+                return e.map;
+            }
+        return nullptr;
+    };
+    {
+        std::lock_guard<std::mutex> lock(restMutex_);
+        if (auto m = find()) return m;
+    }
+    auto map = std::make_shared<const RestSurfaceMap>(bakeRestSurface(*model_, *layout, width, height));
+    restSurfaceBuilds_.fetch_add(1);
+    std::lock_guard<std::mutex> lock(restMutex_);
+    if (auto m = find()) return m; // another caller baked it meanwhile
+    restCache_.insert(restCache_.begin(), RestEntry{layout, width, height, map});
+    // Entries whose layout is gone, then the least recently used beyond the bound.
+    restCache_.erase(std::remove_if(restCache_.begin(), restCache_.end(),
+                                    [](const RestEntry& e) { return e.layout.expired(); }),
+                     restCache_.end());
+    if (restCache_.size() > kRestCacheEntries) restCache_.resize(kRestCacheEntries);
+    return map;
+}
+
 std::shared_ptr<const ModelDerived>
 ModelDerivedSlot::get(const std::shared_ptr<const Model>& model) {
     std::lock_guard<std::mutex> lock(mutex_);

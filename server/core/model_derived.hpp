@@ -1,9 +1,11 @@
 // Dermis core — data derived from one immutable model, built once and shared by every request that
 // reads it: the UV index (UvLookup: lint, pick by UV, mirror), the rest-pose skinning (RestSkin:
 // mirror, lint's mirror pairs, the symmetry plane), the rest pose's symmetry plane (mirror, lint),
-// the UV diagnosis (GET /models/{id}, lint's uv_overlap and no_influence, uv_layout auto) and the
-// joints' angle ranges over the clips (the picks' driver suggestion). The service keeps one per
-// model entry, and model ids are content addresses: the diagnosis is cached by content. Each piece
+// the UV diagnosis (GET /models/{id}, lint's uv_overlap and no_influence, uv_layout auto), the
+// joints' angle ranges over the clips (the picks' driver suggestion), the model's own UVs as a
+// height-map layout and the rest-surface maps of layouts (SPEC §8; a small cache). The service
+// keeps one per model entry, and model ids are content addresses: the diagnosis is cached by
+// content. Each piece
 // is built lazily, on its first use, at most once (std::call_once): a route pays only for what it
 // reads, and concurrent first uses wait for one build instead of each making its own.
 //
@@ -22,6 +24,7 @@
 #include "model.hpp"
 #include "pick.hpp"
 #include "uv_diagnosis.hpp"
+#include "texture_layout.hpp"
 #include "uv_lookup.hpp"
 
 #include <array>
@@ -66,12 +69,25 @@ public:
     /// not skin joints, an empty list and a model without clips go to suggestDriver itself.
     SuggestedDriver suggestDriver(const std::vector<std::pair<int, float>>& joints) const;
 
+    /// modelTextureLayout(model()) (SPEC §8: the model's own UVs as a height-map layout), built
+    /// on the first call; the same object for the lifetime of this one (a stable key for the
+    /// renderer's per-layout vertex arrays and for restSurface below).
+    const std::shared_ptr<const TextureLayout>& modelLayout() const;
+    /// bakeRestSurface(model(), *layout, width, height), cached by (layout object, size): the
+    /// kRestCacheEntries most recently used maps are kept (each is ~25 bytes per texel). Built
+    /// outside the cache's lock; two first uses at once may both bake (one result is kept).
+    /// `layout` must be a layout of model(); null = modelLayout().
+    std::shared_ptr<const RestSurfaceMap> restSurface(const std::shared_ptr<const TextureLayout>& layout,
+                                                      int width, int height) const;
+    static constexpr std::size_t kRestCacheEntries = 2;
+
     /// How many times each piece was built: 0 before its first use, 1 after (for tests).
     int uvLookupBuilds() const { return lookupBuilds_.load(); }
     int restSkinBuilds() const { return restBuilds_.load(); }
     int symmetryPlaneBuilds() const { return planeBuilds_.load(); }
     int clipRangeBuilds() const { return rangesBuilds_.load(); }
     int uvDiagnosisBuilds() const { return diagnosisBuilds_.load(); }
+    int restSurfaceBuilds() const { return restSurfaceBuilds_.load(); }
 
 private:
     std::shared_ptr<const Model> model_;
@@ -86,6 +102,16 @@ private:
     mutable std::vector<bool> ranged_;                      ///< by node: a skin joint, in ranges_
     mutable std::atomic<int> lookupBuilds_{0}, restBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0},
         diagnosisBuilds_{0};
+    mutable std::once_flag layoutOnce_;
+    mutable std::shared_ptr<const TextureLayout> layout_;
+    struct RestEntry {
+        std::weak_ptr<const TextureLayout> layout;
+        int width = 0, height = 0;
+        std::shared_ptr<const RestSurfaceMap> map;
+    };
+    mutable std::mutex restMutex_;
+    mutable std::vector<RestEntry> restCache_; ///< most recently used first
+    mutable std::atomic<int> restSurfaceBuilds_{0};
 };
 
 class ModelDerivedSlot {

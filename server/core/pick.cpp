@@ -2,6 +2,7 @@
 #include "pick.hpp"
 
 #include "camera.hpp"
+#include "texture_layout.hpp"
 #include "uv_lookup.hpp"
 
 #include <algorithm>
@@ -119,6 +120,89 @@ Result<std::optional<PickHit>> pickFrame(const FramePlan& plan, const Model& mod
         best->joints = weightsAt(part, base, best->bary);
     }
     return best;
+}
+
+std::optional<glm::vec2> layoutUv(const TextureLayout& layout, const PickHit& hit) {
+    if (hit.part < 0 || static_cast<std::size_t>(hit.part) >= layout.parts.size() || hit.triangle < 0)
+        return std::nullopt;
+    const PartLayout& pl = layout.parts[static_cast<std::size_t>(hit.part)];
+    const std::size_t base = 3 * static_cast<std::size_t>(hit.triangle);
+    if (base + 2 >= pl.indices.size()) return std::nullopt;
+    glm::vec2 uv(0.0f);
+    for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = pl.indices[base + static_cast<std::size_t>(k)];
+        if (v >= pl.uvs.size()) return std::nullopt;
+        uv += hit.bary[k] * pl.uvs[v];
+    }
+    return uv;
+}
+
+namespace {
+
+/// Any unit vector ⟂ n: the world axis least aligned with n, projected.
+glm::dvec3 perpendicular(glm::dvec3 n) {
+    const glm::dvec3 a = std::abs(n.x) <= std::abs(n.y) && std::abs(n.x) <= std::abs(n.z) ? glm::dvec3(1, 0, 0)
+                         : std::abs(n.y) <= std::abs(n.z)                                  ? glm::dvec3(0, 1, 0)
+                                                                                            : glm::dvec3(0, 0, 1);
+    return glm::normalize(a - glm::dot(a, n) * n);
+}
+
+glm::dvec3 originOf(const std::vector<glm::mat4>& world, int n) {
+    return glm::dvec3(world[static_cast<std::size_t>(n)][3]);
+}
+
+} // namespace
+
+PickAnchor pickAnchor(const Model& model, const PickHit& hit, int joint,
+                      const std::vector<glm::mat4>& restWorld) {
+    PickAnchor a;
+    if (hit.part < 0 || static_cast<std::size_t>(hit.part) >= model.parts.size()) return a;
+    const MeshPart& part = model.parts[static_cast<std::size_t>(hit.part)];
+    const std::size_t base = 3 * static_cast<std::size_t>(hit.triangle);
+    if (hit.triangle < 0 || base + 2 >= part.indices.size()) return a;
+    std::uint32_t v[3];
+    for (int k = 0; k < 3; ++k) {
+        v[k] = part.indices[base + static_cast<std::size_t>(k)];
+        if (v[k] >= part.positions.size()) return a;
+    }
+    const glm::dvec3 p0(part.positions[v[0]]), p1(part.positions[v[1]]), p2(part.positions[v[2]]);
+    a.position = static_cast<double>(hit.bary[0]) * p0 + static_cast<double>(hit.bary[1]) * p1 +
+                 static_cast<double>(hit.bary[2]) * p2;
+    glm::dvec3 n(0.0);
+    if (part.normals.size() == part.positions.size())
+        for (int k = 0; k < 3; ++k) n += static_cast<double>(hit.bary[k]) * glm::dvec3(part.normals[v[k]]);
+    if (!(glm::length(n) > 1e-12)) n = glm::cross(p1 - p0, p2 - p0);
+    a.normal = glm::length(n) > 0.0 ? glm::normalize(n) : glm::dvec3(0, 0, 1);
+    a.tangent = perpendicular(a.normal);
+    const auto valid = [&](int node) { return node >= 0 && static_cast<std::size_t>(node) < restWorld.size(); };
+    if (!valid(joint)) return a;
+    // The bone in rest world space.
+    glm::dvec3 sum(0.0);
+    int children = 0;
+    for (int j : model.joints)
+        if (valid(j) && model.parentJoint(j) == joint) {
+            sum += originOf(restWorld, j);
+            ++children;
+        }
+    glm::dvec3 bone(0.0);
+    if (children > 0) {
+        bone = sum / static_cast<double>(children) - originOf(restWorld, joint);
+    } else if (const int parent = model.parentJoint(joint); valid(parent)) {
+        bone = originOf(restWorld, joint) - originOf(restWorld, parent);
+    }
+    // Into bind space through the most weighted influence at the hit (its rest skinning).
+    glm::dmat3 toWorld(1.0);
+    const int node = hit.joints.empty() ? -1 : hit.joints.front().first;
+    for (const Influence& inf : part.influences)
+        if (inf.node == node && valid(node)) {
+            toWorld = glm::dmat3(glm::dmat4(restWorld[static_cast<std::size_t>(node)]) * glm::dmat4(inf.inverseBind));
+            break;
+        }
+    const double det = glm::determinant(toWorld);
+    if (std::abs(det) > 1e-12 && std::isfinite(det)) bone = glm::inverse(toWorld) * bone;
+    const glm::dvec3 across = glm::cross(a.normal, bone);
+    if (glm::length(across) > 1e-9 * std::max(1.0, glm::length(bone))) a.tangent = glm::normalize(across);
+    return a;
 }
 
 SuggestedDriver suggestDriver(const Model& model, const std::vector<std::pair<int, float>>& joints) {

@@ -43,6 +43,31 @@ std::optional<PickHit> pickUv(const Model& model, const UvLookup& lookup, glm::d
 
 Result<std::optional<PickHit>> pickFrame(const FramePlan& plan, const Model& model, double x, double y);
 
+struct TextureLayout;
+
+/// The UV of `hit` in `layout` (SPEC §8: pick's uv is in the layout the scene uses): the layout
+/// triangle with the hit triangle's index, its corners' UVs blended by the hit's barycentrics
+/// (a layout keeps the part's triangle order and corner order). nullopt where the layout has no
+/// such triangle (a part it does not cover) or an index is out of range.
+std::optional<glm::vec2> layoutUv(const TextureLayout& layout, const PickHit& hit);
+
+/// Where a surface placement would sit at a hit (SPEC §8 pick `anchor`), in bind space.
+struct PickAnchor {
+    glm::dvec3 position{0.0};       ///< the hit triangle's bind-space corners blended
+    glm::dvec3 normal{0, 0, 1};     ///< its corners' normals blended (the face normal without), unit
+    glm::dvec3 tangent{1, 0, 0};    ///< unit, ⟂ normal, across the bone of `joint`
+};
+
+/// The anchor at `hit` (part, triangle and barycentrics of a pick of `model`): position and
+/// normal from the rest mesh; the tangent runs across the bending direction of node `joint`
+/// (the suggested driver): perpendicular, in the tangent plane, to its bone — from the joint to
+/// the mean of its child joints, else from its parent joint to it — carried from rest world into
+/// bind space by the skinning of the hit's most weighted influence. Without a usable bone (no
+/// joint, a bone along the normal) any unit vector ⟂ normal, chosen deterministically.
+/// `restWorld` is worldMatrices(model, restPose(model)) (ModelDerived::restSkin().world).
+PickAnchor pickAnchor(const Model& model, const PickHit& hit, int joint,
+                      const std::vector<glm::mat4>& restWorld);
+
 struct SuggestedDriver {
     std::string joint;
     std::string axis = "x"; ///< "x", "y" or "z" (the joint's rest frame)

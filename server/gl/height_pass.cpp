@@ -120,13 +120,16 @@ HeightPassBlock surfaceBlock(const BakePlacement& p, const TexelRect& rect, int 
 
 /// Whether this height pass is baked by the CPU (RendererOptions::softwareCpuBakeCoverage): a
 /// software rasterizer and footprints covering more than `coverage` map areas.
+bool softwareRasterizer(const std::string& glRenderer) {
+    return glRenderer.find("llvmpipe") != std::string::npos ||
+           glRenderer.find("softpipe") != std::string::npos ||
+           glRenderer.find("swrast") != std::string::npos;
+}
+
 bool bakeOnCpu(const HeightPassInput& in, const std::vector<TexelRect>& rects, double coverage,
                const std::string& glRenderer) {
     if (!(coverage > 0.0)) return false;
-    const bool software = glRenderer.find("llvmpipe") != std::string::npos ||
-                          glRenderer.find("softpipe") != std::string::npos ||
-                          glRenderer.find("swrast") != std::string::npos;
-    if (!software) return false;
+    if (!softwareRasterizer(glRenderer)) return false;
     double covered = 0.0;
     for (std::size_t k = 0; k < in.placements.size(); ++k) {
         const BakePlacement& p = in.placements[k];
@@ -317,6 +320,12 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
     }
     const std::size_t stride = uploadHeightBlocks(in, *resolved);
     drawHeightPass(in, *resolved, stride);
+    // Mesa's llvmpipe (egl-surfaceless and OSMesa alike) was seen to let the skin pass sample
+    // part of the previous content of the height targets when this pass follows an upload of CPU
+    // maps (glTexSubImage2D) and only clears them: a frame without placements after a CPU-baked
+    // one differed from the same frame rendered again (glFlush did not help). Waiting for the
+    // pass makes frames depend on their inputs only; hardware GLs are not affected.
+    if (softwareRasterizer(info.renderer)) glFinish();
     if (auto st = checkGl("height pass"); !st) return st;
     lastHeights = std::move(key);
     ++heightPasses;

@@ -167,7 +167,18 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool
         merged = images;
         for (const auto& [address, img] : overlay->images) merged[address] = img;
     }
-    auto plan = planFrame(resolved(*scene), m, merged.empty() ? images : merged, nullptr, {}, rl);
+    // The height-map layout and rest map the frames will use (SPEC §8), from the model entry's
+    // derived data (a listed model) so that its caches serve the frames after this check.
+    std::shared_ptr<const ModelDerived> derived;
+    if (auto entry = models.find(scene->model);
+        entry != models.end() && entry->second.model == modelPtr && entry->second.derived)
+        derived = entry->second.derived->get(modelPtr);
+    else
+        derived = std::make_shared<const ModelDerived>(modelPtr);
+    FrameOverrides o;
+    const Scene resolvedScene = resolved(*scene);
+    if (auto s = withLayout(resolvedScene, *derived, o); !s) return s.error();
+    auto plan = planFrame(resolvedScene, m, merged.empty() ? images : merged, nullptr, o, rl);
     if (!plan) return plan.error();
     Prepared out;
     out.canonical = toJson(*scene);
@@ -197,6 +208,12 @@ Service::State::Snapshot Service::State::snapshotOf(const Scene& scene, std::sha
     for (const Placement& p : snap.scene.placements)
         if (auto img = find(p.pattern)) snap.images.emplace(p.pattern, std::move(img));
     if (snap.scene.heightmapBase) snap.base = find(*snap.scene.heightmapBase);
+    // The model's derived data (layout, rest maps, UV index…): its entry's, built once per model.
+    if (auto entry = models.find(scene.model);
+        entry != models.end() && entry->second.model == snap.model && entry->second.derived)
+        snap.derived = entry->second.derived->get(snap.model);
+    else
+        snap.derived = std::make_shared<const ModelDerived>(snap.model);
     return snap;
 }
 

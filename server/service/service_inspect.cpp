@@ -27,15 +27,24 @@ double rounded(double x) {
 }
 
 /// The pick answer of a hit (shared by the frame and texture picks); the suggestion from the
-/// model's cached clip ranges (ModelDerived::suggestDriver, equal to core suggestDriver).
-json pickAnswer(const ModelDerived& derived, const PickHit& h) {
+/// model's cached clip ranges (ModelDerived::suggestDriver, equal to core suggestDriver). `uv` is
+/// in `layout` (the scene's height-map layout, SPEC §8) when given and covering the hit;
+/// `anchor` is where a surface placement would sit there (bind space; tangent across the
+/// suggested joint's bone).
+json pickAnswer(const ModelDerived& derived, const PickHit& h, const TextureLayout* layout) {
     const Model& m = derived.model();
     json joints = json::array();
     for (auto [node, weight] : h.joints)
         joints.push_back({{"name", m.nodes[static_cast<std::size_t>(node)].name}, {"weight", weight}});
     const SuggestedDriver d = derived.suggestDriver(h.joints);
+    glm::vec2 uv = h.uv;
+    if (layout)
+        if (auto l = layoutUv(*layout, h)) uv = *l;
+    const PickAnchor a = pickAnchor(m, h, d.joint.empty() ? -1 : findPosable(m, d.joint), derived.restSkin().world);
+    const auto vec = [](glm::dvec3 v) { return json::array({v.x, v.y, v.z}); };
     return json{{"hit", true},
-                {"uv", {h.uv.x, h.uv.y}},
+                {"uv", {uv.x, uv.y}},
+                {"anchor", {{"position", vec(a.position)}, {"normal", vec(a.normal)}, {"tangent", vec(a.tangent)}}},
                 {"position", {h.position.x, h.position.y, h.position.z}},
                 {"part", h.part},
                 {"triangle", h.triangle},
@@ -47,6 +56,7 @@ json pickAnswer(const ModelDerived& derived, const PickHit& h) {
 } // namespace
 
 std::shared_ptr<const ModelDerived> Service::State::derivedOf(const Snapshot& snap) const {
+    if (snap.derived && snap.derived->modelPtr() == snap.model) return snap.derived;
     std::shared_ptr<ModelDerivedSlot> slot;
     {
         std::shared_lock<std::shared_mutex> lock(mutex);
@@ -63,6 +73,7 @@ Result<json> Service::probe(const std::string& id, double u, double v, std::opti
     if (!snap) return snap.error();
     FrameOverrides o;
     o.time = time;
+    if (auto s = state_->withLayout(snap->scene, *state_->derivedOf(*snap), o); !s) return s.error();
     auto plan = planFrame(snap->scene, *snap->model, snap->images, snap->base, o);
     if (!plan) {
         Error e = plan.error();
@@ -154,7 +165,7 @@ Result<json> Service::pick(const std::string& id, const FrameParams& params, dou
     auto hit = pickFrame(*plan, *snap->model, x, y);
     if (!hit) return hit.error();
     if (!*hit) return json{{"hit", false}};
-    return pickAnswer(*state_->derivedOf(*snap), **hit);
+    return pickAnswer(*state_->derivedOf(*snap), **hit, plan->heights.layout.get());
 }
 
 
@@ -165,9 +176,11 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     if (!snap) return snap.error();
     if (!snap->model->hasUVs()) return bad("u", "the model has no UVs: nothing lies at a texture point");
     const auto derived = state_->derivedOf(*snap); // the model's UV index, built once
+    // TODO(lead): with a generated layout the texture view shows that layout's UV space: look
+    // the point up in an index of the layout (a UvLookup over its triangles), not the model's.
     const auto hit = dermis::pickUv(*snap->model, derived->uvLookup(), {u, v});
     if (!hit) return json{{"hit", false}};
-    return pickAnswer(*derived, *hit);
+    return pickAnswer(*derived, *hit, nullptr);
 }
 
 Result<json> Service::drivers(const std::string& id, const FrameParams& params) {

@@ -27,6 +27,7 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     o.view = p.view;
     RenderLimits rl;
     rl.maxSide = limits.maxRenderSide;
+    if (auto s = withLayout(snap.scene, *derivedOf(snap), o); !s) return s.error();
     auto planned = planFrame(snap.scene, *snap.model, snap.images, snap.base, o, rl);
     if (!planned) return detail::asParamError(planned.error(), p);
     return planned;
@@ -41,6 +42,9 @@ Result<std::vector<FrameOutline>> outlinesOf(const Scene& scene, const FramePara
     auto add = [&](const std::string& pid, FrameOutline::Kind kind, const char* field) -> Status {
         for (const Placement& pl : scene.placements)
             if (pl.id == pid) {
+                // TODO: an outline of a surface placement's decal (SPEC §8) — the outline block
+                // holds UV rectangles only; a surface placement is not outlined yet.
+                if (pl.projection == Projection::Surface) return Ok{};
                 out.push_back({glm::vec2(static_cast<float>(pl.center[0]), static_cast<float>(pl.center[1])),
                                glm::vec2(static_cast<float>(pl.scale[0]), static_cast<float>(pl.scale[1])),
                                static_cast<float>(pl.rotation), kind});
@@ -297,7 +301,9 @@ Result<EncodedImage> Service::heightmap(const std::string& id, const std::string
     if (!slot.ok()) return queueFull();
     auto snap = state_->snapshot(id);
     if (!snap) return snap.error();
-    auto plan = planFrame(snap->scene, *snap->model, snap->images, snap->base);
+    FrameOverrides o;
+    if (auto s = state_->withLayout(snap->scene, *state_->derivedOf(*snap), o); !s) return s.error();
+    auto plan = planFrame(snap->scene, *snap->model, snap->images, snap->base, o);
     if (!plan) return plan.error();
     auto maps = state_->renderer->bakeHeightMaps(plan->heights);
     if (!maps) return maps.error();

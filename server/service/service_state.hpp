@@ -247,6 +247,10 @@ struct Service::State {
         std::shared_ptr<const Model> model;
         PatternImages images; ///< the ones the scene uses
         std::shared_ptr<const PatternImage> base;
+        /// The model's derived data (its model entry's, or a fresh one for a model that is not
+        /// listed: a batch's content-addressed model); null when made elsewhere (derivedOf
+        /// finds it then).
+        std::shared_ptr<const ModelDerived> derived;
     };
     Result<Snapshot> snapshot(const std::string& id) const;
     /// The derived data of `snap`'s model (service_inspect.cpp): the one its model entry keeps,
@@ -254,6 +258,15 @@ struct Service::State {
     /// (or no longer) the entry's — deleted since the snapshot — gets a fresh, uncached one.
     /// Takes `mutex` shared itself (caller holds none). Never fails.
     std::shared_ptr<const ModelDerived> derivedOf(const Snapshot& snap) const;
+    /// The height-map layout `scene` uses on the model of `derived` (SPEC §8 uv_layout) — the
+    /// one place where it is chosen (service_layout.cpp). Today: the model's own UVs
+    /// (ModelDerived::modelLayout) for "model" and "auto"; "generated" fails (Unsupported,
+    /// "/uv_layout") until the generated layout is wired in.
+    Result<std::shared_ptr<const TextureLayout>> layoutFor(const Scene& scene, const ModelDerived& derived) const;
+    /// `o` given the layout of `scene` (layoutFor) and, when an enabled surface placement needs
+    /// one, the rest-surface map at the scene's height-map size from `derived`'s cache. Fails
+    /// like layoutFor.
+    Status withLayout(const Scene& scene, const ModelDerived& derived, FrameOverrides& o) const;
     /// Same for a document that is not stored (batch); caller holds `mutex` shared.
     Snapshot snapshotOf(const Scene& scene, std::shared_ptr<const Model> model,
                         const detail::ContentOverlay* overlay = nullptr) const;

@@ -11,6 +11,7 @@
 #include "io/webp_anim.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace dermis {
 
@@ -37,10 +38,39 @@ Result<json> Service::focus(const std::string& id, const std::string& pid, const
     if (!snap) return snap.error();
     auto index = placementAt(snap->scene, pid, id);
     if (!index) return index.error();
+    const Placement& p = snap->scene.placements[*index];
+    if (p.projection == Projection::Surface) {
+        // SPEC §8: the decal's anchor on the posed body (through the rest-mesh vertex nearest to
+        // it in bind space), and half the decal's diagonal.
+        auto plan = state_->plan(*snap, params);
+        if (!plan) return asParamError(plan.error(), params);
+        const Model& m = *snap->model;
+        const glm::dvec3 c(p.anchor.position[0], p.anchor.position[1], p.anchor.position[2]);
+        double best = std::numeric_limits<double>::infinity();
+        std::size_t bp = 0, bv = 0;
+        for (std::size_t pi = 0; pi < m.parts.size(); ++pi)
+            for (std::size_t v = 0; v < m.parts[pi].positions.size(); ++v) {
+                const double d = glm::length(glm::dvec3(m.parts[pi].positions[v]) - c);
+                if (d < best) {
+                    best = d;
+                    bp = pi;
+                    bv = v;
+                }
+            }
+        if (!std::isfinite(best)) return bad("placement", "the model has no vertices");
+        const std::vector<SkinnedPart> posed = skin(m, plan->world);
+        const glm::vec3 target = posed[bp].positions[bv];
+        const double radius = std::max(0.5 * std::hypot(p.size[0], p.size[1]), 1e-3);
+        return json{{"scene", id},
+                    {"placement", pid},
+                    {"target", {rounded(target.x), rounded(target.y), rounded(target.z)}},
+                    {"radius", rounded(radius)},
+                    {"distance", rounded(focusDistance(radius))},
+                    {"hit", best <= p.depthOrDefault()}};
+    }
     if (!snap->model->hasUVs()) return bad("placement", "the model has no UVs: a footprint lies nowhere");
     auto plan = state_->plan(*snap, params);
     if (!plan) return asParamError(plan.error(), params);
-    const Placement& p = snap->scene.placements[*index];
     const auto derived = state_->derivedOf(*snap);
     const auto region = footprintRegion(*snap->model, derived->uvLookup(), skin(*snap->model, plan->world),
                                         {p.center[0], p.center[1]}, {p.scale[0], p.scale[1]}, p.rotation);

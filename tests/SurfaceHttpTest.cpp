@@ -1,0 +1,236 @@
+// SurfaceHttpTest — surface placements (SPEC §8) over real HTTP (HttpTestFixture.hpp): pick
+// answers an anchor; a surface placement added there (POST) changes the frame only near the
+// picked pixel (frame-diff against patterns=off); PATCHing its anchor to another pick moves the
+// change; the canonical document echoes projection / anchor / size / depth and uv_layout; the
+// probe, lint, maps and the batch route take it; on CesiumMan the same; on RiggedFigure (no UVs)
+// uv_layout "model" refuses it with a clear error naming /uv_layout.
+#include "HttpTestFixture.hpp"
+
+#include <cmath>
+#include <cstring>
+
+using namespace dermis;
+using namespace dermis::test;
+using namespace dermis::test::http;
+
+namespace {
+
+class SurfaceHttpTest : public SharedServerTest {
+protected:
+    /// A scene of `model` with no placements, frames of 256² at msaa 1.
+    static json emptyScene(const std::string& model) {
+        return {{"format", "dermis.scene/1"},
+                {"model", model},
+                {"heightmap", {{"size", {512, 512}}}},
+                {"placements", json::array()},
+                {"render", {{"size", {256, 256}}, {"msaa", 1}, {"bump_strength", 4.0}}}};
+    }
+
+    /// A surface placement at a pick's anchor with the pick's suggested joint, active in any pose
+    /// (θ range [−360, −359]).
+    static json decalAt(const json& pick, const std::string& id, double size) {
+        return {{"id", id},
+                {"pattern", "round_bulge"},
+                {"joint", pick["suggested"]["joint"]},
+                {"theta_min", -360},
+                {"theta_max", -359},
+                {"target", "bump"},
+                {"projection", "surface"},
+                {"anchor", pick["anchor"]},
+                {"size", {size, size}}};
+    }
+
+    /// Bounds of the lit pixels of a frame-diff heat image, and their count.
+    struct Lit {
+        long count = 0;
+        int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+    };
+    static Lit litOf(const Reply& diff) {
+        Lit l;
+        auto heat = decodeFrame(diff.bytes());
+        EXPECT_TRUE(heat);
+        if (!heat) return l;
+        for (int y = 0; y < heat->height; ++y)
+            for (int x = 0; x < heat->width; ++x)
+                if (heat->rgba[(static_cast<std::size_t>(y) * heat->width + x) * 4] > 0) {
+                    ++l.count;
+                    l.x0 = std::min(l.x0, x);
+                    l.y0 = std::min(l.y0, y);
+                    l.x1 = std::max(l.x1, x);
+                    l.y1 = std::max(l.y1, y);
+                }
+        return l;
+    }
+
+    /// The first pixel of a scan (centre column outwards, `rows`) that hits the body: its pick.
+    static json pickOnBody(const std::string& s, std::initializer_list<int> rows, int& px, int& py) {
+        Http h = http();
+        for (int y : rows)
+            for (int dx : {0, 6, -6, 12, -12}) {
+                Reply r = h.get(s + "/pick?x=" + std::to_string(128 + dx) + "&y=" + std::to_string(y));
+                EXPECT_EQ(r.status, 200) << r;
+                if (r.status == 200 && r.js()["hit"] == true) {
+                    px = 128 + dx;
+                    py = y;
+                    return r.js();
+                }
+            }
+        return json();
+    }
+
+    /// Adds a decal at the pick of (px, py) and checks the frame changes only near it.
+    static void expectLocalDecal(const std::string& s, const json& pick, int px, int py, double size,
+                                 int reach) {
+        Http h = http();
+        Reply add = h.post(s + "/placements", decalAt(pick, "decal", size));
+        ASSERT_EQ(add.status, 201) << add;
+        Reply diff = h.get(s + "/frame-diff?against=off");
+        ASSERT_EQ(diff.status, 200) << diff;
+        const Lit l = litOf(diff);
+        EXPECT_GT(l.count, 20) << "the decal changes the frame";
+        EXPECT_EQ(std::to_string(l.count), diff.header("X-Dermis-Changed-Pixels"));
+        EXPECT_LE(std::max(std::abs(l.x0 - px), std::abs(l.x1 - px)), reach) << l.x0 << ".." << l.x1 << " vs " << px;
+        EXPECT_LE(std::max(std::abs(l.y0 - py), std::abs(l.y1 - py)), reach) << l.y0 << ".." << l.y1 << " vs " << py;
+    }
+};
+
+} // namespace
+
+TEST_F(SurfaceHttpTest, PickAnchorThenASurfacePlacementOnTheDefaultCharacter) {
+    Http h = http();
+    const std::string id = createScene(emptyScene("builtin:default"));
+    const std::string s = "/scenes/" + id;
+    int px = 0, py = 0;
+    const json pick = pickOnBody(s, {110, 120, 100}, px, py);
+    ASSERT_TRUE(pick.is_object()) << "no pixel of the torso hit";
+    ASSERT_TRUE(pick.contains("anchor")) << pick;
+    for (const char* key : {"position", "normal", "tangent"}) ASSERT_EQ(pick["anchor"][key].size(), 3u) << key;
+    double nn = 0, nt = 0;
+    for (int k = 0; k < 3; ++k) {
+        nn += std::pow(pick["anchor"]["normal"][k].get<double>(), 2);
+        nt += pick["anchor"]["normal"][k].get<double>() * pick["anchor"]["tangent"][k].get<double>();
+    }
+    EXPECT_NEAR(nn, 1.0, 1e-6);
+    EXPECT_NEAR(nt, 0.0, 1e-6);
+
+    expectLocalDecal(s, pick, px, py, 0.12, 40);
+
+    // The canonical document echoes what SPEC §8 lists.
+    Reply got = h.get(s);
+    ASSERT_EQ(got.status, 200);
+    const json doc = got.js()["scene"];
+    EXPECT_EQ(doc["uv_layout"], "auto");
+    const json& p = doc["placements"][0];
+    EXPECT_EQ(p["projection"], "surface");
+    EXPECT_EQ(p["anchor"]["position"].size(), 3u);
+    EXPECT_EQ(p["size"], json({0.12, 0.12}));
+    EXPECT_EQ(p["depth"], "auto");
+
+    // The probe at the pick's UV names the decal; the served map holds its value.
+    const double u = pick["uv"][0], v = pick["uv"][1];
+    Reply probe = h.get(s + "/probe?u=" + std::to_string(u) + "&v=" + std::to_string(v));
+    ASSERT_EQ(probe.status, 200) << probe;
+    ASSERT_EQ(probe.js()["contributions"].size(), 1u) << probe;
+    EXPECT_EQ(probe.js()["contributions"][0]["placement"], "decal");
+    EXPECT_GT(probe.js()["bump"].get<double>(), 0.0);
+    Reply map = h.get(s + "/heightmaps/bump?format=f32");
+    ASSERT_EQ(map.status, 200) << map;
+    const int x = probe.js()["texel"][0], y = probe.js()["texel"][1];
+    float served = 0;
+    std::memcpy(&served, map.body.data() + (static_cast<std::size_t>(y) * 512 + x) * 4, 4);
+    EXPECT_NEAR(served, probe.js()["bump"].get<double>(), 2e-3);
+
+    // Lint: the decal lies on the skin.
+    Reply lint = h.get(s + "/lint");
+    ASSERT_EQ(lint.status, 200) << lint;
+    for (const json& f : lint.js()) EXPECT_NE(f["code"], "off_surface") << f;
+
+    // Pick elsewhere, PATCH the anchor there: the change moves with it.
+    int qx = 0, qy = 0;
+    const json other = pickOnBody(s, {190, 200, 180}, qx, qy);
+    ASSERT_TRUE(other.is_object()) << "no pixel of the legs hit";
+    Reply patched = h.patch(s + "/placements/decal", {{"anchor", other["anchor"]}});
+    ASSERT_EQ(patched.status, 200) << patched;
+    Reply moved = h.get(s + "/frame-diff?against=off");
+    ASSERT_EQ(moved.status, 200);
+    const Lit l = litOf(moved);
+    EXPECT_GT(l.count, 20);
+    EXPECT_LE(std::max(std::abs(l.y0 - qy), std::abs(l.y1 - qy)), 40);
+
+    // Bad surface members are 422 with the field named; so is a layout not available yet.
+    expectError(h.patch(s + "/placements/decal", {{"size", {0, 1}}}), 422, "/placements/0/size/0");
+    // A merge patch merges into the anchor: null removes a member, which is required.
+    expectError(h.patch(s + "/placements/decal", {{"anchor", {{"normal", nullptr}}}}), 422,
+                "/placements/0/anchor/normal");
+    expectError(h.patch(s + "/placements/decal", {{"anchor", {{"tangent", other["anchor"]["normal"]}}}}),
+                422, "/placements/0/anchor/tangent");
+    json generated = doc;
+    generated["uv_layout"] = "generated";
+    expectError(h.put(s, generated), 422, "/uv_layout");
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
+TEST_F(SurfaceHttpTest, BatchAndSweepTakeSurfacePlacements) {
+    Http h = http();
+    const std::string id = createScene(emptyScene("builtin:default"));
+    const std::string s = "/scenes/" + id;
+    int px = 0, py = 0;
+    const json pick = pickOnBody(s, {110, 120, 100}, px, py);
+    ASSERT_TRUE(pick.is_object());
+    json doc = emptyScene("builtin:default");
+    doc["placements"].push_back(decalAt(pick, "decal", 0.12));
+    json off = doc;
+    off["placements"][0]["enabled"] = false;
+    auto frame = [&](const json& scene) {
+        Reply r = h.post("/render", {{"scene", scene}, {"frames", json::array({json{{"time", 0.0}}})},
+                                     {"format", "png"}});
+        EXPECT_EQ(r.status, 200) << r;
+        const auto parts = multipartAnswerParts(r);
+        EXPECT_EQ(parts.size(), 1u) << r;
+        return parts.empty() ? std::string() : parts[0].content;
+    };
+    const std::string with = frame(doc), without = frame(off);
+    ASSERT_FALSE(with.empty());
+    EXPECT_NE(with, without) << "the batch renders the decal";
+    EXPECT_EQ(with, frame(doc)) << "deterministic";
+    // The scene's own frame at that time is the batch's.
+    json stored = doc;
+    ASSERT_EQ(h.put(s, stored).status, 200);
+    Reply own = h.get(s + "/frame?time=0");
+    ASSERT_EQ(own.status, 200) << own;
+    EXPECT_EQ(own.body, with);
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
+TEST_F(SurfaceHttpTest, CesiumManTakesASurfacePlacement) {
+    const std::string model = uploadModel(kCesiumMan);
+    const std::string id = createScene(emptyScene(model));
+    const std::string s = "/scenes/" + id;
+    int px = 0, py = 0;
+    const json pick = pickOnBody(s, {110, 120, 100, 130}, px, py);
+    ASSERT_TRUE(pick.is_object()) << "no pixel of CesiumMan's body hit";
+    ASSERT_TRUE(pick.contains("anchor"));
+    expectLocalDecal(s, pick, px, py, 0.12, 50);
+    Http h = http();
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
+TEST_F(SurfaceHttpTest, RiggedFigureWithoutUvsRefusesSurfacePlacementsInItsOwnLayout) {
+    Http h = http();
+    const std::string model = uploadModel(kRiggedFigure);
+    const std::string id = createScene(emptyScene(model));
+    const std::string s = "/scenes/" + id;
+    // Pick works without UVs and answers an anchor.
+    int px = 0, py = 0;
+    const json pick = pickOnBody(s, {110, 120, 100, 130, 90}, px, py);
+    ASSERT_TRUE(pick.is_object()) << "no pixel of the figure hit";
+    ASSERT_TRUE(pick.contains("anchor"));
+    // The model's own (missing) UVs cannot hold the maps: a clear error naming /uv_layout.
+    json doc = emptyScene(model);
+    doc["uv_layout"] = "model";
+    doc["placements"].push_back(decalAt(pick, "decal", 0.1));
+    Reply r = h.put(s, doc);
+    expectError(r, 422, "/uv_layout");
+    EXPECT_NE(r.body.find("generated"), std::string::npos) << r;
+    ASSERT_EQ(h.del(s).status, 204);
+}
