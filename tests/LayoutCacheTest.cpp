@@ -173,16 +173,3 @@ TEST(LayoutCacheTest, KeepsTheNewestEntries) {
     EXPECT_EQ(gen.calls->load(), 4);
 }
 
-TEST(LayoutCacheTest, TheModelsOwnLayoutOncePerModel) {
-    CountingGenerator gen;
-    LayoutCache cache("", "test1", gen.fn());
-    auto m = std::make_shared<Model>(*quadModel());
-    m->parts[0].uvs = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
-    std::shared_ptr<const Model> model = m;
-    auto a = cache.own(model);
-    ASSERT_TRUE(a);
-    EXPECT_EQ(a->kind, "model");
-    EXPECT_EQ(a->parts[0].uvs, m->parts[0].uvs);
-    EXPECT_EQ(cache.own(model).get(), a.get());
-    EXPECT_EQ(gen.calls->load(), 0);
-}

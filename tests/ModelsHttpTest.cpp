@@ -132,6 +132,7 @@ TEST_F(ModelsHttpTest, CesiumManUploadsInspectsAndDeletes) {
     Reply uv = h.get("/models/" + id + "/uv-layout");
     ASSERT_EQ(uv.status, 200) << uv;
     const json layout = uv.js();
+    EXPECT_EQ(layout["layout"], "model"); // CesiumMan: its own UVs are usable
     ASSERT_TRUE(layout["edges"].is_array());
     EXPECT_GT(layout["edge_count"].get<std::size_t>(), 1000u);
     EXPECT_EQ(layout["edges"].size(), 4 * layout["edge_count"].get<std::size_t>());
@@ -352,6 +353,10 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
         density = density || (j["joint"] == "lowerarm.l" && j["texels_per_unit"].get<double>() > 0);
     EXPECT_TRUE(density) << uv["density"];
 
+    // Its UVs are not usable: auto lays the height maps out anew; the model's own stay asked for.
+    EXPECT_EQ(h.get("/models/" + barbId + "/uv-layout").js()["layout"], "generated");
+    EXPECT_EQ(h.get("/models/" + barbId + "/uv-layout?layout=model").js()["layout"], "model");
+
     // A scene on an uploaded model renders.
     json doc = {{"format", "dermis.scene/1"},
                 {"model", barbId},
@@ -379,8 +384,18 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
     EXPECT_EQ(figUv["missing"]["triangles"], 256);
     EXPECT_EQ(figUv["missing"]["parts"], 1);
     EXPECT_EQ(figUv["used_fraction"], 0.0);
-    expectError(h.get("/models/" + figId + "/uv-layout"), 422, "id");
-    expectError(h.get("/models/" + figId + "/uv-layout?format=png"), 422, "id");
+    // No UVs: the layout in use is the generated one (SPEC §8 uv_layout auto); its own is none.
+    Reply gen = h.get("/models/" + figId + "/uv-layout");
+    ASSERT_EQ(gen.status, 200) << gen;
+    EXPECT_EQ(gen.js()["layout"], "generated");
+    EXPECT_GT(gen.js()["edge_count"].get<std::size_t>(), 256u); // every triangle laid out
+    for (const json& v : gen.js()["edges"]) ASSERT_TRUE(v.get<double>() >= 0.0 && v.get<double>() <= 1.0);
+    Reply genPng = h.get("/models/" + figId + "/uv-layout?format=png&size=128&layout=generated");
+    ASSERT_EQ(genPng.status, 200) << genPng;
+    EXPECT_EQ(genPng.header("Content-Type"), "image/png");
+    expectError(h.get("/models/" + figId + "/uv-layout?layout=model"), 422, "layout");
+    expectError(h.get("/models/" + figId + "/uv-layout?format=png&layout=model"), 422, "layout");
+    expectError(h.get("/models/" + figId + "/uv-layout?layout=unique"), 422, "layout");
     json withPlacement = {{"format", "dermis.scene/1"},
                           {"model", figId},
                           {"placements", {placementOf("crease", "a")}}};

@@ -27,21 +27,6 @@ std::string LayoutCache::keyOf(const std::shared_ptr<const Model>& model) {
     return key;
 }
 
-std::shared_ptr<const TextureLayout> LayoutCache::own(const std::shared_ptr<const Model>& model) {
-    {
-        std::lock_guard<std::mutex> lock(mutex_);
-        auto it = own_.find(model.get());
-        if (it != own_.end() && !it->second.first.expired()) return it->second.second;
-    }
-    auto layout = std::make_shared<const TextureLayout>(modelTextureLayout(*model));
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (auto it = own_.begin(); it != own_.end();)
-        it = it->second.first.expired() ? own_.erase(it) : std::next(it);
-    auto [it, fresh] = own_.try_emplace(model.get(), model, layout);
-    if (!fresh && it->second.first.expired()) it->second = {model, layout};
-    return it->second.second;
-}
-
 void LayoutCache::touch(const std::string& key) {
     recent_.remove(key);
     recent_.push_front(key);

@@ -41,10 +41,6 @@ public:
     /// generator. Fails as the generator does (the failure is not cached).
     Result<std::shared_ptr<const TextureLayout>> generated(const std::shared_ptr<const Model>& model);
 
-    /// The model's own layout (core modelTextureLayout), made once per model object (memory only;
-    /// forgotten with the model).
-    std::shared_ptr<const TextureLayout> own(const std::shared_ptr<const Model>& model);
-
     /// The key `model`'s layout is cached under (core layoutContentKey with the salt); computed
     /// once per model object.
     std::string keyOf(const std::shared_ptr<const Model>& model);
@@ -64,7 +60,6 @@ private:
     std::map<std::string, Entry> entries_;             ///< by content key
     std::list<std::string> recent_;                    ///< keys, most recently used first
     std::map<const Model*, std::pair<std::weak_ptr<const Model>, std::string>> keys_;
-    std::map<const Model*, std::pair<std::weak_ptr<const Model>, std::shared_ptr<const TextureLayout>>> own_;
     Stats stats_;
 
     void touch(const std::string& key);

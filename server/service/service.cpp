@@ -338,7 +338,7 @@ Result<std::unique_ptr<Service>> Service::open(const ServiceConfig& config,
     auto store = Store::open(config.dataDir);
     if (!store) return store.error();
     st.store = std::move(*store);
-    st.layouts = detail::makeLayoutCache(st.store->dir() + "/cache/layouts");
+    st.layouts = makeLayoutCache(st.store->dir() + "/cache/layouts");
     // Single-threaded until returned: no locks needed.
     if (auto s = st.loadContent(); !s) return s.error();
     st.loadStored(svc->warnings_);

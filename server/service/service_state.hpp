@@ -191,7 +191,7 @@ private:
 } // namespace detail
 
 /// The service's cache of height-map layouts in `folder` (<data>/cache/layouts), generating with
-/// core generateTextureLayout at its default options (service_layouts.cpp).
+/// core generateTextureLayout at its default options (service_layout.cpp).
 std::unique_ptr<LayoutCache> makeLayoutCache(const std::string& folder);
 
 struct Service::State {
@@ -217,14 +217,14 @@ struct Service::State {
     std::unique_ptr<ContentCache> content; ///< by address; its own lock (no order with the others)
     std::unique_ptr<LayoutCache> layouts;  ///< height-map layouts per model; its own lock
 
-    /// The height-map layout `mode` names for `model` (SPEC §8; service_layouts.cpp): the model's
-    /// own UVs for Model, the generated layout for Generated, and for Auto the model's UVs when
-    /// the UV diagnosis finds them usable (present, overlap < 0.5 %), else generated. Needs no
-    /// lock (the model is shared and immutable). Fails for Model on a model without UVs
-    /// (InvalidArgument, field `field`) and as the generator does.
-    Result<std::shared_ptr<const TextureLayout>> layoutOf(const std::shared_ptr<const Model>& model,
-                                                          UvLayoutMode mode,
-                                                          const std::string& field = "uv_layout") const;
+    /// The height-map layout `mode` names for the model of `derived` (SPEC §8; service_layout.cpp,
+    /// the one place it is chosen): the model's own UVs (ModelDerived::modelLayout) for Model, the
+    /// generated layout (`layouts`) for Generated, and for Auto the model's UVs when the UV
+    /// diagnosis finds them usable (present, overlap < 0.5 % of used texels), else generated.
+    /// Needs no lock. Fails for Model on a model without UVs (InvalidArgument, field `field`)
+    /// and as the generator does.
+    Result<std::shared_ptr<const TextureLayout>> layoutOf(const ModelDerived& derived, UvLayoutMode mode,
+                                                          const std::string& field) const;
 
     /// The scene a document describes, validated against this server's models and patterns.
     struct Prepared {
@@ -258,10 +258,8 @@ struct Service::State {
     /// (or no longer) the entry's — deleted since the snapshot — gets a fresh, uncached one.
     /// Takes `mutex` shared itself (caller holds none). Never fails.
     std::shared_ptr<const ModelDerived> derivedOf(const Snapshot& snap) const;
-    /// The height-map layout `scene` uses on the model of `derived` (SPEC §8 uv_layout) — the
-    /// one place where it is chosen (service_layout.cpp). Today: the model's own UVs
-    /// (ModelDerived::modelLayout) for "model" and "auto"; "generated" fails (Unsupported,
-    /// "/uv_layout") until the generated layout is wired in.
+    /// The height-map layout `scene` uses on the model of `derived` (SPEC §8 uv_layout):
+    /// layoutOf(derived, scene.uvLayout, "/uv_layout").
     Result<std::shared_ptr<const TextureLayout>> layoutFor(const Scene& scene, const ModelDerived& derived) const;
     /// `o` given the layout of `scene` (layoutFor) and, when an enabled surface placement needs
     /// one, the rest-surface map at the scene's height-map size from `derived`'s cache. Fails
