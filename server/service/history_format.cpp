@@ -1,6 +1,7 @@
 #include "service/history_format.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -115,12 +116,21 @@ std::uint64_t lineRevision(std::string_view line, std::size_t& rest) {
 
 /// Index just past the string that starts at s[i] ('"'), or npos when it is not closed.
 std::size_t skipString(std::string_view s, std::size_t i) {
+    const char* p = s.data();
     for (++i; i < s.size(); ++i) {
-        if (s[i] == '\\') ++i;
-        else if (s[i] == '"') return i + 1;
+        const char c = p[i];
+        if (c == '\\') ++i;
+        else if (c == '"') return i + 1;
     }
     return std::string_view::npos;
 }
+
+/// The characters skipValue stops at inside an object or array.
+constexpr std::array<bool, 256> kStructural = [] {
+    std::array<bool, 256> t{};
+    for (unsigned char c : {'"', '{', '}', '[', ']'}) t[c] = true;
+    return t;
+}();
 
 /// Index just past the value that starts at s[i] in compact text (dump()'s: no whitespace), or
 /// npos when it is not closed: strings, brackets balanced, or a scalar up to , ] or }.
@@ -128,16 +138,21 @@ std::size_t skipValue(std::string_view s, std::size_t i) {
     if (i >= s.size()) return std::string_view::npos;
     if (s[i] == '"') return skipString(s, i);
     if (s[i] == '{' || s[i] == '[') {
+        const char* p = s.data();
         int depth = 0;
         while (i < s.size()) {
-            const char c = s[i];
+            const char c = p[i];
+            if (!kStructural[static_cast<unsigned char>(c)]) {
+                ++i;
+                continue;
+            }
             if (c == '"') {
                 i = skipString(s, i);
                 if (i == std::string_view::npos) return i;
                 continue;
             }
             if (c == '{' || c == '[') ++depth;
-            else if ((c == '}' || c == ']') && --depth == 0) return i + 1;
+            else if (--depth == 0) return i + 1;
             ++i;
         }
         return std::string_view::npos;
@@ -339,9 +354,10 @@ private:
             return makeError(ErrorCode::Parse, where, "patch", "the document is damaged there");
         std::string path;
         for (std::size_t k = from; k < t.size(); ++k) path += "/" + token(t[k]);
-        json inner = op;
-        inner["path"] = path;
-        return applyHistoryPatch(value, json::array({std::move(inner)}), where);
+        json ops = json::array();
+        ops.push_back(op);
+        ops.back()["path"] = std::move(path);
+        return applyHistoryPatch(value, ops, where);
     }
     /// Gives up the parts: the document parsed whole from them.
     void makeWhole() {

@@ -119,7 +119,16 @@ Result<std::string> Service::getSceneRevisionText(const std::string& id, std::ui
         scene = recent->dump();
     } else {
         auto text = state_->store->readRevisionText(id, revision);
-        if (!text) return text.error();
+        if (!text) {
+            if (text.error().code == ErrorCode::NotFound) { // dropped (and compacted) meanwhile?
+                std::shared_lock<std::shared_mutex> lock(state_->mutex);
+                auto it = state_->scenes.find(id);
+                if (it != state_->scenes.end())
+                    if (auto s = keptRevision(id, it->second, revision, state_->limits.historyKeep.flag()); !s)
+                        return s.error();
+            }
+            return text.error();
+        }
         scene = std::move(*text);
     }
     // {"current_revision", "id", "revision", "scene"}: dump()'s order (keys sorted).

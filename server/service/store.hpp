@@ -1,9 +1,10 @@
 // Dermis service — the server's data directory: uploaded models and patterns, and scene
 // documents, each written atomically and durably before a call returns (writeFileAtomically with
 // Durability::Durable: temp file in the same folder, fsync, rename over the target, fsync of the
-// folder), so that an acknowledged edit survives a crash or kill -9. Store::open removes what an
-// interrupted write left (names holding kTempMarker, at the top and in the three folders); the
-// store knows no other temporary names.
+// folder) — or, for the lines of a scene's history, appended whole and fsync'd — so that an
+// acknowledged edit survives a crash or kill -9. Store::open removes what an interrupted write
+// left (names holding kTempMarker, at the top and in the three folders; loadHistory those in a
+// history folder); the store knows no other temporary names.
 //
 // Layout under the data directory:
 //   models/<id>.glb      + models/<id>.json    (metadata, written last: the commit record)
