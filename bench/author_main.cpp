@@ -1,6 +1,7 @@
 // dermis-authorbench — the authoring API (SPEC §6) on a scene with a long history, over HTTP on
 // loopback; prints JSON. Usage: dermis-authorbench [--revisions N] [--repeat N] [--gl BACKEND]
-// (default 10,000 revisions, 50 requests per figure).
+// [--big-revisions N] [--big-placements N] (default 10,000 revisions, 50 requests per figure; a
+// 1,000-placement scene with 10,000 revisions; --big-revisions 0 leaves it out).
 //
 // Starts the server in-process (Service + Api on 127.0.0.1, a temporary data folder), creates a
 // small scene on the default character and edits it until it has N revisions (through the Service
@@ -16,6 +17,12 @@
 //    untimed, before each);
 //  * edit_if_match_rebased: the same PATCH with an If-Match one revision old, another client
 //    having changed the pose meanwhile (rebased);
+//  * big_history (issue #27.4): a scene of --big-placements placements edited one placement at a
+//    time until it has --big-revisions revisions: bytes its history takes on disk per edit (files'
+//    sizes, and the blocks they hold), the time of an edit while filling; then revision_read_big
+//    (GET ?revision=k, k spread over that history: its chunk's snapshot plus up to 255 patches),
+//    revision_read_big_service (Service::getSceneRevision, without HTTP and the answer's text)
+//    and edit_big (PATCH one placement with If-Match);
 //  * reopen_ms: Service::open of the data folder with that history.
 #include "http/api.hpp"
 #include "service/service.hpp"
@@ -32,7 +39,9 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <random>
 #include <thread>
+#include <sys/stat.h>
 #include <unistd.h>
 
 using namespace dermis;
@@ -49,28 +58,60 @@ const json kScene = json::parse(R"({
                   "joint": "forearm.l", "axis": "x", "theta_min": 0, "theta_max": 120}],
   "render": {"size": [128, 128], "msaa": 1}})");
 
+/// A scene of `n` placements of the crease, spread over the UV square.
+json bigScene(int n) {
+    json doc = kScene;
+    doc["placements"] = json::array();
+    for (int k = 0; k < n; ++k)
+        doc["placements"].push_back({{"id", "p" + std::to_string(k)}, {"pattern", "crease"},
+                                     {"center", {0.02 + 0.96 * (k % 40) / 40.0, 0.02 + 0.96 * (k / 40 % 40) / 40.0}},
+                                     {"scale", {0.02, 0.02}}, {"joint", "forearm.l"}, {"axis", "x"},
+                                     {"theta_min", 0}, {"theta_max", 120}});
+    return doc;
+}
+
+/// Bytes of the files under `dir`, and bytes of the blocks they hold.
+std::pair<double, double> folderBytes(const std::filesystem::path& dir) {
+    double bytes = 0, blocks = 0;
+    std::error_code ec;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(dir, ec)) {
+        struct stat st {};
+        if (!e.is_regular_file() || ::stat(e.path().c_str(), &st) != 0) continue;
+        bytes += static_cast<double>(st.st_size);
+        blocks += static_cast<double>(st.st_blocks) * 512.0;
+    }
+    return {bytes, blocks};
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
-    int revisions = 10000, repeat = 50;
+    int revisions = 10000, repeat = 50, bigRevisions = 10000, bigPlacements = 1000;
     GlBackend backend = GlBackend::Auto;
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--revisions") == 0 && i + 1 < argc) {
             revisions = std::max(10, std::atoi(argv[++i]));
         } else if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
             repeat = std::max(5, std::atoi(argv[++i]));
+        } else if (std::strcmp(argv[i], "--big-revisions") == 0 && i + 1 < argc) {
+            bigRevisions = std::max(0, std::atoi(argv[++i]));
+        } else if (std::strcmp(argv[i], "--big-placements") == 0 && i + 1 < argc) {
+            bigPlacements = std::clamp(std::atoi(argv[++i]), 1, 100000);
         } else if (std::strcmp(argv[i], "--gl") == 0 && i + 1 < argc) {
             auto b = glBackendFromString(argv[++i]);
             if (!b) return 2;
             backend = *b;
         } else {
-            std::cerr << "usage: dermis-authorbench [--revisions N] [--repeat N] [--gl BACKEND]\n";
+            std::cerr << "usage: dermis-authorbench [--revisions N] [--repeat N] [--gl BACKEND] "
+                         "[--big-revisions N] [--big-placements N]\n";
             return 2;
         }
     }
     const std::filesystem::path data = std::filesystem::temp_directory_path() /
                                        ("dermis-authorbench-" + std::to_string(::getpid()));
-    auto service = Service::open(data.string(), backend, ServerLimits{});
+    ServerLimits limits;
+    limits.maxPlacements = std::max<std::size_t>(limits.maxPlacements, static_cast<std::size_t>(bigPlacements));
+    auto service = Service::open(data.string(), backend, limits);
     if (!service) {
         std::cerr << service.error().message << "\n";
         return 1;
@@ -91,6 +132,34 @@ int main(int argc, char** argv) {
         }
     }
     const double fillMs = ms(fill0, Clock::now());
+
+    // The big scene: one placement moved per revision, as an editor's drags do.
+    json big = {{"revisions", bigRevisions}, {"placements", bigPlacements}};
+    std::string bigId;
+    if (bigRevisions > 1) {
+        auto made = (*service)->createScene(bigScene(bigPlacements));
+        if (!made) {
+            std::cerr << made.error().message << "\n";
+            return 1;
+        }
+        bigId = (*made)["id"];
+        std::mt19937 rng(27);
+        std::uniform_real_distribution<double> u(0.05, 0.95);
+        const auto t0 = Clock::now();
+        for (int r = 2; r <= bigRevisions; ++r) {
+            auto e = (*service)->patchPlacement(bigId, "p" + std::to_string(rng() % bigPlacements),
+                                                {{"center", {u(rng), u(rng)}}}, EditContext{{}, "bench"});
+            if (!e) {
+                std::cerr << e.error().message << "\n";
+                return 1;
+            }
+        }
+        const auto [bytes, blocks] = folderBytes(data / "scenes" / (bigId + ".history"));
+        big["fill_ms_per_edit"] = std::round(ms(t0, Clock::now()) / (bigRevisions - 1) * 100) / 100;
+        big["document_bytes"] = (*service)->getScene(bigId).value()["scene"].dump().size();
+        big["history_bytes_per_edit"] = std::round(bytes / bigRevisions);
+        big["history_block_bytes_per_edit"] = std::round(blocks / bigRevisions);
+    }
 
     ApiOptions opt;
     opt.port = 0;
@@ -136,6 +205,29 @@ int main(int argc, char** argv) {
         const int k = 1 + (r * 7919) % (revisions - 1);
         return ok(c.Get(base + "?revision=" + std::to_string(k)));
     });
+    if (!bigId.empty()) {
+        const std::string bigBase = "/api/v1/scenes/" + bigId;
+        measure("revision_read_big", [&](int r) {
+            const int k = 1 + (r * 7919) % (bigRevisions - 1);
+            return ok(c.Get(bigBase + "?revision=" + std::to_string(k)));
+        });
+        results.back()["revisions"] = bigRevisions;
+        measure("revision_read_big_service", [&](int r) {
+            const int k = 1 + (r * 104729) % (bigRevisions - 1);
+            return static_cast<bool>((*service)->getSceneRevision(bigId, static_cast<std::uint64_t>(k)));
+        });
+        results.back()["revisions"] = bigRevisions;
+        std::uint64_t bigCurrent = static_cast<std::uint64_t>(bigRevisions);
+        measure("edit_big", [&](int r) {
+            httplib::Headers h{{"If-Match", "\"r" + std::to_string(bigCurrent) + "\""},
+                               {"X-Dermis-Client", "bench"}};
+            auto res = c.Patch(bigBase + "/placements/p" + std::to_string(r % bigPlacements), h,
+                               json{{"center", {0.5, 0.3 + 0.001 * r}}}.dump(), "application/json");
+            ++bigCurrent;
+            return ok(res);
+        });
+        results.back()["revisions"] = bigRevisions;
+    }
     measure("revisions_page_newest", [&](int) { return ok(c.Get(base + "/revisions?limit=50")); });
     measure("revisions_page_middle", [&](int) {
         return ok(c.Get(base + "/revisions?limit=50&before=" + std::to_string(revisions / 2)));
@@ -225,7 +317,7 @@ int main(int argc, char** argv) {
     api.reset(); // before the service it serves
     service->reset();
     const auto open0 = Clock::now();
-    auto reopened = Service::open(data.string(), backend, ServerLimits{});
+    auto reopened = Service::open(data.string(), backend, limits);
     const double reopenMs = ms(open0, Clock::now());
     const bool reopenOk = reopened && (*reopened)->getScene(id);
     reopened = makeError(ErrorCode::Internal, "", "", "closed");
@@ -236,6 +328,7 @@ int main(int argc, char** argv) {
                       {"revisions", revisions},
                       {"fill_ms_per_edit", std::round(fillMs / (revisions - 1) * 1000) / 1000},
                       {"reopen_ms", std::round(reopenMs * 10) / 10},
+                      {"big_history", big},
                       {"hardware_threads", std::thread::hardware_concurrency()},
                       {"results", results}}
                      .dump(2)

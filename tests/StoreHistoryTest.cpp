@@ -80,6 +80,7 @@ json sceneOf(int n) {
 /// a deleted one, one moved, the pose, an odd value (−0.0, 1 vs 1.0, a key with "/" and "~").
 void randomEdit(json& doc, std::mt19937& rng, int& nextId) {
     std::uniform_real_distribution<double> u(0.0, 1.0);
+    if (!doc.contains("placements") || !doc["placements"].is_array()) doc["placements"] = json::array();
     json& pl = doc["placements"];
     const std::size_t n = pl.size();
     auto any = [&](std::size_t m) { return static_cast<std::size_t>(rng() % std::max<std::size_t>(1, m)); };
@@ -148,17 +149,45 @@ TEST(StoreHistoryTest, PatchesTurnEveryDocumentIntoTheNextByteForByte) {
     std::mt19937 rng(27);
     int nextId = 1000;
     json doc = sceneOf(40);
-    for (int step = 0; step < 3000; ++step) {
+    // Chunks of 40 revisions, as the store writes them: each revision read back from its chunk's
+    // text (the snapshot split, only touched parts parsed) and from a tree the patches applied to.
+    std::string chunk = snapshotLine(1, doc.dump());
+    std::uint64_t base = 1;
+    std::vector<std::string> texts = {doc.dump()};
+    for (std::uint64_t revision = 2; revision <= 3000; ++revision) {
         json next = doc;
         randomEdit(next, rng, nextId);
-        if (step % 7 == 0) randomEdit(next, rng, nextId);
+        if (revision % 7 == 0) randomEdit(next, rng, nextId);
+        if (revision % 500 == 0) next["placements"] = json::array({json{{"a", 1}}, json{{"b", 2}}}); // not an editor's
+        if (revision % 501 == 0) next.erase("placements");
+        if (revision % 502 == 0) next = sceneOf(3);
         const json patch = historyDiff(doc, next);
-        // Applied as a reader does: to the document parsed back from its text, the patch too.
         json replay = json::parse(doc.dump());
         ASSERT_TRUE(applyHistoryPatch(replay, json::parse(patch.dump()), "test")) << patch.dump();
-        ASSERT_EQ(replay.dump(), next.dump()) << "step " << step << ": " << patch.dump();
+        ASSERT_EQ(replay.dump(), next.dump()) << "revision " << revision << ": " << patch.dump();
+        if ((revision - 1) % 40 == 0) {
+            chunk = snapshotLine(revision, next.dump());
+            base = revision;
+            texts = {next.dump()};
+        } else {
+            chunk += patchLine(revision, patch);
+            texts.push_back(next.dump());
+            const std::uint64_t r = base + rng() % texts.size();
+            auto text = replayChunk(chunk, base, r, "c.jsonl", "test");
+            ASSERT_TRUE(text) << text.error().message;
+            ASSERT_EQ(*text, texts[r - base]) << "revision " << r << " of chunk " << base;
+        }
         doc = std::move(next);
     }
+    for (std::uint64_t r = base; r < base + texts.size(); ++r)
+        ASSERT_EQ(*replayChunk(chunk, base, r, "c.jsonl", "test"), texts[r - base]);
+    // A document that is not an object, and a root replaced: read back all the same.
+    const std::string odd = snapshotLine(1, "[1,2]") + patchLine(2, historyDiff(json::array({1, 2}), {{"x", 1}})) +
+                            patchLine(3, historyDiff({{"x", 1}}, {{"placements", json::array()}, {"x", 1}})) +
+                            patchLine(4, historyDiff({{"placements", json::array()}, {"x", 1}},
+                                                     {{"placements", {placement(1, 0.5)}}, {"x", 1}}));
+    EXPECT_EQ(*replayChunk(odd, 1, 2, "c1.jsonl", "test"), R"({"x":1})");
+    EXPECT_EQ(*replayChunk(odd, 1, 4, "c1.jsonl", "test"), json({{"placements", {placement(1, 0.5)}}, {"x", 1}}).dump());
     // Strict: values nlohmann::json::operator== calls equal still differ when their text does.
     for (const auto& [a, b] : std::vector<std::pair<json, json>>{{0.0, -0.0}, {1u, 1.0}, {1, 1u}}) {
         const json patch = historyDiff({{"x", a}}, {{"x", b}});
@@ -206,7 +235,8 @@ TEST(StoreHistoryTest, ChunkLinesAreScannedAndATornOneEndsTheChunk) {
     EXPECT_EQ(scanChunk(text, 8).size(), 2u);
     EXPECT_EQ(scanChunk(text + "{\"revision\":10,\"patch\":[{\"op\"").size(), 3u); // torn append
     EXPECT_EQ(scanChunk(text + "garbage\n" + patchLine(10, json::array())).size(), 3u);
-    EXPECT_EQ(replayChunk(text, 7, 9, "c7.jsonl", "test")->dump(), R"({"a":2,"b":"}\n"})");
+    EXPECT_EQ(*replayChunk(text, 7, 9, "c7.jsonl", "test"), R"({"a":2,"b":"}\n"})");
+    EXPECT_EQ(*replayChunk(text, 7, 7, "c7.jsonl", "test"), R"({"a":1})");
     EXPECT_EQ(replayChunk(text, 7, 10, "c7.jsonl", "test").error().code, ErrorCode::NotFound);
     EXPECT_EQ(replayChunk(text, 6, 9, "c6.jsonl", "test").error().code, ErrorCode::Parse);
     const std::string skipped = snapshotLine(7, R"({"a":1})") + patchLine(9, json::array());
@@ -318,18 +348,24 @@ TEST(StoreHistoryTest, AOnePlacementEditOfAThousandPlacementsTakesUnder2KB) {
               << " edits (" << static_cast<double>(blocks) / edits << " in blocks), "
               << writeMs / edits << " ms per durable write\n";
     EXPECT_LE(perEdit, 2048.0);
-    // Reading any revision: its chunk's snapshot plus at most kChunkRevisions − 1 patches.
-    std::vector<double> ms;
+    // Reading any revision: its chunk's snapshot plus at most kChunkRevisions − 1 patches, as
+    // text (what GET ?revision= sends) and parsed (what a revert or a frame needs).
+    std::vector<double> textMs, treeMs;
     for (int k = 0; k < 40; ++k) {
         const std::uint64_t r = 1 + (k * 7919) % edits;
         const auto t0 = Clock::now();
-        auto got = store->readRevision(id, r);
-        ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-        ASSERT_TRUE(got) << got.error().message;
+        auto text = store->readRevisionText(id, r);
+        const auto t1 = Clock::now();
+        auto tree = store->readRevision(id, r);
+        textMs.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        treeMs.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t1).count());
+        ASSERT_TRUE(text && tree);
+        ASSERT_EQ(tree->dump(), *text);
     }
-    std::sort(ms.begin(), ms.end());
-    std::cout << "[ figures  ] reading a revision of it: " << ms[ms.size() / 2] << " ms p50, " << ms.back()
-              << " ms max\n";
+    std::sort(textMs.begin(), textMs.end());
+    std::sort(treeMs.begin(), treeMs.end());
+    std::cout << "[ figures  ] reading a revision of it: " << textMs[textMs.size() / 2] << " ms p50, "
+              << textMs.back() << " ms max as text; " << treeMs[treeMs.size() / 2] << " ms p50 parsed\n";
     EXPECT_EQ(store->readRevision(id, edits)->dump(), kept.back().dump());
     EXPECT_EQ(store->readRevision(id, 37 * 5)->dump(), kept[4].dump());
 }

@@ -62,8 +62,15 @@ void installDocumentRoutes(RouteTable& t) {
     t.add("GET", "/scenes/{id}", [](Api::Impl& a, const Req& req, Res& res) {
         std::optional<std::uint64_t> revision;
         if (!revisionParam(req, res, "revision", revision)) return;
-        auto r = revision ? a.svc.getSceneRevision(req.matches[1], *revision)
-                          : a.svc.getScene(req.matches[1]);
+        if (revision) { // the stored text as it is (Service::getSceneRevisionText)
+            auto text = a.svc.getSceneRevisionText(req.matches[1], *revision);
+            if (!text) return sendError(res, text.error());
+            res.set_header("ETag", sceneEtag(*revision));
+            res.status = 200;
+            res.set_content(std::move(*text), "application/json");
+            return;
+        }
+        auto r = a.svc.getScene(req.matches[1]);
         if (!r) return sendError(res, r.error());
         setEtag(res, *r);
         sendJson(res, 200, *r);

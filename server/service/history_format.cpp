@@ -1,6 +1,7 @@
 #include "service/history_format.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -113,6 +114,265 @@ std::uint64_t lineRevision(std::string_view line, std::size_t& rest) {
     return n;
 }
 
+/// Index just past the string that starts at s[i] ('"'), or npos when it is not closed.
+std::size_t skipString(std::string_view s, std::size_t i) {
+    const char* p = s.data();
+    for (++i; i < s.size(); ++i) {
+        const char c = p[i];
+        if (c == '\\') ++i;
+        else if (c == '"') return i + 1;
+    }
+    return std::string_view::npos;
+}
+
+/// The characters skipValue stops at inside an object or array.
+constexpr std::array<bool, 256> kStructural = [] {
+    std::array<bool, 256> t{};
+    for (unsigned char c : {'"', '{', '}', '[', ']'}) t[c] = true;
+    return t;
+}();
+
+/// Index just past the value that starts at s[i] in compact text (dump()'s: no whitespace), or
+/// npos when it is not closed: strings, brackets balanced, or a scalar up to , ] or }.
+std::size_t skipValue(std::string_view s, std::size_t i) {
+    if (i >= s.size()) return std::string_view::npos;
+    if (s[i] == '"') return skipString(s, i);
+    if (s[i] == '{' || s[i] == '[') {
+        const char* p = s.data();
+        int depth = 0;
+        while (i < s.size()) {
+            const char c = p[i];
+            if (!kStructural[static_cast<unsigned char>(c)]) {
+                ++i;
+                continue;
+            }
+            if (c == '"') {
+                i = skipString(s, i);
+                if (i == std::string_view::npos) return i;
+                continue;
+            }
+            if (c == '{' || c == '[') ++depth;
+            else if (--depth == 0) return i + 1;
+            ++i;
+        }
+        return std::string_view::npos;
+    }
+    const std::size_t start = i;
+    while (i < s.size() && s[i] != ',' && s[i] != ']' && s[i] != '}' && s[i] != ' ' && s[i] != '\n') ++i;
+    return i > start ? i : std::string_view::npos;
+}
+
+/// The reference tokens of a JSON Pointer ("/a/b~1c" → a, b/c); nullopt when it is not one.
+std::optional<std::vector<std::string>> pointerTokens(const std::string& path) {
+    if (path.empty()) return std::vector<std::string>{};
+    if (path[0] != '/') return std::nullopt;
+    std::vector<std::string> tokens;
+    std::string t;
+    for (std::size_t i = 1; i <= path.size(); ++i) {
+        if (i == path.size() || path[i] == '/') {
+            tokens.push_back(std::move(t));
+            t.clear();
+        } else if (path[i] == '~') {
+            if (i + 1 >= path.size() || (path[i + 1] != '0' && path[i + 1] != '1')) return std::nullopt;
+            t += path[++i] == '0' ? '~' : '/';
+        } else {
+            t += path[i];
+        }
+    }
+    return tokens;
+}
+
+/// An array index token: digits without a leading zero, ≤ `limit`; nullopt otherwise.
+std::optional<std::size_t> indexToken(const std::string& t, std::size_t limit) {
+    if (t.empty() || t.size() > 9 || (t.size() > 1 && t[0] == '0')) return std::nullopt;
+    std::size_t n = 0;
+    for (char c : t) {
+        if (c < '0' || c > '9') return std::nullopt;
+        n = n * 10 + static_cast<std::size_t>(c - '0');
+    }
+    if (n > limit) return std::nullopt;
+    return n;
+}
+
+/// A document kept as the text it was stored as, split into its top-level members and the
+/// elements of its "placements" array: a patch operation parses only the part it touches, and
+/// text() joins the parts again — dump()'s bytes for the patched document (dump() is made of
+/// the dumps of the parts). Operations on the root, or other than add/remove/replace, parse the
+/// document whole first.
+class PartedDoc {
+public:
+    /// Splits compact object text (as dump() writes it); false when it is not of that shape.
+    bool load(std::string_view text) {
+        std::size_t i = 0;
+        if (text.size() < 2 || text[0] != '{') return false;
+        ++i;
+        if (text[i] == '}') return i + 1 == text.size();
+        while (true) {
+            if (i >= text.size() || text[i] != '"') return false;
+            const std::size_t k = skipString(text, i);
+            if (k == std::string_view::npos || k >= text.size() || text[k] != ':') return false;
+            const json key = json::parse(text.substr(i, k - i), nullptr, false);
+            if (!key.is_string()) return false;
+            const std::size_t v = skipValue(text, k + 1);
+            if (v == std::string_view::npos || v >= text.size()) return false;
+            if (!members_.empty() && !(members_.back().first < key.get_ref<const std::string&>()))
+                return false; // dump() writes members once each, in key order
+            members_.push_back({key.get<std::string>(), Part{text.substr(k + 1, v - k - 1), std::nullopt}});
+            i = v + 1;
+            if (text[v] == '}') break;
+            if (text[v] != ',') return false;
+        }
+        if (i != text.size()) return false;
+        if (Part* p = member("placements"); p && p->text.size() >= 2 && p->text[0] == '[') {
+            const std::string_view a = p->text;
+            split_ = true;
+            if (a == "[]") return true;
+            for (std::size_t j = 1; j < a.size();) {
+                const std::size_t e = skipValue(a, j);
+                if (e == std::string_view::npos || e >= a.size()) return false;
+                elements_.push_back(Part{a.substr(j, e - j), std::nullopt});
+                if (a[e] == ']') return e + 1 == a.size();
+                if (a[e] != ',') return false;
+                j = e + 1;
+            }
+            return false;
+        }
+        return true;
+    }
+    /// The fallback: `text` parsed whole. False when it is not JSON.
+    bool loadWhole(std::string_view text) {
+        json doc = json::parse(text, nullptr, false);
+        if (doc.is_discarded()) return false;
+        whole_ = std::move(doc);
+        return true;
+    }
+
+    Status apply(const json& op, const char* where) {
+        if (whole_) return applyHistoryPatch(*whole_, json::array({op}), where);
+        const std::string name = op.is_object() ? op.value("op", "") : "";
+        const auto path = op.is_object() && op.contains("path") && op["path"].is_string()
+                              ? pointerTokens(op["path"].get<std::string>())
+                              : std::nullopt;
+        const bool plain = name == "add" || name == "remove" || name == "replace";
+        if (!plain || !path || path->empty() || (name != "remove" && !op.contains("value"))) {
+            makeWhole();
+            return applyHistoryPatch(*whole_, json::array({op}), where);
+        }
+        const std::vector<std::string>& t = *path;
+        auto fail = [&](const std::string& what) {
+            return makeError(ErrorCode::Parse, where, "patch", op.value("path", "") + ": " + what);
+        };
+        const bool isPlacements = t[0] == "placements";
+        auto at = std::find_if(members_.begin(), members_.end(), [&](const auto& m) { return m.first == t[0]; });
+        if (t.size() == 1) { // a member itself
+            if (name != "add" && at == members_.end()) return fail("no such member");
+            if (name == "remove") {
+                members_.erase(at);
+                if (isPlacements) split_ = false, elements_.clear();
+                return Ok{};
+            }
+            const json& value = op["value"];
+            if (at == members_.end())
+                at = members_.insert(std::lower_bound(members_.begin(), members_.end(), t[0],
+                                                      [](const auto& m, const std::string& k) { return m.first < k; }),
+                                     {t[0], Part{}});
+            at->second = Part{{}, value};
+            if (isPlacements) {
+                split_ = value.is_array();
+                elements_.clear();
+                if (split_)
+                    for (const json& e : value) elements_.push_back(Part{{}, e});
+            }
+            return Ok{};
+        }
+        if (at == members_.end()) return fail("no such member");
+        if (isPlacements && split_) {
+            if (t.size() == 2) { // an element itself
+                const bool add = name == "add";
+                const auto k = t[1] == "-" && add ? std::optional<std::size_t>(elements_.size())
+                                                  : indexToken(t[1], add ? elements_.size() : elements_.size() - 1);
+                if (!k || (!add && elements_.empty())) return fail("no such element");
+                const auto pos = elements_.begin() + static_cast<std::ptrdiff_t>(*k);
+                if (name == "remove") elements_.erase(pos);
+                else if (add) elements_.insert(pos, Part{{}, op["value"]});
+                else *pos = Part{{}, op["value"]};
+                return Ok{};
+            }
+            const auto k = indexToken(t[1], elements_.empty() ? 0 : elements_.size() - 1);
+            if (!k || elements_.empty()) return fail("no such element");
+            return applyWithin(elements_[*k], t, 2, op, where);
+        }
+        return applyWithin(at->second, t, 1, op, where);
+    }
+
+    std::string text() const {
+        if (whole_) return whole_->dump();
+        std::string out = "{";
+        for (const auto& [key, part] : members_) {
+            if (out.size() > 1) out += ',';
+            out += json(key).dump();
+            out += ':';
+            if (key == "placements" && split_) {
+                out += '[';
+                for (std::size_t k = 0; k < elements_.size(); ++k) {
+                    if (k) out += ',';
+                    elements_[k].appendTo(out);
+                }
+                out += ']';
+            } else {
+                part.appendTo(out);
+            }
+        }
+        out += '}';
+        return out;
+    }
+
+private:
+    struct Part {
+        std::string_view text;       ///< as stored, while `value` is empty
+        std::optional<json> value;   ///< parsed (or replaced) once an operation touched it
+        json& get() {
+            if (!value) value = json::parse(text, nullptr, false);
+            return *value;
+        }
+        void appendTo(std::string& out) const {
+            if (value) out += value->dump();
+            else out.append(text);
+        }
+    };
+
+    Part* member(const std::string& key) {
+        for (auto& m : members_)
+            if (m.first == key) return &m.second;
+        return nullptr;
+    }
+    /// `op` applied inside `part`, at the path's tokens from `from` on.
+    static Status applyWithin(Part& part, const std::vector<std::string>& t, std::size_t from,
+                              const json& op, const char* where) {
+        json& value = part.get();
+        if (value.is_discarded())
+            return makeError(ErrorCode::Parse, where, "patch", "the document is damaged there");
+        std::string path;
+        for (std::size_t k = from; k < t.size(); ++k) path += "/" + token(t[k]);
+        json ops = json::array();
+        ops.push_back(op);
+        ops.back()["path"] = std::move(path);
+        return applyHistoryPatch(value, ops, where);
+    }
+    /// Gives up the parts: the document parsed whole from them.
+    void makeWhole() {
+        whole_ = json::parse(text(), nullptr, false);
+        members_.clear();
+        elements_.clear();
+        split_ = false;
+    }
+
+    std::vector<std::pair<std::string, Part>> members_; ///< in key order, as dump() writes them
+    std::vector<Part> elements_;                        ///< of "placements", when split_
+    bool split_ = false;
+    std::optional<json> whole_;
+};
+
 } // namespace
 
 json historyDiff(const json& from, const json& to) {
@@ -166,34 +426,35 @@ std::vector<ChunkLine> scanChunk(std::string_view bytes, std::uint64_t upTo) {
     return lines;
 }
 
-Result<json> replayChunk(std::string_view bytes, std::uint64_t base, std::uint64_t revision,
-                         const std::string& file, const char* where) {
+Result<std::string> replayChunk(std::string_view bytes, std::uint64_t base, std::uint64_t revision,
+                                const std::string& file, const char* where) {
     const std::vector<ChunkLine> lines = scanChunk(bytes, revision);
     auto damaged = [&](const std::string& what) {
         return makeError(ErrorCode::Parse, where, file, "damaged history chunk: " + what);
     };
     if (lines.empty() || !lines[0].snapshot || lines[0].revision != base)
         return damaged("its first line is not the snapshot of revision " + std::to_string(base));
-    json doc;
-    for (std::size_t k = 0; k < lines.size(); ++k) {
+    // The snapshot's document: the line less {"revision":B,"scene": and }\n.
+    const std::string head = "{\"revision\":" + std::to_string(base) + ",\"scene\":";
+    const std::string_view first = bytes.substr(lines[0].begin, lines[0].end - lines[0].begin);
+    if (first.size() < head.size() + 3) return damaged("an empty snapshot");
+    const std::string_view snapshot = first.substr(head.size(), first.size() - head.size() - 2);
+    if (revision == base) return std::string(snapshot);
+    PartedDoc doc;
+    if (!doc.load(snapshot) && !doc.loadWhole(snapshot)) return damaged("the snapshot is not JSON");
+    for (std::size_t k = 1; k < lines.size(); ++k) {
         const ChunkLine& l = lines[k];
-        if (l.revision != base + k || (k > 0 && l.snapshot))
+        if (l.revision != base + k || l.snapshot)
             return damaged("line " + std::to_string(k + 1) + " is not revision " + std::to_string(base + k));
-        json rec = json::parse(bytes.begin() + static_cast<std::ptrdiff_t>(l.begin),
-                               bytes.begin() + static_cast<std::ptrdiff_t>(l.end), nullptr, false);
-        if (!rec.is_object()) return damaged("revision " + std::to_string(l.revision) + " is not JSON");
-        if (k == 0) {
-            auto scene = rec.find("scene");
-            if (scene == rec.end()) return damaged("no snapshot document");
-            doc = std::move(*scene);
-        } else {
-            auto patch = rec.find("patch");
-            if (patch == rec.end() || !patch->is_array())
-                return damaged("revision " + std::to_string(l.revision) + " has no patch");
-            if (auto s = applyHistoryPatch(doc, *patch, where); !s)
+        const json rec = json::parse(bytes.begin() + static_cast<std::ptrdiff_t>(l.begin),
+                                     bytes.begin() + static_cast<std::ptrdiff_t>(l.end), nullptr, false);
+        const auto patch = rec.is_object() ? rec.find("patch") : rec.end();
+        if (!rec.is_object() || patch == rec.end() || !patch->is_array())
+            return damaged("revision " + std::to_string(l.revision) + " has no patch");
+        for (const json& op : *patch)
+            if (auto s = doc.apply(op, where); !s)
                 return damaged("revision " + std::to_string(l.revision) + ": " + s.error().message);
-        }
-        if (l.revision == revision) return doc;
+        if (l.revision == revision) return doc.text();
     }
     return makeError(ErrorCode::NotFound, where, "revision",
                      "the history holds no revision " + std::to_string(revision));

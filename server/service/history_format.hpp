@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -66,13 +67,18 @@ struct ChunkLine {
 std::vector<ChunkLine> scanChunk(std::string_view bytes,
                                  std::uint64_t upTo = ~std::uint64_t(0));
 
-/// Revision `revision`'s document from the bytes of chunk c<base>: its snapshot (first line, of
-/// revision `base`), then each patch line in turn (revisions base+1, base+2, …). NotFound (field
-/// "revision") when the chunk's lines stop before `revision`; Parse (field `file`) when a line
-/// on the way is damaged, out of order or does not apply.
-Result<nlohmann::json> replayChunk(std::string_view bytes, std::uint64_t base,
-                                   std::uint64_t revision, const std::string& file,
-                                   const char* where);
+/// The text of revision `revision`'s document — byte for byte the dump() of the document that
+/// was stored — from the bytes of chunk c<base>: its snapshot (first line, of revision `base`),
+/// then each patch line in turn (revisions base+1, base+2, …). The snapshot is not parsed whole:
+/// it is split into its top-level members and the elements of "placements", and a patch parses
+/// and dumps again only the parts it touches (so reading a revision of a 1,000-placement scene
+/// costs a scan of its text, not a parse); an operation elsewhere (the root, move/copy/test)
+/// parses the document whole. NotFound (field "revision") when the chunk's lines stop before
+/// `revision`; Parse (field `file`) when a line on the way is damaged, out of order or does not
+/// apply. The snapshot's text is checked for shape (strings closed, brackets balanced, members
+/// in order), not validated as JSON throughout.
+Result<std::string> replayChunk(std::string_view bytes, std::uint64_t base, std::uint64_t revision,
+                                const std::string& file, const char* where);
 
 /// `serve --history-keep`: how much of each scene's history is kept. Default: everything.
 struct HistoryRetention {

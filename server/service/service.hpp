@@ -300,7 +300,12 @@ public:
     Result<nlohmann::json> listRevisions(const std::string& id, std::size_t limit,
                                          std::optional<std::uint64_t> before) const;
     /// {"id", "revision": N, "current_revision", "scene"}: the document as it was at revision N.
+    /// NotFound for a revision the scene never had (or never kept); Gone for one the history
+    /// retention dropped (limits.historyKeep).
     Result<nlohmann::json> getSceneRevision(const std::string& id, std::uint64_t revision) const;
+    /// The same answer as JSON text (what GET ?revision=N sends): a revision read from the
+    /// history is put together from the stored text, never parsed whole (Store::readRevisionText).
+    Result<std::string> getSceneRevisionText(const std::string& id, std::uint64_t revision) const;
     /// A new revision whose document equals revision N's (undo and redo are reverts). Fails
     /// (NotFound, field "revision") for a revision the scene does not keep, and like any edit
     /// when N's document no longer validates (a model or pattern it used was deleted).

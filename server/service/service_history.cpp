@@ -96,8 +96,9 @@ Result<json> Service::listRevisions(const std::string& id, std::size_t limit,
     return json{{"id", id}, {"revision", it->second.revision}, {"revisions", std::move(list)}};
 }
 
-Result<json> Service::getSceneRevision(const std::string& id, std::uint64_t revision) const {
+Result<std::string> Service::getSceneRevisionText(const std::string& id, std::uint64_t revision) const {
     std::uint64_t current = 0;
+    std::shared_ptr<const json> recent;
     {
         std::shared_lock<std::shared_mutex> lock(state_->mutex);
         auto it = state_->scenes.find(id);
@@ -109,15 +110,45 @@ Result<json> Service::getSceneRevision(const std::string& id, std::uint64_t revi
                                             std::to_string(current) + ")");
         if (auto s = keptRevision(id, it->second, revision, state_->limits.historyKeep.flag()); !s)
             return s.error();
-        if (const SceneVersion* v = it->second.recentVersion(revision))
-            return json{{"id", id}, {"revision", revision}, {"current_revision", current},
-                        {"scene", *v->doc}};
+        if (const SceneVersion* v = it->second.recentVersion(revision)) recent = v->doc;
     }
     // Older revisions are read from disk, outside the lock (a chunk is only appended to; a
     // compaction deletes files of dropped revisions only).
-    auto doc = state_->store->readRevision(id, revision);
-    if (!doc) return doc.error();
-    return json{{"id", id}, {"revision", revision}, {"current_revision", current}, {"scene", *doc}};
+    std::string scene;
+    if (recent) {
+        scene = recent->dump();
+    } else {
+        auto text = state_->store->readRevisionText(id, revision);
+        if (!text) {
+            if (text.error().code == ErrorCode::NotFound) { // dropped (and compacted) meanwhile?
+                std::shared_lock<std::shared_mutex> lock(state_->mutex);
+                auto it = state_->scenes.find(id);
+                if (it != state_->scenes.end())
+                    if (auto s = keptRevision(id, it->second, revision, state_->limits.historyKeep.flag()); !s)
+                        return s.error();
+            }
+            return text.error();
+        }
+        scene = std::move(*text);
+    }
+    // {"current_revision", "id", "revision", "scene"}: dump()'s order (keys sorted).
+    std::string answer = json{{"current_revision", current}, {"id", id}, {"revision", revision}}.dump();
+    answer.pop_back();
+    answer.reserve(answer.size() + scene.size() + 10);
+    answer += ",\"scene\":";
+    answer += scene;
+    answer += '}';
+    return answer;
+}
+
+Result<json> Service::getSceneRevision(const std::string& id, std::uint64_t revision) const {
+    auto text = getSceneRevisionText(id, revision);
+    if (!text) return text.error();
+    json answer = json::parse(*text, nullptr, false);
+    if (answer.is_discarded())
+        return makeError(ErrorCode::Parse, "dermis::Service", "revision",
+                         "scene " + id + ": revision " + std::to_string(revision) + " is damaged in the history");
+    return answer;
 }
 
 Result<json> Service::revert(const std::string& id, std::uint64_t revision, const EditContext& ctx) {

@@ -1,9 +1,10 @@
 // Dermis service — the server's data directory: uploaded models and patterns, and scene
 // documents, each written atomically and durably before a call returns (writeFileAtomically with
 // Durability::Durable: temp file in the same folder, fsync, rename over the target, fsync of the
-// folder), so that an acknowledged edit survives a crash or kill -9. Store::open removes what an
-// interrupted write left (names holding kTempMarker, at the top and in the three folders); the
-// store knows no other temporary names.
+// folder) — or, for the lines of a scene's history, appended whole and fsync'd — so that an
+// acknowledged edit survives a crash or kill -9. Store::open removes what an interrupted write
+// left (names holding kTempMarker, at the top and in the three folders; loadHistory those in a
+// history folder); the store knows no other temporary names.
 //
 // Layout under the data directory:
 //   models/<id>.glb      + models/<id>.json    (metadata, written last: the commit record)
@@ -91,11 +92,14 @@ public:
     Status putScene(const std::string& id, std::uint64_t revision, const nlohmann::json& doc);
     /// Removes the current record, then the scene's history.
     Status removeScene(const std::string& id);
-    /// The document of revision `revision` of scene `id`, byte for byte (once dumped) the one
-    /// putScene was given: a whole-revision file r<N>.json when there is one, else the chunk
-    /// c<B>.jsonl with the largest B ≤ N (at most kChunkRevisions − 1 below), replayed up to N.
-    /// NotFound (field "revision") when no file holds that revision, Parse when one on the way is
-    /// damaged. Does not know the retention window (the service answers dropped revisions).
+    /// The text of revision `revision` of scene `id`: byte for byte the dump() of the document
+    /// putScene was given. From a whole-revision file r<N>.json when there is one, else from the
+    /// chunk c<B>.jsonl with the largest B ≤ N (at most kChunkRevisions − 1 below), replayed up to
+    /// N (replayChunk: the snapshot's text is split, not parsed). NotFound (field "revision") when
+    /// no file holds that revision, Parse when one on the way is damaged. Does not know the
+    /// retention window (the service answers dropped revisions).
+    Result<std::string> readRevisionText(const std::string& id, std::uint64_t revision) const;
+    /// The same document parsed (Parse when its text is not JSON).
     Result<nlohmann::json> readRevision(const std::string& id, std::uint64_t revision) const;
 
     /// A scene's history as loadHistory finds it.
@@ -150,7 +154,7 @@ private:
     Status putSceneImpl(const std::string& id, const RevisionInfo& info,
                         std::shared_ptr<const nlohmann::json> doc);
     Status removeSceneImpl(const std::string& id);
-    Result<nlohmann::json> readRevisionImpl(const std::string& id, std::uint64_t revision) const;
+    Result<std::string> readRevisionTextImpl(const std::string& id, std::uint64_t revision) const;
     Result<History> loadHistoryImpl(const std::string& id, std::uint64_t current,
                                     const nlohmann::json& currentDoc);
     Status dropRevisionsBeforeImpl(const std::string& id, std::uint64_t oldestKept,

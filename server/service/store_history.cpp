@@ -228,7 +228,7 @@ Status Store::removeSceneImpl(const std::string& id) {
     return Ok{};
 }
 
-Result<nlohmann::json> Store::readRevisionImpl(const std::string& id, std::uint64_t revision) const {
+Result<std::string> Store::readRevisionTextImpl(const std::string& id, std::uint64_t revision) const {
     const char* where = "dermis::Store::readRevision";
     const fs::path hist = historyDir(dir_, id);
     auto notKept = [&] {
@@ -240,11 +240,11 @@ Result<nlohmann::json> Store::readRevisionImpl(const std::string& id, std::uint6
     const fs::path whole = hist / revisionFile(revision);
     auto bytes = readWholeFile(whole.string(), std::size_t(1) << 30, where);
     if (bytes) {
-        nlohmann::json record = nlohmann::json::parse(bytes->begin(), bytes->end(), nullptr, false);
+        const nlohmann::json record = nlohmann::json::parse(bytes->begin(), bytes->end(), nullptr, false);
         if (!record.is_object() || !record.contains("scene") ||
             record.value("revision", std::uint64_t{0}) != revision)
             return makeError(ErrorCode::Parse, where, whole.string(), "damaged revision record");
-        return std::move(record["scene"]);
+        return record["scene"].dump();
     }
     if (bytes.error().code != ErrorCode::NotFound) return bytes.error();
     // The chunk with the largest base ≤ revision: at most kChunkRevisions − 1 below it.
@@ -398,8 +398,17 @@ Status Store::putScene(const std::string& id, const RevisionInfo& info,
     return hidden(putSceneImpl(id, info, std::move(doc)));
 }
 Status Store::removeScene(const std::string& id) { return hidden(removeSceneImpl(id)); }
+Result<std::string> Store::readRevisionText(const std::string& id, std::uint64_t revision) const {
+    return hidden(readRevisionTextImpl(id, revision));
+}
 Result<nlohmann::json> Store::readRevision(const std::string& id, std::uint64_t revision) const {
-    return hidden(readRevisionImpl(id, revision));
+    auto text = readRevisionText(id, revision);
+    if (!text) return text.error();
+    nlohmann::json doc = nlohmann::json::parse(*text, nullptr, false);
+    if (doc.is_discarded())
+        return makeError(ErrorCode::Parse, "dermis::Store::readRevision", "revision",
+                         "scene " + id + ": revision " + std::to_string(revision) + " is damaged");
+    return doc;
 }
 Result<Store::History> Store::loadHistory(const std::string& id, std::uint64_t current,
                                           const nlohmann::json& currentDoc) {
