@@ -125,6 +125,17 @@ int runRender(const RenderArgs& a) {
     // Frames are encoded and written on a worker while the next one renders (at most two waiting:
     // bounded memory). Each file's bytes are those of the sequential path (deterministic encoders).
     FrameWriteQueue writer(1, 2);
+    // SPEC §8: the height-map layout (the model's own UVs; TODO(lead): uv_layout "generated" and
+    // "auto" without usable UVs, as the service's layoutFor) and its rest-surface map, baked once
+    // for every frame when a surface placement needs it (planFrame would bake it per frame).
+    overrides.layout = std::make_shared<const TextureLayout>(modelTextureLayout(*model));
+    for (const Placement& p : loaded->scene.placements)
+        if (p.enabled && p.projection == Projection::Surface && !overrides.layout->empty()) {
+            overrides.rest = std::make_shared<const RestSurfaceMap>(
+                bakeRestSurface(*model, *overrides.layout, loaded->scene.heightmapSize[0],
+                                loaded->scene.heightmapSize[1]));
+            break;
+        }
     for (int k : todo) {
         overrides.time = animation ? range.time(k) : stillTime;
         auto plan = planFrame(loaded->scene, *model, loaded->images, loaded->base, overrides);
