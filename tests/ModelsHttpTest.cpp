@@ -396,10 +396,20 @@ TEST_F(ModelsHttpTest, BarbarianAndRiggedFigureUpload) {
     expectError(h.get("/models/" + figId + "/uv-layout?layout=model"), 422, "layout");
     expectError(h.get("/models/" + figId + "/uv-layout?format=png&layout=model"), 422, "layout");
     expectError(h.get("/models/" + figId + "/uv-layout?layout=unique"), 422, "layout");
+    // Its height maps live in the generated layout: a UV placement there is valid (and renders);
+    // the model's own layout has no texel for it.
+    json inUv = placementOf("crease", "a");
+    inUv["joint"] = "arm_joint_L_2";
     json withPlacement = {{"format", "dermis.scene/1"},
                           {"model", figId},
-                          {"placements", {placementOf("crease", "a")}}};
-    expectError(h.post("/scenes", withPlacement), 422, "/placements/0");
+                          {"heightmap", {{"size", {256, 256}}}},
+                          {"render", {{"size", {64, 64}}, {"msaa", 1}}},
+                          {"placements", {inUv}}};
+    const std::string genScene = createScene(withPlacement);
+    EXPECT_EQ(h.get("/scenes/" + genScene + "/frame").status, 200);
+    EXPECT_EQ(h.del("/scenes/" + genScene).status, 204);
+    withPlacement["uv_layout"] = "model";
+    expectError(h.post("/scenes", withPlacement), 422, "/uv_layout");
     // Without placements it is a valid scene.
     const std::string figScene = createScene(
         {{"format", "dermis.scene/1"}, {"model", figId}, {"heightmap", {{"size", {256, 256}}}}});

@@ -157,16 +157,25 @@ TEST_F(SurfaceHttpTest, PickAnchorThenASurfacePlacementOnTheDefaultCharacter) {
     EXPECT_GT(l.count, 20);
     EXPECT_LE(std::max(std::abs(l.y0 - qy), std::abs(l.y1 - qy)), 40);
 
-    // Bad surface members are 422 with the field named; so is a layout not available yet.
+    // Bad surface members are 422 with the field named.
     expectError(h.patch(s + "/placements/decal", {{"size", {0, 1}}}), 422, "/placements/0/size/0");
     // A merge patch merges into the anchor: null removes a member, which is required.
     expectError(h.patch(s + "/placements/decal", {{"anchor", {{"normal", nullptr}}}}), 422,
                 "/placements/0/anchor/normal");
     expectError(h.patch(s + "/placements/decal", {{"anchor", {{"tangent", other["anchor"]["normal"]}}}}),
                 422, "/placements/0/anchor/tangent");
-    json generated = doc;
+    // The same decal in the generated layout (SPEC §8: identical in every layout) changes the
+    // frame at the same place.
+    json generated = h.get(s).js()["scene"];
     generated["uv_layout"] = "generated";
-    expectError(h.put(s, generated), 422, "/uv_layout");
+    Reply put = h.put(s, generated);
+    ASSERT_EQ(put.status, 200) << put;
+    EXPECT_EQ(put.js()["scene"]["uv_layout"], "generated");
+    Reply inGenerated = h.get(s + "/frame-diff?against=off");
+    ASSERT_EQ(inGenerated.status, 200) << inGenerated;
+    const Lit g = litOf(inGenerated);
+    EXPECT_GT(g.count, 20);
+    EXPECT_LE(std::max(std::abs(g.y0 - qy), std::abs(g.y1 - qy)), 40);
     ASSERT_EQ(h.del(s).status, 204);
 }
 

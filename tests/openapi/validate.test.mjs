@@ -243,7 +243,9 @@ try {
   assert.equal(uv.json().edges.length, 4 * uv.json().edge_count);
   assert.ok(isPng((await api("GET", "/models/{id}/uv-layout", { params: { id: "builtin:default" }, query: "format=png&size=64", expect: 200 })).bytes));
   await api("GET", "/models/{id}/uv-layout", { params: { id: "builtin:default" }, query: "format=svg", expect: 422 });
-  await api("GET", "/models/{id}/uv-layout", { params: { id: uploaded.id }, expect: 422 }); // no UVs
+  // No UVs: auto is the generated layout; the model's own is refused.
+  assert.equal((await api("GET", "/models/{id}/uv-layout", { params: { id: uploaded.id }, expect: 200 })).json().layout, "generated");
+  await api("GET", "/models/{id}/uv-layout", { params: { id: uploaded.id }, query: "layout=model", expect: 422 });
   await api("DELETE", "/models/{id}", { params: { id: uploaded.id }, expect: 204 });
   await api("DELETE", "/models/{id}", { params: { id: uploadedGltf.id }, expect: 204 });
   await api("DELETE", "/models/{id}", { params: { id: "builtin:default" }, expect: 409 });
