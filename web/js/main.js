@@ -46,7 +46,10 @@ async function loadLint() {
 async function openScene(id, link = {}) {
   const answer = await api.get(`/scenes/${id}`);
   const model = await api.get(`/models/${encodeURIComponent(answer.scene.model)}`);
-  const layout = model.has_uvs ? await api.get(`/models/${encodeURIComponent(model.id)}/uv-layout`) : null;
+  // The height-map layout the scene uses (SPEC §8: its own UVs, or the generated layout where
+  // they are missing or shared); null where there is none to draw (uv_layout "model" without UVs).
+  const layoutMode = encodeURIComponent(answer.scene.uv_layout || "auto");
+  const layout = await api.get(`/models/${encodeURIComponent(model.id)}/uv-layout?layout=${layoutMode}`).catch(() => null);
   clearUndo();
   store.presence.clear();
   const camera = { yaw: link.yaw ?? 0, pitch: link.pitch ?? 10, distance: link.distance ?? null, target: link.target ?? null };

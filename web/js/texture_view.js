@@ -1,5 +1,5 @@
-// Texture view: the model's UV layout over its base-colour texture, the current bump or
-// displacement map as an optional overlay, and every placement as its pattern image inside its
+// Texture view: the height-map layout in use (the model's UVs over its base-colour texture, or
+// the generated layout), the current bump or displacement map as an optional overlay, and every placement as its pattern image inside its
 // rotated footprint, with handles on the selection (drag inside: move; corners: scale, Shift keeps
 // aspect; the round handle: rotate, Shift snaps to 15°; Esc during a drag cancels it). Wheel zooms
 // about the pointer; dragging empty space (or with the middle button) pans. Lint findings are
@@ -116,8 +116,10 @@ function draw() {
   // The UV square, its texture and the overlay.
   ctx.fillStyle = "#1a1f26";
   ctx.fillRect(ox, oy, s, s);
-  // Only a model with a base-colour texture is asked for one (no 404 on a clean load).
-  const tex = store.model.has_uvs && store.model.has_texture ? image(`/models/${encodeURIComponent(store.model.id)}/texture?size=1024`) : null;
+  // Only a model with a base-colour texture is asked for one (no 404 on a clean load), and only
+  // where the maps live in the model's own UVs (a generated layout has no texture under it).
+  const ownUVs = store.layout && store.layout.layout === "model";
+  const tex = ownUVs && store.model.has_texture ? image(`/models/${encodeURIComponent(store.model.id)}/texture?size=1024`) : null;
   if (tex) {
     ctx.globalAlpha = 0.55;
     ctx.drawImage(tex, ox, oy, s, s);
