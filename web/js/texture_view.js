@@ -1,13 +1,13 @@
-// Texture view: the height-map layout in use (the model's UVs over its base-colour texture, or
-// the generated layout), the current bump or displacement map as an optional overlay, and every
-// placement as its pattern image inside its rotated footprint, with handles on the selection (drag inside: move; corners: scale, Shift keeps
-// aspect; the round handle: rotate, Shift snaps to 15°; Esc during a drag cancels it). Wheel zooms
-// about the pointer; dragging empty space (or with the middle button) pans. Lint findings are
-// drawn on the footprints they concern, other people's selections in their colour. Labels are
-// placed so that they never overlap (the selection's first, then the hovered one, then document
-// order; each tries a few spots around its footprint); a label with no free spot is hidden until
-// its placement is hovered or selected. Keys (keys.js) zoom (Ctrl/Cmd+= / −) and pan (arrows
-// with nothing selected) through zoomBy and panBy.
+// Texture view: the height-map layout in use (the model's UVs over its base-colour texture, or the
+// generated layout), the current bump or displacement map as an optional overlay, and every
+// placement as its pattern image inside its rotated footprint, with handles on the selection (drag
+// inside: move; corners: scale, Shift keeps aspect; the round handle: rotate, Shift snaps to 15°;
+// Esc during a drag cancels it). Wheel zooms about the pointer; dragging empty space (or with the
+// middle button) pans. Lint findings are drawn on the footprints they concern, other people's
+// selections in their colour. Labels are placed so that they never overlap (the selection's first,
+// then the hovered one, then document order; each tries a few spots around its footprint); a label
+// with no free spot is hidden until its placement is hovered or selected. Keys (keys.js) zoom
+// (Ctrl/Cmd+= / −) and pan (arrows with nothing selected) through zoomBy and panBy.
 //
 // Draws from the store; edits go through edits.js (a Stream per drag: one edit when it ends).
 
