@@ -6,6 +6,7 @@
 // uv_layout "model" refuses it with a clear error naming /uv_layout.
 #include "HttpTestFixture.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -242,4 +243,55 @@ TEST_F(SurfaceHttpTest, RiggedFigureWithoutUvsRefusesSurfacePlacementsInItsOwnLa
     expectError(r, 422, "/uv_layout");
     EXPECT_NE(r.body.find("generated"), std::string::npos) << r;
     ASSERT_EQ(h.del(s).status, 204);
+}
+
+// Issue #22's acceptance: on a palette atlas (the KayKit Barbarian: texels shared by the hat, the
+// body and both arms) and on a model without UVs (RiggedFigure), one surface placement at one
+// elbow with `uv_layout: auto` changes frame pixels only near that elbow — auto lays the height
+// maps out anew (the generated layout), so no other region shares the decal's texels. In the
+// model's own UVs the Barbarian's decal shows elsewhere too (checked, so the test can fail).
+TEST_F(SurfaceHttpTest, OneElbowDecalStaysAtThatElbowOnAnyCharacter) {
+    struct Case {
+        std::string path;
+        std::vector<std::string> elbow;
+        double size; // model units: the Barbarian's elbow is wider than RiggedFigure's
+    };
+    // Scans a grid of the frame for a pick whose suggested driver is one of `joints`.
+    auto pickDrivenBy = [](const std::string& s, const std::vector<std::string>& joints, int& px, int& py) {
+        Http h = http();
+        for (int y = 24; y < 232; y += 8)
+            for (int x = 8; x < 248; x += 8) {
+                Reply r = h.get(s + "/pick?x=" + std::to_string(x) + "&y=" + std::to_string(y));
+                if (r.status != 200 || r.js()["hit"] != true || !r.js().contains("suggested")) continue;
+                const std::string j = r.js()["suggested"].value("joint", "");
+                if (std::find(joints.begin(), joints.end(), j) == joints.end()) continue;
+                px = x;
+                py = y;
+                return r.js();
+            }
+        return json();
+    };
+    for (const Case& c : {Case{kBarbarian, {"lowerarm.r", "lowerarm.l"}, 0.18},
+                          Case{kRiggedFigure, {"arm_joint_R_2", "arm_joint_L_2", "arm_joint_R_3", "arm_joint_L_3"}, 0.08}}) {
+        SCOPED_TRACE(c.path);
+        Http h = http();
+        const std::string model = uploadModel(c.path);
+        const std::string id = createScene(emptyScene(model));
+        const std::string s = "/scenes/" + id;
+        int px = 0, py = 0;
+        const json pick = pickDrivenBy(s, c.elbow, px, py);
+        ASSERT_TRUE(pick.is_object()) << "no pixel of an elbow found";
+        expectLocalDecal(s, pick, px, py, c.size, 45);
+        EXPECT_EQ(h.get("/models/" + model + "/uv-layout").js()["layout"], "generated");
+        if (c.path == kBarbarian) {
+            // The same decal in the model's own (shared) texels lights pixels far from the elbow.
+            json own = h.get(s).js()["scene"];
+            own["uv_layout"] = "model";
+            ASSERT_EQ(h.put(s, own).status, 200);
+            const Lit l = litOf(h.get(s + "/frame-diff?against=off"));
+            EXPECT_GT(std::max({std::abs(l.x0 - px), std::abs(l.x1 - px), std::abs(l.y0 - py), std::abs(l.y1 - py)}), 40)
+                << "in the palette atlas the decal also shows on the regions sharing its texels";
+        }
+        ASSERT_EQ(h.del(s).status, 204);
+    }
 }
