@@ -15,16 +15,6 @@
 namespace dermis::layout_detail {
 namespace {
 
-bool segmentsCross(const glm::dvec2& p1, const glm::dvec2& p2, const glm::dvec2& q1,
-                   const glm::dvec2& q2) {
-    auto orient = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
-        return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-    };
-    const double d1 = orient(q1, q2, p1), d2 = orient(q1, q2, p2);
-    const double d3 = orient(p1, p2, q1), d4 = orient(p1, p2, q2);
-    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
-}
-
 /// True when two boundary edges cross (edges sharing a vertex are not compared): a sweep over
 /// the edges sorted by their smallest x.
 bool boundaryCrosses(const LocalChart& lc, const std::vector<glm::dvec2>& uv) {

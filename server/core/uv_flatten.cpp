@@ -84,8 +84,6 @@ void conjugateGradient(const SparseMatrix& a, const std::vector<double>& b, std:
     }
 }
 
-namespace {
-
 bool segmentsCross(const glm::dvec2& p1, const glm::dvec2& p2, const glm::dvec2& q1,
                    const glm::dvec2& q2) {
     auto orient = [](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c) {
@@ -95,6 +93,8 @@ bool segmentsCross(const glm::dvec2& p1, const glm::dvec2& p2, const glm::dvec2&
     const double d3 = orient(p1, p2, q1), d4 = orient(p1, p2, q2);
     return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
 }
+
+namespace {
 
 /// True when the chart's boundary loop crosses itself (non-adjacent edges intersect).
 bool boundarySelfIntersects(const std::vector<std::uint32_t>& loop,

@@ -24,6 +24,11 @@
 
 namespace dermis {
 
+/// Whether the open segments p1p2 and q1q2 cross at one point inside both (touching ends or
+/// collinear overlaps do not count).
+bool segmentsCross(const glm::dvec2& p1, const glm::dvec2& p2, const glm::dvec2& q1,
+                   const glm::dvec2& q2);
+
 /// Signed area of the 2-D triangle (a, b, c), positive when counter-clockwise (y up).
 double signedArea(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c);
 
