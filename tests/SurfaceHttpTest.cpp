@@ -222,6 +222,33 @@ TEST_F(SurfaceHttpTest, CesiumManTakesASurfacePlacement) {
     ASSERT_TRUE(pick.contains("anchor"));
     expectLocalDecal(s, pick, px, py, 0.12, 50);
     Http h = http();
+    // SPEC §8: the decal is the same in every layout — CesiumMan's own UVs and the generated
+    // layout give the same frame up to the maps' sampling (different texel densities).
+    Reply own = h.get(s + "/frame?format=png");
+    ASSERT_EQ(own.status, 200);
+    json doc = h.get(s).js()["scene"];
+    doc["uv_layout"] = "generated";
+    ASSERT_EQ(h.put(s, doc).status, 200);
+    Reply gen = h.get(s + "/frame?format=png");
+    ASSERT_EQ(gen.status, 200);
+    auto a = decodeFrame(own.bytes()), b = decodeFrame(gen.bytes());
+    ASSERT_TRUE(a && b);
+    ASSERT_EQ(a->rgba.size(), b->rgba.size());
+    double sum = 0;
+    int worst = 0;
+    long far = 0;
+    for (std::size_t k = 0; k < a->rgba.size(); ++k) {
+        const int d = std::abs(int(a->rgba[k]) - int(b->rgba[k]));
+        sum += d;
+        worst = std::max(worst, d);
+        far += d > 24;
+    }
+    const double mean = sum / double(a->rgba.size());
+    std::printf("CesiumMan decal, model vs generated layout: mean |d| %.4f, max %d, %ld channels > 24\n", mean, worst,
+                far);
+    EXPECT_LT(mean, 0.05);  // seen: 0.0008
+    EXPECT_LE(worst, 8);    // seen: 2 (of 255)
+    EXPECT_EQ(far, 0);
     ASSERT_EQ(h.del(s).status, 204);
 }
 
