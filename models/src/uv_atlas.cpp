@@ -413,21 +413,10 @@ bool buildAtlas(const TriMesh& mesh, const Body& body, const Skeleton& skeleton,
         const ChartInfo& info = atlas.charts[ci];
         const glm::dvec3 p0(mesh.positions[mesh.tris[t][0]]), p1(mesh.positions[mesh.tris[t][1]]),
             p2(mesh.positions[mesh.tris[t][2]]);
-        const glm::dvec3 e1 = glm::normalize(p1 - p0),
-                         nrm = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-        const glm::dvec3 e2 = glm::cross(nrm, e1);
-        const glm::dvec2 x1(glm::length(p1 - p0), 0),
-            x2(glm::dot(p2 - p0, e1), glm::dot(p2 - p0, e2));
         const glm::dvec2 u0(atlas.uvs[atlas.tris[t][0]]), u1(atlas.uvs[atlas.tris[t][1]]),
             u2(atlas.uvs[atlas.tris[t][2]]);
-        // J · [x1 x2] = [u1−u0 u2−u0]
-        const glm::dmat2 X(x1, x2), U(u1 - u0, u2 - u0);
-        const glm::dmat2 J = U * glm::inverse(X);
-        const double a = J[0][0], b = J[1][0], c = J[0][1], d = J[1][1];
-        const double s1sq = 0.5 * (a * a + b * b + c * c + d * d);
-        const double det = std::abs(a * d - b * c);
-        const double disc = std::sqrt(std::max(s1sq * s1sq - det * det, 0.0));
-        const double smax = std::sqrt(s1sq + disc), smin = std::sqrt(std::max(s1sq - disc, 1e-30));
+        const MapSingularValues sv = mapSingularValues(p0, p1, p2, u0, u1, u2);
+        const double smax = sv.smax, smin = std::max(sv.smin, std::sqrt(1e-30)), det = sv.det;
         const double area = 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
         const double chartScale = info.uvArea / info.surfaceArea;
         confSum[ci] += area * smax / smin;

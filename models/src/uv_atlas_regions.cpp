@@ -5,6 +5,8 @@
 // Declared in uv_atlas_internal.hpp.
 #include "uv_atlas_internal.hpp"
 
+#include "core/disjoint_sets.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -117,18 +119,7 @@ LocalMesh buildLocal(const TriMesh& mesh, const std::vector<std::array<int, 3>>&
     for (std::size_t i = 0; i < tris.size(); ++i)
         localIndex[tris[i]] = static_cast<int>(i);
     const std::size_t nc = tris.size() * 3;
-    std::vector<std::size_t> parent(nc);
-    std::iota(parent.begin(), parent.end(), std::size_t(0));
-    auto find = [&](std::size_t x) {
-        while (parent[x] != x)
-            x = parent[x] = parent[parent[x]];
-        return x;
-    };
-    auto unite = [&](std::size_t a, std::size_t b) {
-        a = find(a);
-        b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    };
+    DisjointSets corners(nc);
     auto cornerOf = [&](int lt, std::uint32_t v) {
         const glm::uvec3& tri =
             mesh.tris[static_cast<std::size_t>(tris[static_cast<std::size_t>(lt)])];
@@ -144,15 +135,15 @@ LocalMesh buildLocal(const TriMesh& mesh, const std::vector<std::array<int, 3>>&
             const std::uint32_t a = mesh.tris[t][c], b = mesh.tris[t][(c + 1) % 3];
             if (cuts.count(edgeKey(a, b))) continue;
             const int lo = localIndex[o];
-            unite(i * 3 + static_cast<std::size_t>(c), cornerOf(lo, a));
-            unite(i * 3 + static_cast<std::size_t>((c + 1) % 3), cornerOf(lo, b));
+            corners.joinToSmaller(i * 3 + static_cast<std::size_t>(c), cornerOf(lo, a));
+            corners.joinToSmaller(i * 3 + static_cast<std::size_t>((c + 1) % 3), cornerOf(lo, b));
         }
     }
     std::map<std::size_t, std::uint32_t> vid;
     lm.local.resize(tris.size());
     for (std::size_t i = 0; i < tris.size(); ++i)
         for (int c = 0; c < 3; ++c) {
-            const std::size_t root = find(i * 3 + static_cast<std::size_t>(c));
+            const std::size_t root = corners.root(i * 3 + static_cast<std::size_t>(c));
             auto it = vid.find(root);
             if (it == vid.end()) {
                 it = vid.emplace(root, static_cast<std::uint32_t>(lm.source.size())).first;

@@ -2,6 +2,7 @@
 // and orientation per triangle; charts as connected pieces; two rasters at the map's resolution —
 // texel centres covered (used and overlapping texels) and texels touched at all (conservative:
 // the gutters) — and the distortion of the map surface → UV.
+#include "disjoint_sets.hpp"
 #include "layout_gen.hpp"
 
 #include "uv_flatten.hpp"
@@ -75,17 +76,7 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
     LayoutCheck check;
     const int n = std::max(resolution, 1);
     std::vector<Tri> tris;
-    std::vector<std::size_t> parent;
-    auto find = [&](std::size_t x) {
-        while (parent[x] != x)
-            x = parent[x] = parent[parent[x]];
-        return x;
-    };
-    auto unite = [&](std::size_t a, std::size_t b) {
-        a = find(a);
-        b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    };
+    DisjointSets pieces; // by triangle: those sharing a layout vertex or UV point
     for (std::size_t k = 0; k < layout.parts.size() && k < model.parts.size(); ++k) {
         const PartLayout& pl = layout.parts[k];
         const MeshPart& part = model.parts[k];
@@ -139,20 +130,20 @@ LayoutCheck checkTextureLayout(const Model& model, const TextureLayout& layout, 
             if (!(signedArea(tri.uv[0], tri.uv[1], tri.uv[2]) < 0)) ++check.flipped;
             const std::size_t id = tris.size();
             tris.push_back(tri);
-            parent.push_back(id);
+            pieces.add();
             for (int c = 0; c < 3; ++c) {
                 const std::uint32_t p = point[pl.indices[3 * t + static_cast<std::size_t>(c)]];
                 if (firstTri[p] < 0)
                     firstTri[p] = static_cast<std::int64_t>(id);
                 else
-                    unite(static_cast<std::size_t>(firstTri[p]), id);
+                    pieces.joinToSmaller(static_cast<std::size_t>(firstTri[p]), id);
             }
         }
     }
     // Dense chart numbers in order of first triangle.
     std::vector<std::int64_t> dense(tris.size(), -1);
     for (std::size_t i = 0; i < tris.size(); ++i) {
-        const std::size_t r = find(i);
+        const std::size_t r = pieces.root(i);
         if (dense[r] < 0) dense[r] = static_cast<std::int64_t>(check.charts++);
         tris[i].chart = static_cast<std::size_t>(dense[r]);
     }

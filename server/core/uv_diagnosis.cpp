@@ -1,6 +1,8 @@
 // UV diagnosis. See uv_diagnosis.hpp.
 #include "uv_diagnosis.hpp"
 
+#include "disjoint_sets.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -29,15 +31,6 @@ std::int64_t wrap(std::int64_t a, std::int64_t n) {
     return r < 0 ? r + n : r;
 }
 
-struct Components {
-    std::vector<std::uint32_t> parent;
-    explicit Components(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    std::uint32_t root(std::uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-    }
-    void join(std::uint32_t a, std::uint32_t b) { parent[root(a)] = root(b); }
-};
 
 /// One triangle with UVs.
 struct Tri {
@@ -196,7 +189,7 @@ UvDiagnosis diagnoseUvs(const Model& model, const RestSkin& rest, const Symmetry
             }
             return true;
         };
-        Components comp(p.uvs.size());
+        DisjointSets comp(p.uvs.size());
         for (std::size_t t = 0; t < count; ++t)
             if (valid(t)) {
                 comp.join(p.indices[3 * t], p.indices[3 * t + 1]);
@@ -209,7 +202,7 @@ UvDiagnosis diagnoseUvs(const Model& model, const RestSkin& rest, const Symmetry
                 ++d.missingTriangles;
                 continue;
             }
-            const std::uint32_t r = comp.root(p.indices[3 * t]);
+            const auto r = static_cast<std::uint32_t>(comp.root(p.indices[3 * t]));
             if (islandOfRoot[r] < 0) {
                 islandOfRoot[r] = static_cast<int>(islands.size());
                 islands.emplace_back();

@@ -51,37 +51,7 @@ void SparseMatrix::mul(const std::vector<double>& x, std::vector<double>& y) con
 
 void conjugateGradient(const SparseMatrix& a, const std::vector<double>& b, std::vector<double>& x,
                        int maxIter, double tol) {
-    const auto n = static_cast<std::size_t>(a.n);
-    std::vector<double> r(n), p(n), ap(n);
-    a.mul(x, ap);
-    double bb = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        r[i] = b[i] - ap[i];
-        bb += b[i] * b[i];
-    }
-    p = r;
-    double rr = 0;
-    for (double v : r)
-        rr += v * v;
-    if (bb == 0) bb = 1;
-    for (int it = 0; it < maxIter && rr > tol * tol * bb; ++it) {
-        a.mul(p, ap);
-        double pap = 0;
-        for (std::size_t i = 0; i < n; ++i)
-            pap += p[i] * ap[i];
-        if (pap <= 0) break;
-        const double alpha = rr / pap;
-        double rr2 = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * ap[i];
-            rr2 += r[i] * r[i];
-        }
-        const double beta = rr2 / rr;
-        rr = rr2;
-        for (std::size_t i = 0; i < n; ++i)
-            p[i] = r[i] + beta * p[i];
-    }
+    preconditionedConjugateGradient(a, [](std::size_t) { return 1.0; }, b, x, maxIter, tol);
 }
 
 bool segmentsCross(const glm::dvec2& p1, const glm::dvec2& p2, const glm::dvec2& q1,
@@ -123,23 +93,6 @@ double signedArea(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c)
     return 0.5 * ((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y));
 }
 
-double conformalDistortion(const glm::vec3& q0, const glm::vec3& q1, const glm::vec3& q2,
-                           const glm::dvec2& u0, const glm::dvec2& u1, const glm::dvec2& u2) {
-    const glm::dvec3 p0(q0), p1(q1), p2(q2);
-    const glm::dvec3 e1 = glm::normalize(p1 - p0),
-                     nrm = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-    const glm::dvec3 e2 = glm::cross(nrm, e1);
-    const glm::dvec2 x1(glm::length(p1 - p0), 0), x2(glm::dot(p2 - p0, e1), glm::dot(p2 - p0, e2));
-    const glm::dmat2 X(x1, x2), U(u1 - u0, u2 - u0);
-    const glm::dmat2 J = U * glm::inverse(X);
-    const double a = J[0][0], b = J[1][0], c = J[0][1], d = J[1][1];
-    const double s1sq = 0.5 * (a * a + b * b + c * c + d * d);
-    const double det = std::abs(a * d - b * c);
-    const double disc = std::sqrt(std::max(s1sq * s1sq - det * det, 0.0));
-    const double smax = std::sqrt(s1sq + disc), smin = std::sqrt(std::max(s1sq - disc, 1e-30));
-    return smax / smin;
-}
-
 MapSingularValues mapSingularValues(const glm::dvec3& p0, const glm::dvec3& p1,
                                     const glm::dvec3& p2, const glm::dvec2& u0,
                                     const glm::dvec2& u1, const glm::dvec2& u2) {
@@ -154,6 +107,13 @@ MapSingularValues mapSingularValues(const glm::dvec3& p0, const glm::dvec3& p1,
     const double det = std::abs(a * d - b * c);
     const double disc = std::sqrt(std::max(s1sq * s1sq - det * det, 0.0));
     return {std::sqrt(s1sq + disc), std::sqrt(std::max(s1sq - disc, 0.0)), det};
+}
+
+double conformalDistortion(const glm::vec3& q0, const glm::vec3& q1, const glm::vec3& q2,
+                           const glm::dvec2& u0, const glm::dvec2& u1, const glm::dvec2& u2) {
+    const MapSingularValues sv = mapSingularValues(glm::dvec3(q0), glm::dvec3(q1), glm::dvec3(q2), u0, u1, u2);
+    // max(√x, √1e-30) = √max(x, 1e-30) exactly: σ_min clamped at 1e-15.
+    return sv.smax / std::max(sv.smin, std::sqrt(1e-30));
 }
 
 // --- Tutte + ARAP -------------------------------------------------------------------------------

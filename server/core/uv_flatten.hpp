@@ -58,8 +58,49 @@ struct SparseMatrix {
     void mul(const std::vector<double>& x, std::vector<double>& y) const;
 };
 
-/// Conjugate gradients for a symmetric positive definite system; x holds the initial guess and
-/// receives the solution. Stops after maxIter iterations or when ‖r‖ ≤ tol·‖b‖.
+/// Preconditioned conjugate gradients for a symmetric positive definite system: `a.mul(x, y)`
+/// sets y = A·x (y has x's size), `invDiag(i)` is the preconditioner's factor for unknown i (1
+/// for plain CG; Jacobi: the inverse of the diagonal). x holds the initial guess and receives
+/// the solution. Stops after maxIter iterations, when ‖r‖ ≤ tol·‖b‖, or when the search
+/// direction has no positive curvature (a singular or indefinite system, or NaN).
+template <class Operator, class InvDiagonal>
+void preconditionedConjugateGradient(const Operator& a, InvDiagonal invDiag, const std::vector<double>& b,
+                                     std::vector<double>& x, int maxIter, double tol) {
+    const std::size_t n = x.size();
+    std::vector<double> r(n), z(n), p(n), ap(n);
+    a.mul(x, ap);
+    double bb = 0, rz = 0, rr = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        r[i] = b[i] - ap[i];
+        z[i] = r[i] * invDiag(i);
+        bb += b[i] * b[i];
+        rz += r[i] * z[i];
+        rr += r[i] * r[i];
+    }
+    p = z;
+    if (bb == 0) bb = 1;
+    for (int it = 0; it < maxIter && rr > tol * tol * bb; ++it) {
+        a.mul(p, ap);
+        double pap = 0;
+        for (std::size_t i = 0; i < n; ++i) pap += p[i] * ap[i];
+        if (!(pap > 0)) break;
+        const double alpha = rz / pap;
+        double rz2 = 0;
+        rr = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * ap[i];
+            z[i] = r[i] * invDiag(i);
+            rz2 += r[i] * z[i];
+            rr += r[i] * r[i];
+        }
+        const double beta = rz2 / rz;
+        rz = rz2;
+        for (std::size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
+    }
+}
+
+/// Plain conjugate gradients on a SparseMatrix (preconditionedConjugateGradient with factor 1).
 void conjugateGradient(const SparseMatrix& a, const std::vector<double>& b, std::vector<double>& x,
                        int maxIter = 4000, double tol = 1e-12);
 

@@ -1,6 +1,8 @@
 // UV → surface lookup. See uv_lookup.hpp.
 #include "uv_lookup.hpp"
 
+#include "disjoint_sets.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -8,17 +10,6 @@
 namespace dermis {
 
 namespace {
-
-/// Union-find over vertex indices of one part.
-struct Components {
-    std::vector<std::uint32_t> parent;
-    explicit Components(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    std::uint32_t root(std::uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-    }
-    void join(std::uint32_t a, std::uint32_t b) { parent[root(a)] = root(b); }
-};
 
 /// Barycentric coordinates of p in triangle (a, b, c); nullopt for a degenerate triangle.
 std::optional<glm::dvec3> barycentric(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) {
@@ -42,7 +33,7 @@ UvLookup::UvLookup(const Model& model, int cells) : model_(&model) {
     for (std::size_t pi = 0; pi < model.parts.size(); ++pi) {
         const MeshPart& p = model.parts[pi];
         if (p.uvs.empty()) continue;
-        Components comp(p.uvs.size());
+        DisjointSets comp(p.uvs.size());
         const std::size_t n = p.indices.size() / 3;
         auto valid = [&](std::size_t t) {
             for (int k = 0; k < 3; ++k)
@@ -57,7 +48,7 @@ UvLookup::UvLookup(const Model& model, int cells) : model_(&model) {
         std::vector<int> chartOfRoot(p.uvs.size(), -1);
         for (std::size_t t = 0; t < n; ++t) {
             if (!valid(t)) continue;
-            const std::uint32_t r = comp.root(p.indices[3 * t]);
+            const auto r = static_cast<std::uint32_t>(comp.root(p.indices[3 * t]));
             if (chartOfRoot[r] < 0) chartOfRoot[r] = chartCount_++;
             const int id = static_cast<int>(tris_.size());
             tris_.push_back({static_cast<int>(pi), static_cast<int>(t), chartOfRoot[r]});

@@ -37,45 +37,6 @@ struct SimilarityRows {
     }
 };
 
-/// Jacobi-preconditioned conjugate gradients on SimilarityRows (x holds the initial guess;
-/// `inv` the inverse of each row's diagonal).
-void solve(const SimilarityRows& a, const std::vector<double>& inv, const std::vector<double>& b,
-           std::vector<double>& x, int maxIter, double tol) {
-    const std::size_t n = x.size();
-    std::vector<double> r(n), z(n), p(n), ap(n);
-    a.mul(x, ap);
-    double bb = 0, rz = 0, rr = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        r[i] = b[i] - ap[i];
-        z[i] = r[i] * inv[i / 2];
-        bb += b[i] * b[i];
-        rz += r[i] * z[i];
-        rr += r[i] * r[i];
-    }
-    p = z;
-    if (bb == 0) bb = 1;
-    for (int it = 0; it < maxIter && rr > tol * tol * bb; ++it) {
-        a.mul(p, ap);
-        double pap = 0;
-        for (std::size_t i = 0; i < n; ++i)
-            pap += p[i] * ap[i];
-        if (!(pap > 0)) break;
-        const double alpha = rz / pap;
-        double rz2 = 0;
-        rr = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * ap[i];
-            z[i] = r[i] * inv[i / 2];
-            rz2 += r[i] * z[i];
-            rr += r[i] * r[i];
-        }
-        const double beta = rz2 / rz;
-        rz = rz2;
-        for (std::size_t i = 0; i < n; ++i)
-            p[i] = z[i] + beta * p[i];
-    }
-}
 
 } // namespace
 
@@ -165,7 +126,8 @@ std::vector<glm::dvec2> flattenLscm(const ChartMesh& chart, const std::uint32_t 
             x[2 * static_cast<std::size_t>(idx[v])] = uv[v].x;
             x[2 * static_cast<std::size_t>(idx[v]) + 1] = uv[v].y;
         }
-    solve(m, inv, rhs, x, maxIter, tol);
+    // Jacobi: the inverse of each row's (real) diagonal block, for both of its unknowns.
+    preconditionedConjugateGradient(m, [&inv](std::size_t i) { return inv[i / 2]; }, rhs, x, maxIter, tol);
     for (std::size_t v = 0; v < n; ++v)
         if (idx[v] >= 0)
             uv[v] = {x[2 * static_cast<std::size_t>(idx[v])],
