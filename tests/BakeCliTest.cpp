@@ -143,6 +143,7 @@ TEST_F(BakeCliTest, BadScenesExitNonZeroNamingTheField) {
     d["pose"] = json::object();
     d["placements"][0]["joint"] = "torso_joint_2";
     d["placements"][1]["joint"] = "torso_joint_2";
+    d["uv_layout"] = "model"; // auto would generate a layout (NoUvsBakeInTheGeneratedLayout)
     cases.push_back({"no uvs", d, "TEXCOORD_0"});
     d = baseScene(dir / "nope.glb");
     cases.push_back({"model", d, "/model"});
@@ -161,4 +162,21 @@ TEST_F(BakeCliTest, BadScenesExitNonZeroNamingTheField) {
     r = runServer(dir, "bake --scene " + (dir / "absent.json") + " --out " + (dir / "x"));
     EXPECT_EQ(r.code, 2);
     EXPECT_FALSE(r.err.empty());
+}
+
+// SPEC §8: a model without UVs bakes in the generated layout under uv_layout "auto" (the default),
+// exactly as the server renders it; the maps carry the placements.
+TEST_F(BakeCliTest, NoUvsBakeInTheGeneratedLayout) {
+    json d = baseScene(kRigged);
+    d["placements"][0]["joint"] = "torso_joint_2";
+    d["placements"][1]["joint"] = "torso_joint_2";
+    d["pose"] = {{"joints", {{"torso_joint_2", {{"axis_angles", {{"x", 45}}}}}}}};
+    writeScene(d);
+    const CliRun r = runServer(dir, "bake --scene " + (dir / "scene.json") + " --out " + (dir / "g"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto bump = readHeightImage(dir / "g/bump.exr");
+    ASSERT_TRUE(bump.ok()) << bump.error().message;
+    float peak = 0.0f;
+    for (float v : bump->data) peak = std::max(peak, v);
+    EXPECT_GT(peak, 0.0f) << "the placements left no mark in the generated layout";
 }

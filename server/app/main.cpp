@@ -10,10 +10,11 @@
 // Errors go to stderr as "dermis-server: error: <message>" with exit code 1 (2 for usage).
 #include "app/cli_common.hpp"
 #include "app/render_cmd.hpp"
+#include "core/frame_plan.hpp"
+#include "core/layout_gen.hpp"
 #include "core/normalmap.hpp"
 #include "gl/gl_backend.hpp"
 #include "gl/renderer.hpp"
-#include "core/frame_plan.hpp"
 #include "io/frame_io.hpp"
 #include "io/frame_queue.hpp"
 #include "io/image_io.hpp"
@@ -55,6 +56,10 @@ int runBake(const BakeArgs& a) {
     if (!loaded) return fail(loaded.error());
     FrameOverrides overrides;
     if (a.hasTime) overrides.time = a.time;
+    // SPEC §8: the maps live in the layout the scene names (as on the server).
+    auto layout = textureLayoutFor(loaded->model, loaded->scene.uvLayout);
+    if (!layout) return fail(layout.error());
+    overrides.layout = std::make_shared<const TextureLayout>(std::move(*layout));
     auto plan = planFrame(loaded->scene, loaded->model, loaded->images, loaded->base, overrides);
     if (!plan) return fail(plan.error());
     HeightMaps maps;

@@ -3,6 +3,7 @@
 #include "app/cli_common.hpp"
 #include "core/frame_plan.hpp"
 #include "core/frame_range.hpp"
+#include "core/layout_gen.hpp"
 #include "gl/renderer.hpp"
 #include "io/atomic_file.hpp"
 #include "io/farm_manifest.hpp"
@@ -125,10 +126,11 @@ int runRender(const RenderArgs& a) {
     // Frames are encoded and written on a worker while the next one renders (at most two waiting:
     // bounded memory). Each file's bytes are those of the sequential path (deterministic encoders).
     FrameWriteQueue writer(1, 2);
-    // SPEC §8: the height-map layout (the model's own UVs; TODO(lead): uv_layout "generated" and
-    // "auto" without usable UVs, as the service's layoutFor) and its rest-surface map, baked once
-    // for every frame when a surface placement needs it (planFrame would bake it per frame).
-    overrides.layout = std::make_shared<const TextureLayout>(modelTextureLayout(*model));
+    // SPEC §8: the height-map layout by the service's rule (core textureLayoutFor) and its
+    // rest-surface map, baked once for every frame when a surface placement needs it.
+    auto layout = textureLayoutFor(*model, loaded->scene.uvLayout);
+    if (!layout) return fail(layout.error());
+    overrides.layout = std::make_shared<const TextureLayout>(std::move(*layout));
     for (const Placement& p : loaded->scene.placements)
         if (p.enabled && p.projection == Projection::Surface && !overrides.layout->empty()) {
             overrides.rest = std::make_shared<const RestSurfaceMap>(

@@ -6,6 +6,7 @@
 #include "layout_gen.hpp"
 
 #include "layout_gen_internal.hpp"
+#include "uv_diagnosis.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -206,6 +207,12 @@ Result<TextureLayout> generateTextureLayout(const Model& model, const LayoutGenO
     auto made = generateTextureLayoutWithReport(model, options);
     if (!made) return made.error();
     return std::move(made->layout);
+}
+
+Result<TextureLayout> textureLayoutFor(const Model& model, UvLayoutMode mode) {
+    if (mode == UvLayoutMode::Model || (mode == UvLayoutMode::Auto && modelUvsHoldHeightmaps(mode, diagnoseUvs(model))))
+        return modelTextureLayout(model);
+    return generateTextureLayout(model);
 }
 
 } // namespace dermis

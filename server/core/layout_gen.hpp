@@ -114,4 +114,10 @@ Result<GeneratedLayout> generateTextureLayoutWithReport(const Model& model,
 Result<TextureLayout> generateTextureLayout(const Model& model,
                                             const LayoutGenOptions& options = {});
 
+/// The layout a scene with `mode` uses on `model`, uncached (the one-shot commands `render` and
+/// `bake`; the service caches the same choice per model): the model's own UVs when
+/// modelUvsHoldHeightmaps (uv_diagnosis.hpp) says so — "model", or "auto" on usable UVs — else
+/// the generated layout. Fails as generateTextureLayout does.
+Result<TextureLayout> textureLayoutFor(const Model& model, UvLayoutMode mode);
+
 } // namespace dermis

@@ -139,4 +139,21 @@ std::shared_ptr<const ModelDerived> ModelDerivedSlot::peek() const {
     return derived_;
 }
 
+std::shared_ptr<const ModelDerived>
+ModelDerived::throughLayout(const std::shared_ptr<const TextureLayout>& layout) const {
+    {
+        std::lock_guard<std::mutex> lock(throughMutex_);
+        for (const auto& [l, d] : through_)
+            if (l == layout) return d;
+    }
+    // Built outside the lock (copies the mesh); two first uses at once may both build, one is kept.
+    auto made = std::make_shared<const ModelDerived>(
+        std::make_shared<const Model>(modelThroughLayout(model(), *layout)));
+    std::lock_guard<std::mutex> lock(throughMutex_);
+    for (const auto& [l, d] : through_)
+        if (l == layout) return d;
+    through_.emplace_back(layout, made);
+    return made;
+}
+
 } // namespace dermis

@@ -81,6 +81,13 @@ public:
                                                       int width, int height) const;
     static constexpr std::size_t kRestCacheEntries = 2;
 
+    /// The derived data of model() seen through `layout` (core modelThroughLayout): its UV index,
+    /// UV diagnosis, rest skin, … in that layout's texture space, for the tools that work there
+    /// (pick by UV, focus, mirror, lint) when the layout in use is not the model's own. Made on
+    /// the first call per layout object and kept while this object lives (the service asks for
+    /// one: the generated layout). `layout` must be a layout of model() and not null.
+    std::shared_ptr<const ModelDerived> throughLayout(const std::shared_ptr<const TextureLayout>& layout) const;
+
     /// How many times each piece was built: 0 before its first use, 1 after (for tests).
     int uvLookupBuilds() const { return lookupBuilds_.load(); }
     int restSkinBuilds() const { return restBuilds_.load(); }
@@ -112,6 +119,8 @@ private:
     mutable std::mutex restMutex_;
     mutable std::vector<RestEntry> restCache_; ///< most recently used first
     mutable std::atomic<int> restSurfaceBuilds_{0};
+    mutable std::mutex throughMutex_;
+    mutable std::vector<std::pair<std::shared_ptr<const TextureLayout>, std::shared_ptr<const ModelDerived>>> through_;
 };
 
 class ModelDerivedSlot {

@@ -1,6 +1,8 @@
 // Dermis core — texture layouts (texture_layout.hpp).
 #include "texture_layout.hpp"
 
+#include <type_traits>
+
 namespace dermis {
 
 std::string_view toString(UvLayoutMode m) {
@@ -39,6 +41,33 @@ TextureLayout modelTextureLayout(const Model& model) {
         out.indices = part.indices;
     }
     return layout;
+}
+
+Model modelThroughLayout(const Model& model, const TextureLayout& layout) {
+    Model out = model;
+    for (std::size_t k = 0; k < out.parts.size() && k < layout.parts.size(); ++k) {
+        const PartLayout& pl = layout.parts[k];
+        MeshPart& part = out.parts[k];
+        if (pl.indices.empty()) {
+            part.uvs.clear();
+            continue;
+        }
+        const MeshPart& src = model.parts[k];
+        auto gather = [&pl](const auto& values) {
+            std::remove_cvref_t<decltype(values)> picked;
+            if (values.empty()) return picked;
+            picked.reserve(pl.source.size());
+            for (std::uint32_t v : pl.source) picked.push_back(values[v]);
+            return picked;
+        };
+        part.positions = gather(src.positions);
+        part.normals = gather(src.normals);
+        part.joints = gather(src.joints);
+        part.weights = gather(src.weights);
+        part.uvs = pl.uvs;
+        part.indices = pl.indices;
+    }
+    return out;
 }
 
 } // namespace dermis

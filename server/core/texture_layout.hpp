@@ -49,6 +49,16 @@ struct TextureLayout {
 /// A part without UVs (or with fewer UVs than positions) gets an empty PartLayout.
 TextureLayout modelTextureLayout(const Model& model);
 
+/// `model` as seen through `layout`: each part with layout triangles gets the layout's vertices
+/// (positions, normals, joints and weights copied from the part vertex each names), the layout's
+/// UVs as TEXCOORD_0 and its indices; a part without layout triangles keeps its vertices and
+/// triangles but no UVs. Triangle k of a part stays triangle k with its corners in the same order,
+/// so a UV hit on the result (part, triangle, barycentrics) names the same surface point of
+/// `model`. Nodes, joints, materials, images and clips are copied. For the tools that work in
+/// texture space (UV lookup, pick by UV, focus, mirror, lint) when the layout in use is not the
+/// model's own. Precondition: `layout` is a layout of `model` (one PartLayout per part).
+Model modelThroughLayout(const Model& model, const TextureLayout& layout);
+
 /// Per texel centre ((i+0.5)/W, (j+0.5)/H) of a W×H map: the bind-space position and unit normal
 /// of the layout's triangle covering it (barycentric interpolation of MeshPart positions and
 /// normals), or — within `dilate` texels of a covered texel — those of the nearest covered texel

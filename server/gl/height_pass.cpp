@@ -107,8 +107,9 @@ HeightPassBlock placementBlock(const BakePlacement& p, int W, int H) {
 /// W×H map: the constants of dermis::SurfaceFrame.
 HeightPassBlock surfaceBlock(const BakePlacement& p, const TexelRect& rect, int W, int H) {
     HeightPassBlock b = placementBlock(p, W, H);
-    b.centerScale = glm::vec4(static_cast<float>(rect.x0) / W, static_cast<float>(rect.y0) / H,
-                              static_cast<float>(rect.x1) / W, static_cast<float>(rect.y1) / H);
+    const float w = static_cast<float>(W), h = static_cast<float>(H);
+    b.centerScale = glm::vec4(static_cast<float>(rect.x0) / w, static_cast<float>(rect.y0) / h,
+                              static_cast<float>(rect.x1) / w, static_cast<float>(rect.y1) / h);
     b.mode.w = 1;
     const SurfaceFrame f(p);
     b.anchor = glm::vec4(glm::vec3(f.c), static_cast<float>(f.depth));

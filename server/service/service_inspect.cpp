@@ -139,9 +139,10 @@ Result<json> Service::lint(const std::string& id) {
         for (const auto& [pid, e] : state_->patterns)
             if (!e.builtin && !used.count(pid)) unused.push_back(pid);
     }
-    const auto derived = state_->derivedOf(*snap);
+    // The model's UV index, rest skin and symmetry plane, built once, in the texture space the
+    // scene's maps live in (a generated layout: UV placements are checked there).
+    const auto derived = state_->derivedInLayout(*snap);
     json out = json::array();
-    // The model's UV index, rest skin and symmetry plane, built once (derived->model() is snap's).
     for (const LintFinding& f : lintScene(snap->scene, *derived, snap->images))
         out.push_back({{"code", f.code},
                        {"severity", std::string(toString(f.severity))},
@@ -174,11 +175,11 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     if (!std::isfinite(v) || v < 0.0 || v > 1.0) return bad("v", "must be in [0, 1]");
     auto snap = state_->snapshot(id);
     if (!snap) return snap.error();
-    if (!snap->model->hasUVs()) return bad("u", "the model has no UVs: nothing lies at a texture point");
-    const auto derived = state_->derivedOf(*snap); // the model's UV index, built once
-    // TODO(lead): with a generated layout the texture view shows that layout's UV space: look
-    // the point up in an index of the layout (a UvLookup over its triangles), not the model's.
-    const auto hit = dermis::pickUv(*snap->model, derived->uvLookup(), {u, v});
+    // The UV index of the layout the scene's maps live in (the model's own, or the generated
+    // one: what the texture view shows), built once.
+    const auto derived = state_->derivedInLayout(*snap);
+    if (!derived->model().hasUVs()) return bad("u", "the model has no UVs: nothing lies at a texture point");
+    const auto hit = dermis::pickUv(derived->model(), derived->uvLookup(), {u, v});
     if (!hit) return json{{"hit", false}};
     return pickAnswer(*derived, *hit, nullptr);
 }

@@ -32,9 +32,10 @@ std::unique_ptr<LayoutCache> makeLayoutCache(const std::string& folder) {
 Result<std::shared_ptr<const TextureLayout>> Service::State::layoutOf(const ModelDerived& derived, UvLayoutMode mode,
                                                                       const std::string& field) const {
     const Model& model = derived.model();
-    if (mode == UvLayoutMode::Auto)
-        mode = model.hasUVs() && derived.uvDiagnosis().usable() ? UvLayoutMode::Model : UvLayoutMode::Generated;
-    if (mode == UvLayoutMode::Model) {
+    // The diagnosis is read (built once per model) only when auto needs it.
+    const bool own = mode == UvLayoutMode::Model ||
+                     (mode == UvLayoutMode::Auto && modelUvsHoldHeightmaps(mode, derived.uvDiagnosis()));
+    if (own) {
         if (!model.hasUVs())
             return bad(field, "the model has no TEXCOORD_0: use uv_layout \"auto\" or \"generated\"");
         return derived.modelLayout();
@@ -45,6 +46,13 @@ Result<std::shared_ptr<const TextureLayout>> Service::State::layoutOf(const Mode
 Result<std::shared_ptr<const TextureLayout>> Service::State::layoutFor(const Scene& scene,
                                                                       const ModelDerived& derived) const {
     return layoutOf(derived, scene.uvLayout, "/uv_layout");
+}
+
+std::shared_ptr<const ModelDerived> Service::State::derivedInLayout(const Snapshot& snap) const {
+    auto derived = derivedOf(snap);
+    auto layout = layoutFor(snap.scene, *derived);
+    if (!layout || *layout == derived->modelLayout()) return derived;
+    return derived->throughLayout(*layout);
 }
 
 Status Service::State::withLayout(const Scene& scene, const ModelDerived& derived,

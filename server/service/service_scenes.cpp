@@ -284,7 +284,7 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
     // The model's derived data (UV index, rest skin, symmetry plane) is built here, before the
     // writer lock, so that a first mirror on a large model holds no other edit back meanwhile.
     if (auto warm = state_->snapshot(id)) {
-        const auto derived = state_->derivedOf(*warm);
+        const auto derived = state_->derivedInLayout(*warm);
         if (derived->model().hasUVs()) {
             derived->uvLookup();
             derived->symmetryPlane();
@@ -302,7 +302,8 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
         const int at = placementIndex(doc, pid);
         if (!source || at < 0)
             return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
-        const auto derived = state_->derivedOf(*snap); // UV index, plane and rest skin, built once
+        // UV index, plane and rest skin, built once, in the layout the scene's maps live in.
+        const auto derived = state_->derivedInLayout(*snap);
         auto twin = dermis::mirrorPlacement(*source, derived->model(), derived->uvLookup(),
                                             derived->symmetryPlane(), derived->restSkin());
         if (!twin) {

@@ -258,6 +258,11 @@ struct Service::State {
     /// (or no longer) the entry's — deleted since the snapshot — gets a fresh, uncached one.
     /// Takes `mutex` shared itself (caller holds none). Never fails.
     std::shared_ptr<const ModelDerived> derivedOf(const Snapshot& snap) const;
+    /// The derived data of `snap`'s model in the texture space its scene's height maps live in
+    /// (service_layout.cpp): derivedOf(snap) when that is the model's own UVs (or the layout
+    /// cannot be had: the tools then say what is missing), else its throughLayout(the layout) —
+    /// what pick by UV, focus, mirror and lint look UVs up in.
+    std::shared_ptr<const ModelDerived> derivedInLayout(const Snapshot& snap) const;
     /// The height-map layout `scene` uses on the model of `derived` (SPEC §8 uv_layout):
     /// layoutOf(derived, scene.uvLayout, "/uv_layout").
     Result<std::shared_ptr<const TextureLayout>> layoutFor(const Scene& scene, const ModelDerived& derived) const;

@@ -68,11 +68,12 @@ Result<json> Service::focus(const std::string& id, const std::string& pid, const
                     {"distance", rounded(focusDistance(radius))},
                     {"hit", best <= p.depthOrDefault()}};
     }
-    if (!snap->model->hasUVs()) return bad("placement", "the model has no UVs: a footprint lies nowhere");
+    // The footprint lies in the layout the scene's maps live in (the model's UVs or generated).
+    const auto derived = state_->derivedInLayout(*snap);
+    if (!derived->model().hasUVs()) return bad("placement", "the model has no UVs: a footprint lies nowhere");
     auto plan = state_->plan(*snap, params);
     if (!plan) return asParamError(plan.error(), params);
-    const auto derived = state_->derivedOf(*snap);
-    const auto region = footprintRegion(*snap->model, derived->uvLookup(), skin(*snap->model, plan->world),
+    const auto region = footprintRegion(derived->model(), derived->uvLookup(), skin(derived->model(), plan->world),
                                         {p.center[0], p.center[1]}, {p.scale[0], p.scale[1]}, p.rotation);
     if (!region) return bad("placement", "no skin lies inside the footprint of \"" + pid + "\"");
     return json{{"scene", id},

@@ -57,7 +57,14 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       await page.focus("#uv");
       await page.keyboard.press("Control+=");
       await page.keyboard.press("Control+=");
-      const zoomed = await zoomText(page);
+      // Both presses applied (a loaded machine may show the first one's zoom for a moment).
+      let zoomed = await zoomText(page);
+      for (let i = 0; i < 20; ++i) {
+        await sleep(100);
+        const now = await zoomText(page);
+        if (now === zoomed) break;
+        zoomed = now;
+      }
       assert.notEqual(zoomed, "94%", "zoomed in");
       for (const sel of ["#placementsPanel h2", "#paramsPanel", "#historyPanel h2", ".views"]) {
         const b = await box(page, sel);

@@ -80,8 +80,14 @@ export function scaled(p, k, now, keepAspect, minScale = 0.005) {
   return { center: center.map(round4), scale: [round4(w), round4(h)] };
 }
 
-/// The topmost placement (last drawn) under `uv`, or undefined. Disabled placements count.
+/// Whether a placement has a footprint in texture space: a surface placement (SPEC §8,
+/// `projection: "surface"`) is a decal on the body, drawn by the server into whichever layout is in
+/// use; its center/scale mean nothing, so the texture view neither draws nor hits it.
+export const inTexture = (p) => p.projection !== "surface";
+
+/// The topmost placement (last drawn) under `uv`, or undefined. Disabled placements count;
+/// surface placements have no footprint there (inTexture).
 export function hit(placements, uv, margin = 0) {
-  for (let i = placements.length - 1; i >= 0; --i) if (inside(placements[i], uv, margin)) return placements[i];
+  for (let i = placements.length - 1; i >= 0; --i) if (inTexture(placements[i]) && inside(placements[i], uv, margin)) return placements[i];
   return undefined;
 }

@@ -150,7 +150,7 @@ function draw() {
   for (const f of store.lint) if (f.placement) lintBy.set(f.placement, [...(lintBy.get(f.placement) || []), f]);
   const soloed = new Set(store.solo);
   const dims = new Map();
-  for (const raw of store.doc.placements) {
+  for (const raw of store.doc.placements.filter(geo.inTexture)) {
     const p = shown(raw);
     const selected = store.selection.includes(p.id);
     const dim = !p.enabled || (soloed.size && !soloed.has(p.id));
@@ -222,7 +222,7 @@ function drawFootprint(p, { selected, dim, lint, hover: hovered }) {
 /// footprint's box (left, then right aligned), inside it, and beside it, preferring spots inside
 /// the stage. A label with no free spot is hidden (hover or select its placement to see it).
 function layoutLabels(w, h) {
-  const ps = store.doc.placements.map(shown);
+  const ps = store.doc.placements.filter(geo.inTexture).map(shown);
   const rank = (p) => { const i = store.selection.indexOf(p.id); return i >= 0 ? i : p.id === hover ? store.selection.length : Infinity; };
   const order = ps.map((p, i) => ({ p, i, r: rank(p) })).sort((a, b) => a.r - b.r || a.i - b.i);
   ctx.font = LABEL_FONT;
