@@ -75,10 +75,8 @@ bool anyPartHasUVs(const Model& model) {
     return false;
 }
 
-/// The anchor frame of surface placement `p` (SPEC §8) into `b`: unit normal, tangent made
-/// orthogonal to it (Gram–Schmidt, as the parser does) and turned by `rotation` degrees about the
-/// normal (towards b = n × t), size and depth. False when the anchor is degenerate (possible only
-/// for scenes built in code).
+} // namespace
+
 bool surfaceFrameOf(const Placement& p, BakePlacement& b) {
     const glm::dvec3 n0(p.anchor.normal[0], p.anchor.normal[1], p.anchor.normal[2]);
     const glm::dvec3 t0(p.anchor.tangent[0], p.anchor.tangent[1], p.anchor.tangent[2]);
@@ -99,8 +97,6 @@ bool surfaceFrameOf(const Placement& p, BakePlacement& b) {
     b.depth = p.depthOrDefault();
     return b.size.x > 0.0 && b.size.y > 0.0 && b.depth > 0.0;
 }
-
-} // namespace
 
 Result<std::vector<BakePlacement>> resolvePlacements(const Scene& scene, const Model& model,
                                                      const LocalPose& pose,

@@ -37,6 +37,14 @@ Result<double> placementAngle(const Model& model, const LocalPose& pose, const P
 /// immutable: a frame plan keeps the images it points to alive while the owner's map changes.
 using PatternImages = std::map<std::string, std::shared_ptr<const PatternImage>>;
 
+/// The anchor frame of surface placement `p` (SPEC §8) into `b`'s surface members: unit normal,
+/// tangent made orthogonal to it (Gram–Schmidt, as the parser does) and turned by `rotation`
+/// degrees about the normal (towards b = n × t), size and depth (default max(w, h)/2); sets
+/// `b.surface`. Touches nothing else of `b`. False when the anchor is degenerate (possible only for
+/// scenes built in code) — `b` is then partly written. The one place this frame is made: the bake,
+/// lint and the renderer's decal outlines use it.
+bool surfaceFrameOf(const Placement& p, BakePlacement& b);
+
 /// Resolves every enabled placement to a BakePlacement (pointers into `images`, patternId set), in
 /// document order; disabled ones are checked like the others but left out. A surface placement
 /// (SPEC §8) gets its anchor frame (tangent orthonormalised and turned by `rotation` about the

@@ -1,6 +1,7 @@
 // Lint's view of surface placements. See lint_surface.hpp.
 #include "lint_surface.hpp"
 
+#include "bake.hpp"
 #include "heightmap.hpp"
 
 #include <algorithm>
@@ -11,23 +12,10 @@ namespace dermis::lint_detail {
 
 namespace {
 
-/// The BakePlacement frame of `p` (anchor orthonormalised, rotation applied, as bake.cpp does).
+/// The decal frame of `p` (bake.hpp surfaceFrameOf), or nothing for a degenerate anchor.
 std::optional<SurfaceFrame> frameOf(const Placement& p) {
-    const glm::dvec3 n0(p.anchor.normal[0], p.anchor.normal[1], p.anchor.normal[2]);
-    const glm::dvec3 t0(p.anchor.tangent[0], p.anchor.tangent[1], p.anchor.tangent[2]);
-    if (!(glm::length(n0) > 0.0)) return std::nullopt;
-    const glm::dvec3 n = glm::normalize(n0);
-    glm::dvec3 t = t0 - glm::dot(t0, n) * n;
-    if (!(glm::length(t) > 1e-9)) return std::nullopt;
-    t = glm::normalize(t);
-    const double a = glm::radians(p.rotation);
     BakePlacement b;
-    b.anchorPosition = glm::dvec3(p.anchor.position[0], p.anchor.position[1], p.anchor.position[2]);
-    b.anchorNormal = n;
-    b.anchorTangent = glm::normalize(std::cos(a) * t + std::sin(a) * glm::cross(n, t));
-    b.size = glm::dvec2(p.size[0], p.size[1]);
-    b.depth = p.depthOrDefault();
-    if (!(b.size.x > 0.0 && b.size.y > 0.0 && b.depth > 0.0)) return std::nullopt;
+    if (!surfaceFrameOf(p, b)) return std::nullopt;
     return SurfaceFrame(b);
 }
 
