@@ -28,13 +28,18 @@ layout(std140, binding = 1) uniform FrameBlock {
     vec4 u_viewport;       // frame width, height, target edge length of a tessellated edge (px), max level
 };
 
-// Outlines on the skin (the editor's selection, hover and place brush): footprint rectangles in
-// the height maps' UV space (SPEC §2: centre, size, rotation), drawn as a band where v_mapUv
-// lies on their border.
+// Outlines on the skin (the editor's selection, hover and place brush), drawn as a band where the
+// surface lies on their border. Shape (u_outlineStyle.w): 0 a UV footprint rectangle in the
+// height maps' layout (SPEC §2: centre, size, rotation; v_mapUv), 1 a surface decal's rectangle on
+// the rest surface (SPEC §8: the anchor frame, v_restPosition), 2 a circle on the rest surface (the
+// surface place brush: the decal frame with size = the diameter).
 layout(std140, binding = 3) uniform OutlineBlock {
     ivec4 u_outlineCount;    // outlines in use (0..8), 0, 0, 0
-    vec4 u_outlineRect[8];   // centre u, v; size u, v
-    vec4 u_outlineStyle[8];  // cos(rotation), sin(rotation), kind (0 selected, 1 hovered, 2 brush), 0
+    vec4 u_outlineRect[8];   // shape 0: centre u, v; size u, v
+    vec4 u_outlineStyle[8];  // cos(rotation), sin(rotation), kind (0 selected, 1 hovered, 2 brush), shape
+    vec4 u_outlineAnchor[8]; // shapes 1, 2: anchor position (bind space), depth
+    vec4 u_outlineAxisU[8];  // shapes 1, 2: tangent / width (rotation applied), 0
+    vec4 u_outlineAxisV[8];  // shapes 1, 2: (normal × tangent) / height, 0
 };
 
 // Per-part constants of the skin pass.

@@ -8,8 +8,9 @@
 // (clamped to [−1, 1]), 3 the perturbed world normal as bytes 255·(n·0.5 + 0.5). Those are
 // picture values: written through the sRGB EOTF so that the target's encoding gives them back.
 //
-// Outlines (OutlineBlock, common.glsl): footprint rectangles in the height maps' UV space drawn
-// over any view as a band about 2 pixels wide where v_mapUv lies on their border — selected
+// Outlines (OutlineBlock, common.glsl): footprint rectangles in the height maps' UV space, surface
+// decals' rectangles and the surface brush's circle on the rest surface, drawn over any view as a
+// band about 2 pixels wide where the surface lies on their border — selected
 // (orange, with a faint tint inside and a dark rim outside), hovered (pale blue), the place brush
 // (dashed cyan). With u_outlineCount.x = 0 nothing runs and the frame is exactly the one without
 // outlines.
@@ -23,7 +24,9 @@ layout(binding = 2) uniform sampler2D u_baseColorTexture; // sRGB8_A8, decoded t
 in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;    // the model's TEXCOORD_0: base colour
-in vec2 v_mapUv; // the height-map layout's UV (SPEC §8): heights and outlines
+in vec2 v_mapUv; // the height-map layout's UV (SPEC §8): heights and UV outlines
+in vec3 v_restPosition; // bind space: surface decal outlines (SPEC §8)
+in vec3 v_restNormal;
 
 layout(location = 0) out vec4 o_color;
 
@@ -67,17 +70,35 @@ vec3 outlined(vec3 color) {
         vec4 r = u_outlineRect[i];
         vec4 st = u_outlineStyle[i];
         int kind = int(st.z);
-        // s − 0.5 = R(−rotation)·(uv − centre) / size (SPEC §2): q in [−0.5, 0.5]² inside.
-        vec2 d = v_mapUv - r.xy;
-        vec2 q = vec2(st.x * d.x + st.y * d.y, -st.y * d.x + st.x * d.y) / r.zw;
+        int shape = int(st.w);
+        vec2 q;
+        bool away = false; // a surface shape's point behind the surface or beyond the depth
+        if (shape == 0) {
+            // s − 0.5 = R(−rotation)·(uv − centre) / size (SPEC §2): q in [−0.5, 0.5]² inside.
+            vec2 d = v_mapUv - r.xy;
+            q = vec2(st.x * d.x + st.y * d.y, -st.y * d.x + st.x * d.y) / r.zw;
+        } else {
+            // s − 0.5 = (d·t / w, d·b / h), d = rest position − anchor (SPEC §8, SurfaceFrame in
+            // heightmap.hpp); nothing beyond the depth or on surfaces facing away.
+            vec4 a = u_outlineAnchor[i];
+            vec3 d = v_restPosition - a.xyz;
+            vec3 n = cross(u_outlineAxisU[i].xyz, u_outlineAxisV[i].xyz);
+            away = dot(v_restNormal, n) <= 0.0 || abs(dot(d, normalize(n))) > a.w;
+            q = vec2(dot(d, u_outlineAxisU[i].xyz), dot(d, u_outlineAxisV[i].xyz));
+        }
         vec2 perPixel = max(fwidth(q), vec2(1e-7));
         vec2 e = (abs(q) - 0.5) / perPixel; // pixels beyond each edge (negative inside)
         float dist = length(max(e, vec2(0.0))) + min(max(e.x, e.y), 0.0); // signed, to the border
-        if (dist > 4.0) continue;
+        if (shape == 2) dist = (length(q) - 0.5) / max(length(fwidth(q)) * 0.70710678, 1e-7); // circle
+        // A surface shape where one pixel spans a quarter of it (a silhouette's sliver, whose
+        // derivatives jump across the body) draws no band: it would mark pixels far from it.
+        if (shape != 0 && max(perPixel.x, perPixel.y) > 0.25) away = true;
+        if (away || dist > 4.0) continue; // (after the derivatives: uniform control flow above)
         float halfWidth = kind == 1 ? 0.9 : 1.3;
         float band = 1.0 - smoothstep(halfWidth - 0.5, halfWidth + 0.5, abs(dist));
         if (kind == 2) { // dashes of 6 pixels along the border
-            float along = e.x > e.y ? q.y / perPixel.y : q.x / perPixel.x;
+            float along = shape == 2 ? atan(q.y, q.x) * 0.5 / max(length(fwidth(q)) * 0.70710678, 1e-7)
+                                     : e.x > e.y ? q.y / perPixel.y : q.x / perPixel.x;
             band *= step(0.5, fract(along / 12.0));
         }
         vec3 c = kOutlineColor[clamp(kind, 0, 2)];

@@ -7,10 +7,14 @@ in vec3 v_position[];
 in vec3 v_normal[];
 in vec2 v_uv[];
 in vec2 v_mapUv[];
+in vec3 v_restPosition[];
+in vec3 v_restNormal[];
 out vec3 tc_position[];
 out vec3 tc_normal[];
 out vec2 tc_uv[];
 out vec2 tc_mapUv[];
+out vec3 tc_restPosition[];
+out vec3 tc_restNormal[];
 
 vec2 toScreen(vec3 p) {
     vec4 c = u_viewProj * vec4(p, 1.0);
@@ -27,6 +31,8 @@ void main() {
     tc_normal[gl_InvocationID] = v_normal[gl_InvocationID];
     tc_uv[gl_InvocationID] = v_uv[gl_InvocationID];
     tc_mapUv[gl_InvocationID] = v_mapUv[gl_InvocationID];
+    tc_restPosition[gl_InvocationID] = v_restPosition[gl_InvocationID];
+    tc_restNormal[gl_InvocationID] = v_restNormal[gl_InvocationID];
     if (gl_InvocationID == 0) {
         // Outer level i is the edge opposite corner i.
         gl_TessLevelOuter[0] = edgeLevel(1, 2);

@@ -6,6 +6,8 @@ in vec3 tc_position[];
 in vec3 tc_normal[];
 in vec2 tc_uv[];
 in vec2 tc_mapUv[];
+in vec3 tc_restPosition[];
+in vec3 tc_restNormal[];
 
 layout(binding = 0) uniform sampler2D u_heightMap; // RG32F: bump, displacement
 
@@ -13,6 +15,8 @@ out vec3 v_position;
 out vec3 v_normal;
 out vec2 v_uv;
 out vec2 v_mapUv;
+out vec3 v_restPosition;
+out vec3 v_restNormal;
 
 void main() {
     vec3 b = gl_TessCoord;
@@ -25,5 +29,7 @@ void main() {
     v_normal = n;
     v_uv = uv;
     v_mapUv = mapUv;
+    v_restPosition = b.x * tc_restPosition[0] + b.y * tc_restPosition[1] + b.z * tc_restPosition[2];
+    v_restNormal = b.x * tc_restNormal[0] + b.y * tc_restNormal[1] + b.z * tc_restNormal[2];
     gl_Position = u_viewProj * vec4(p, 1.0);
 }

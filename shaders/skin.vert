@@ -22,6 +22,8 @@ out vec3 v_position; // world space
 out vec3 v_normal;   // world space, unit
 out vec2 v_uv;    // the model's TEXCOORD_0: base colour
 out vec2 v_mapUv; // the height-map layout's UV: bump, displacement, outlines
+out vec3 v_restPosition; // bind space (the rest surface, SPEC §8): surface decal outlines
+out vec3 v_restNormal;   // bind space, not normalised
 
 void main() {
     int base = u_part.x;
@@ -34,6 +36,8 @@ void main() {
     vec3 n = normalize(transpose(inverse(mat3(m))) * a_normal);
     v_uv = a_uv;
     v_mapUv = a_mapUv;
+    v_restPosition = a_position;
+    v_restNormal = a_normal;
 #if !defined(DERMIS_TESSELLATED) && !defined(DERMIS_CAPTURE)
     if (u_part.z != 0) p += n * (textureLod(u_heightMap, a_mapUv, 0.0).g * u_heights.x);
 #endif

@@ -135,7 +135,10 @@ TEST_F(RendererGLTest, UniformBlocksMatchTheirCppMirrors) {
          {sizeof(gl::OutlineBlock),
           {{"u_outlineCount", offsetof(gl::OutlineBlock, count)},
            {"u_outlineRect[0]", offsetof(gl::OutlineBlock, rect)},
-           {"u_outlineStyle[0]", offsetof(gl::OutlineBlock, style)}}}},
+           {"u_outlineStyle[0]", offsetof(gl::OutlineBlock, style)},
+           {"u_outlineAnchor[0]", offsetof(gl::OutlineBlock, anchor)},
+           {"u_outlineAxisU[0]", offsetof(gl::OutlineBlock, axisU)},
+           {"u_outlineAxisV[0]", offsetof(gl::OutlineBlock, axisV)}}}},
     };
     for (const auto& [block, want] : expected) {
         auto layout = gl().blockLayout(block);

@@ -322,3 +322,64 @@ TEST_F(SurfaceHttpTest, OneElbowDecalStaysAtThatElbowOnAnyCharacter) {
         ASSERT_EQ(h.del(s).status, 204);
     }
 }
+
+// The editor's outlines of surface placements (SPEC §8): a selected decal is outlined on the rest
+// surface and the surface place brush is a circle there — both only near the decal's pixel; the
+// frame without them is unchanged; a bad brush is 422 naming it.
+TEST_F(SurfaceHttpTest, SelectedDecalAndSurfaceBrushAreOutlinedWhereTheyAre) {
+    Http h = http();
+    const std::string id = createScene(emptyScene("builtin:default"));
+    const std::string s = "/scenes/" + id;
+    int px = 0, py = 0;
+    const json pick = pickOnBody(s, {110, 120, 100}, px, py);
+    ASSERT_TRUE(pick.is_object()) << "no pixel of the torso hit";
+    ASSERT_EQ(h.post(s + "/placements", decalAt(pick, "decal", 0.12)).status, 201);
+
+    auto frame = [&](const std::string& extra) {
+        Reply r = h.get(s + "/frame?patterns=off" + extra);
+        EXPECT_EQ(r.status, 200) << r;
+        auto img = decodeFrame(r.bytes());
+        EXPECT_TRUE(img);
+        return img ? *img : Image8{};
+    };
+    const auto plain = frame("");
+    auto changed = [&](const std::string& extra) {
+        const auto other = frame(extra);
+        Lit l;
+        if (other.rgba.size() != plain.rgba.size()) return l;
+        for (int y = 0; y < plain.height; ++y)
+            for (int x = 0; x < plain.width; ++x) {
+                const std::size_t i = (static_cast<std::size_t>(y) * plain.width + x) * 4;
+                if (std::memcmp(&plain.rgba[i], &other.rgba[i], 3) == 0) continue;
+                ++l.count;
+                l.x0 = std::min(l.x0, x);
+                l.y0 = std::min(l.y0, y);
+                l.x1 = std::max(l.x1, x);
+                l.y1 = std::max(l.y1, y);
+            }
+        return l;
+    };
+    auto expectNear = [&](const Lit& l, const char* what) {
+        EXPECT_GT(l.count, 20) << what << " drew nothing";
+        EXPECT_LE(std::max(std::abs(l.x0 - px), std::abs(l.x1 - px)), 40) << what << ": " << l.x0 << ".." << l.x1 << " vs " << px;
+        EXPECT_LE(std::max(std::abs(l.y0 - py), std::abs(l.y1 - py)), 40) << what << ": " << l.y0 << ".." << l.y1 << " vs " << py;
+    };
+    expectNear(changed("&highlight=decal"), "the selected decal");
+    expectNear(changed("&hover=decal"), "the hovered decal");
+    std::string brush;
+    for (const char* key : {"position", "normal"})
+        for (int k = 0; k < 3; ++k) brush += std::to_string(pick["anchor"][key][k].get<double>()) + ",";
+    expectNear(changed("&surface_brush=" + brush + "0.12"), "the surface brush");
+    EXPECT_EQ(changed("&surface_brush=" + brush + "0.12").count, changed("&surface_brush=" + brush + "0.12").count)
+        << "deterministic";
+    // A smaller brush draws a smaller circle.
+    const Lit small = changed("&surface_brush=" + brush + "0.04");
+    const Lit large = changed("&surface_brush=" + brush + "0.12");
+    EXPECT_LT(small.x1 - small.x0, large.x1 - large.x0);
+
+    for (const std::string bad : {"1,2,3,0,0,1", "0,0,0,0,0,0,0.1", "0,0,0,0,0,1,0", "0,0,0,0,0,1,20000", "a,0,0,0,0,1,1"}) {
+        Reply r = h.get(s + "/frame?surface_brush=" + bad);
+        EXPECT_EQ(r.status, 422) << bad << ": " << r;
+        EXPECT_EQ(r.js()["error"]["field"], "surface_brush") << bad;
+    }
+}

@@ -203,7 +203,14 @@ void Renderer::Impl::uploadOutlineBlock(const std::vector<FrameOutline>& outline
         const FrameOutline& o = outlines[i];
         const float a = glm::radians(o.rotation);
         ob.rect[i] = glm::vec4(o.center, o.scale);
-        ob.style[i] = glm::vec4(std::cos(a), std::sin(a), static_cast<float>(o.kind), 0.0f);
+        ob.style[i] = glm::vec4(std::cos(a), std::sin(a), static_cast<float>(o.kind), static_cast<float>(o.shape));
+        if (o.shape != FrameOutline::UvRect) {
+            const glm::vec3 nrm = glm::normalize(o.normal), t = glm::normalize(o.tangent);
+            const glm::vec2 size = o.shape == FrameOutline::SurfaceCircle ? glm::vec2(o.size.x) : o.size;
+            ob.anchor[i] = glm::vec4(o.anchor, o.depth);
+            ob.axisU[i] = glm::vec4(t / size.x, 0.0f);
+            ob.axisV[i] = glm::vec4(glm::cross(nrm, t) / size.y, 0.0f);
+        }
     }
     glBindBuffer(GL_UNIFORM_BUFFER, outlineUbo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof ob, &ob);

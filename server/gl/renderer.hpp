@@ -102,14 +102,24 @@ struct FrameTimings {
     double readbackMs = 0.0; ///< pixel-pack readback into the frame
 };
 
-/// An outline drawn on the skin where the surface's UV lies on the border of a footprint
-/// rectangle (SPEC §2 footprint: centre, size, rotation in degrees about the centre): the
-/// editor's selection, hover and place brush. A band about 2 pixels wide, any view.
+/// An outline drawn on the skin: the editor's selection, hover and place brush. A band about 2
+/// pixels wide, any view. Shapes: `UvRect` where the surface's height-map UV lies on the border
+/// of a footprint rectangle (SPEC §2 footprint: centre, size, rotation in degrees about the
+/// centre); `SurfaceRect` where the rest surface lies on the border of a surface decal (SPEC §8:
+/// the frame of core surfaceFrameOf — anchor, unit normal, unit tangent with the rotation applied,
+/// size, depth; surfaces facing away or beyond the depth get none); `SurfaceCircle` a circle of
+/// diameter size.x about the anchor on the rest surface (the surface place brush).
 struct FrameOutline {
     enum Kind { Selected = 0, Hovered = 1, Brush = 2 };
+    enum Shape { UvRect = 0, SurfaceRect = 1, SurfaceCircle = 2 };
     glm::vec2 center{0.5f}, scale{0.1f};
     float rotation = 0.0f; ///< degrees
     Kind kind = Selected;
+    Shape shape = UvRect;
+    // Surface shapes (bind space, model units).
+    glm::vec3 anchor{0.0f}, normal{0.0f, 0.0f, 1.0f}, tangent{1.0f, 0.0f, 0.0f};
+    glm::vec2 size{0.1f};
+    float depth = 0.05f;
 };
 
 /// Most outlines of one frame (the size of the shader's array).

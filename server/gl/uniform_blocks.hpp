@@ -49,7 +49,10 @@ struct PartBlock {
 struct OutlineBlock {
     glm::ivec4 count;        ///< outlines in use (0..kOutlineSlots), 0, 0, 0
     glm::vec4 rect[8];       ///< centre u, v; size u, v
-    glm::vec4 style[8];      ///< cos(rotation), sin(rotation), kind (0 selected, 1 hovered, 2 brush), 0
+    glm::vec4 style[8];      ///< cos(rotation), sin(rotation), kind (0 selected, 1 hovered, 2 brush), shape
+    glm::vec4 anchor[8];     ///< surface shapes: anchor position (bind space), depth
+    glm::vec4 axisU[8];      ///< surface shapes: tangent / width, 0
+    glm::vec4 axisV[8];      ///< surface shapes: (normal × tangent) / height, 0
 };
 inline constexpr int kOutlineSlots = 8; ///< the GLSL arrays' length (= dermis::kMaxFrameOutlines)
 
@@ -66,6 +69,6 @@ static_assert(sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
 static_assert(sizeof(HeightPassBlock) == 144);
 static_assert(sizeof(FrameBlock) == 144);
 static_assert(sizeof(PartBlock) == 32);
-static_assert(sizeof(OutlineBlock) == 16 + 2 * 8 * 16);
+static_assert(sizeof(OutlineBlock) == 16 + 5 * 8 * 16);
 
 } // namespace dermis::gl

@@ -101,6 +101,21 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         }
         p.brush = std::array<double, 5>{b[0], b[1], b[2], b[3], b[4]};
     }
+    if (req.has_param("surface_brush")) {
+        std::vector<double> b;
+        const char* what = "x,y,z,nx,ny,nz,diameter: a surface point (bind space, each in [-1e6, 1e6]), "
+                           "its normal (not zero) and the brush's diameter (model units, in (0, 10000])";
+        if (!numbersParam(req, res, "surface_brush", 7, 7, b, what)) return false;
+        const double nl = std::sqrt(b[3] * b[3] + b[4] * b[4] + b[5] * b[5]);
+        if (std::abs(b[0]) > kMaxAnchorCoordinate || std::abs(b[1]) > kMaxAnchorCoordinate ||
+            std::abs(b[2]) > kMaxAnchorCoordinate || !(nl > 1e-12) || !std::isfinite(nl) ||
+            !(b[6] > 0.0 && b[6] <= kMaxSurfaceSize)) {
+            sendError(res, 422, "invalid_argument", std::string("dermis::Api: surface_brush: ") + what,
+                      "surface_brush");
+            return false;
+        }
+        p.surfaceBrush = std::array<double, 7>{b[0], b[1], b[2], b[3], b[4], b[5], b[6]};
+    }
     if (req.has_param("view")) {
         const auto view = frameViewFromString(req.get_param_value("view"));
         if (!view) {
@@ -206,7 +221,8 @@ namespace {
 bool framePostParams(const Req& req, Res& res, Req& out) {
     static const std::set<std::string> known = {"format", "width", "height", "msaa", "yaw", "pitch",
                                                 "distance", "time", "target", "highlight", "hover",
-                                                "brush", "view", "patterns", "only", "preview", "revision"};
+                                                "brush", "surface_brush", "view", "patterns", "only",
+                                                "preview", "revision"};
     json body;
     if (!jsonBody(req, res, body)) return false;
     if (!body.is_object()) {

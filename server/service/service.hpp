@@ -105,6 +105,10 @@ struct FrameParams {
     std::string hover;                  ///< a placement outlined as hovered ("" = none)
     /// A brush footprint outlined at UV centre (u, v), size (su, sv), rotation (degrees).
     std::optional<std::array<double, 5>> brush;
+    /// A surface brush (SPEC §8) outlined as a circle on the rest surface: anchor position x, y, z
+    /// (bind space), normal x, y, z, diameter (model units) — the decal the 3D view's place tool
+    /// would add.
+    std::optional<std::array<double, 7>> surfaceBrush;
     // Compare (SPEC §6): which version of the scene the frame shows.
     bool patternsOff = false;          ///< no dynamic patterns (every placement disabled)
     std::vector<std::string> only;     ///< solo: only these placements (others disabled)

@@ -2,6 +2,7 @@
 // snapshot under the shared lock and plans and renders without any lock held.
 #include "service/service_state.hpp"
 
+#include "core/bake.hpp"
 #include "core/normalmap.hpp"
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
@@ -36,15 +37,28 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
 namespace {
 
 /// The outlines `p` asks for, from the snapshot's placements (previews applied): the highlighted
-/// ones as selected, the hovered one, the brush. Unknown ids fail (field highlight / hover).
+/// ones as selected, the hovered one, the brushes. A surface placement is outlined as its decal on
+/// the rest surface (core surfaceFrameOf: the frame the bake uses). Unknown ids fail (field
+/// highlight / hover).
 Result<std::vector<FrameOutline>> outlinesOf(const Scene& scene, const FrameParams& p) {
     std::vector<FrameOutline> out;
     auto add = [&](const std::string& pid, FrameOutline::Kind kind, const char* field) -> Status {
         for (const Placement& pl : scene.placements)
             if (pl.id == pid) {
-                // TODO: an outline of a surface placement's decal (SPEC §8) — the outline block
-                // holds UV rectangles only; a surface placement is not outlined yet.
-                if (pl.projection == Projection::Surface) return Ok{};
+                if (pl.projection == Projection::Surface) {
+                    BakePlacement b;
+                    if (!surfaceFrameOf(pl, b)) return Ok{}; // a degenerate anchor: nothing to draw
+                    FrameOutline o;
+                    o.kind = kind;
+                    o.shape = FrameOutline::SurfaceRect;
+                    o.anchor = glm::vec3(b.anchorPosition);
+                    o.normal = glm::vec3(b.anchorNormal);
+                    o.tangent = glm::vec3(b.anchorTangent);
+                    o.size = glm::vec2(b.size);
+                    o.depth = static_cast<float>(b.depth);
+                    out.push_back(o);
+                    return Ok{};
+                }
                 out.push_back({glm::vec2(static_cast<float>(pl.center[0]), static_cast<float>(pl.center[1])),
                                glm::vec2(static_cast<float>(pl.scale[0]), static_cast<float>(pl.scale[1])),
                                static_cast<float>(pl.rotation), kind});
@@ -61,6 +75,22 @@ Result<std::vector<FrameOutline>> outlinesOf(const Scene& scene, const FramePara
         out.push_back({glm::vec2(static_cast<float>(b[0]), static_cast<float>(b[1])),
                        glm::vec2(static_cast<float>(b[2]), static_cast<float>(b[3])),
                        static_cast<float>(b[4]), FrameOutline::Brush});
+    }
+    if (p.surfaceBrush) {
+        const auto& b = *p.surfaceBrush;
+        const glm::dvec3 n = glm::normalize(glm::dvec3(b[3], b[4], b[5]));
+        // Any tangent: a circle has no orientation (the dashes start somewhere).
+        const glm::dvec3 t = glm::normalize(std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0))
+                                                               : glm::cross(n, glm::dvec3(0, 1, 0)));
+        FrameOutline o;
+        o.kind = FrameOutline::Brush;
+        o.shape = FrameOutline::SurfaceCircle;
+        o.anchor = glm::vec3(static_cast<float>(b[0]), static_cast<float>(b[1]), static_cast<float>(b[2]));
+        o.normal = glm::vec3(n);
+        o.tangent = glm::vec3(t);
+        o.size = glm::vec2(static_cast<float>(b[6]));
+        o.depth = static_cast<float>(b[6] * 0.5);
+        out.push_back(o);
     }
     return out;
 }
@@ -238,6 +268,7 @@ Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams
     p.highlight.clear();
     p.hover.clear();
     p.brush.reset();
+    p.surfaceBrush.reset();
     FrameParams other = p;
     if (against == "off") {
         other.patternsOff = true;
