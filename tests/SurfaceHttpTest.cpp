@@ -2,8 +2,9 @@
 // answers an anchor; a surface placement added there (POST) changes the frame only near the
 // picked pixel (frame-diff against patterns=off); PATCHing its anchor to another pick moves the
 // change; the canonical document echoes projection / anchor / size / depth and uv_layout; the
-// probe, lint, maps and the batch route take it; on CesiumMan the same; on RiggedFigure (no UVs)
-// uv_layout "model" refuses it with a clear error naming /uv_layout.
+// probe, lint, maps and the batch route take it; the outline route draws it (and a UV placement's
+// rectangle) in the layout in use; on CesiumMan the same; on RiggedFigure (no UVs) uv_layout
+// "model" refuses it with a clear error naming /uv_layout.
 #include "HttpTestFixture.hpp"
 
 #include <algorithm>
@@ -177,6 +178,88 @@ TEST_F(SurfaceHttpTest, PickAnchorThenASurfacePlacementOnTheDefaultCharacter) {
     const Lit g = litOf(inGenerated);
     EXPECT_GT(g.count, 20);
     EXPECT_LE(std::max(std::abs(g.y0 - qy), std::abs(g.y1 - qy)), 40);
+    ASSERT_EQ(h.del(s).status, 204);
+}
+
+// The texture view's outline (GET /scenes/{id}/placements/{pid}/outline): a surface decal's border
+// in the layout the scene uses, in pieces, inside [0,1]², with its hit test; a UV placement's
+// rotated rectangle; 404 naming the field for an unknown placement or scene.
+TEST_F(SurfaceHttpTest, OutlinesOfASurfaceAndAUvPlacement) {
+    Http h = http();
+    const std::string id = createScene(emptyScene("builtin:default"));
+    const std::string s = "/scenes/" + id;
+    int px = 0, py = 0;
+    const json pick = pickOnBody(s, {110, 120, 100}, px, py);
+    ASSERT_TRUE(pick.is_object()) << "no pixel of the torso hit";
+    ASSERT_EQ(h.post(s + "/placements", decalAt(pick, "decal", 0.12)).status, 201);
+    const double u = pick["uv"][0], v = pick["uv"][1];
+    auto expectInside = [](const json& o) {
+        ASSERT_GE(o["pieces"].get<int>(), 1) << o;
+        ASSERT_EQ(o["bounds"].size(), o["pieces"].get<std::size_t>());
+        EXPECT_GE(o["segments"].size(), 8u) << "a decal crossing triangles has more than a rectangle's sides";
+        for (const json& seg : o["segments"]) {
+            ASSERT_EQ(seg.size(), 4u);
+            for (const json& x : seg) {
+                EXPECT_GE(x.get<double>(), 0.0);
+                EXPECT_LE(x.get<double>(), 1.0);
+            }
+        }
+        EXPECT_EQ(o["truncated"], false);
+    };
+    const std::string at = "?u=" + std::to_string(u) + "&v=" + std::to_string(v);
+    Reply r = h.get(s + "/placements/decal/outline" + at);
+    ASSERT_EQ(r.status, 200) << r;
+    json o = r.js();
+    EXPECT_EQ(o["placement"], "decal");
+    EXPECT_EQ(o["projection"], "surface");
+    // The layout the scene's maps use (auto: what the model's uv-layout route answers).
+    EXPECT_EQ(o["layout"], h.get("/models/builtin:default/uv-layout").js()["layout"]);
+    expectInside(o);
+    EXPECT_EQ(o["hit"], true) << "the picked point is inside the decal";
+    // Its piece's bounds hold the picked point; a point far from it is outside.
+    bool within = false;
+    for (const json& b : o["bounds"])
+        within = within || (b[0].get<double>() <= u + 1e-5 && u - 1e-5 <= b[2].get<double>() &&
+                            b[1].get<double>() <= v + 1e-5 && v - 1e-5 <= b[3].get<double>());
+    EXPECT_TRUE(within) << o["bounds"];
+    int qx = 0, qy = 0;
+    const json legs = pickOnBody(s, {190, 200, 180}, qx, qy);
+    ASSERT_TRUE(legs.is_object());
+    Reply far = h.get(s + "/placements/decal/outline?u=" + std::to_string(legs["uv"][0].get<double>()) +
+                      "&v=" + std::to_string(legs["uv"][1].get<double>()));
+    ASSERT_EQ(far.status, 200) << far;
+    EXPECT_EQ(far.js()["hit"], false);
+    EXPECT_FALSE(h.get(s + "/placements/decal/outline").js().contains("hit")) << "hit only with u, v";
+
+    // In the generated layout the same decal lies elsewhere in UV, still inside [0,1]².
+    json generated = h.get(s).js()["scene"];
+    generated["uv_layout"] = "generated";
+    ASSERT_EQ(h.put(s, generated).status, 200);
+    Reply g = h.get(s + "/placements/decal/outline");
+    ASSERT_EQ(g.status, 200) << g;
+    EXPECT_EQ(g.js()["layout"], "generated");
+    expectInside(g.js());
+    EXPECT_NE(g.js()["segments"], o["segments"]);
+
+    // A UV placement: its rectangle turned by 30° (SPEC: s = R(−rotation)·(p − center)/scale + ½).
+    Reply add = h.post(s + "/placements", {{"id", "rect"}, {"pattern", "crease"}, {"joint", pick["suggested"]["joint"]},
+                                           {"center", {0.3, 0.6}}, {"scale", {0.2, 0.1}}, {"rotation", 30}});
+    ASSERT_EQ(add.status, 201) << add;
+    Reply rect = h.get(s + "/placements/rect/outline");
+    ASSERT_EQ(rect.status, 200) << rect;
+    EXPECT_EQ(rect.js()["projection"], "uv");
+    EXPECT_EQ(rect.js()["pieces"], 1);
+    ASSERT_EQ(rect.js()["segments"].size(), 4u);
+    // Corner s = (0, 0): 0.3 − 0.1·cos30° + 0.05·sin30°, 0.6 − 0.1·sin30° − 0.05·cos30°.
+    EXPECT_NEAR(rect.js()["segments"][0][0].get<double>(), 0.23840, 1e-5);
+    EXPECT_NEAR(rect.js()["segments"][0][1].get<double>(), 0.50670, 1e-5);
+    EXPECT_EQ(h.get(s + "/placements/rect/outline?u=0.3&v=0.6").js()["hit"], true);
+
+    // Unknown placement or scene: 404 naming the field; half a texture point: 422.
+    expectError(h.get(s + "/placements/nope/outline"), 404, "placement");
+    expectError(h.get("/scenes/s_0000000000000000/placements/decal/outline"), 404, "id");
+    expectError(h.get(s + "/placements/decal/outline?u=0.5"), 422, "v");
+    expectError(h.get(s + "/placements/decal/outline?u=2&v=0.5"), 422, "u");
     ASSERT_EQ(h.del(s).status, 204);
 }
 

@@ -1,6 +1,7 @@
 // Dermis HTTP shell — inspection routes (SPEC §6, CPU only): probe (why a texel has its height)
 // activation (each placement's t over a clip, with flags), lint, pick (a frame pixel or a texture
-// point) and drivers (each placement's θ and t now).
+// point), a placement's footprint outline in the texture view (SPEC §8) and drivers (each
+// placement's θ and t now).
 #include "http/api_internal.hpp"
 
 #include <cmath>
@@ -34,6 +35,26 @@ void installInspectRoutes(RouteTable& t) {
             return sendError(res, 422, "invalid_argument", "dermis::Api: x and y are required",
                              !x ? "x" : "y");
         auto r = a.svc.pick(req.matches[1], p, *x, *y);
+        if (!r) return sendError(res, r.error());
+        sendJson(res, 200, *r);
+    });
+    t.add("GET", "/scenes/{id}/placements/{pid}/outline", [](Api::Impl& a, const Req& req, Res& res) {
+        std::optional<double> u, v, revision;
+        if (!numberParam(req, res, "u", u) || !numberParam(req, res, "v", v) ||
+            !numberParam(req, res, "revision", revision))
+            return;
+        if (u.has_value() != v.has_value())
+            return sendError(res, 422, "invalid_argument", "dermis::Api: u and v go together (a texture point to hit test)",
+                             !u ? "u" : "v");
+        std::optional<std::uint64_t> rev;
+        if (revision) {
+            if (*revision < 1 || *revision != std::floor(*revision) || *revision > 1e15)
+                return sendError(res, 422, "invalid_argument", "dermis::Api: revision: must be a revision number >= 1", "revision");
+            rev = static_cast<std::uint64_t>(*revision);
+        }
+        std::optional<std::array<double, 2>> at;
+        if (u) at = std::array<double, 2>{*u, *v};
+        auto r = a.svc.placementOutline(req.matches[1], req.matches[2], rev, at);
         if (!r) return sendError(res, r.error());
         sendJson(res, 200, *r);
     });

@@ -15,7 +15,7 @@
 //
 // Files: service.cpp (open, info), service_models.cpp, service_patterns.cpp,
 // service_scenes.cpp (documents and edits), service_history.cpp (revisions, revert, presence),
-// service_inspect.cpp (pick, probe, activation, lint), service_sweep.cpp (sweeps),
+// service_inspect.cpp (pick, outline, probe, activation, lint), service_sweep.cpp (sweeps),
 // service_renders.cpp (frames, maps, batch), service_view.cpp (focus, turntable),
 // service_events.cpp; shared private state in
 // service_state.hpp.
@@ -340,6 +340,17 @@ public:
     /// mesh there, `position` in bind space. {hit: false} where no UV chart is; fails on u, v
     /// outside [0, 1] (field "u"/"v") and on a model without UVs (field "u").
     Result<nlohmann::json> pickUv(const std::string& id, double u, double v);
+    /// The outline of placement `pid`'s footprint in the height-map layout the scene uses (SPEC
+    /// §8; core surfaceFootprintOutline) for the texture view: {placement, projection ("uv" |
+    /// "surface"), layout ("model" | "generated"), pieces (how many connected pieces the layout's
+    /// seams cut it into), bounds ([u0, v0, u1, v1] per piece), segments ([u0, v0, u1, v1]: the
+    /// border), truncated (more than kMaxOutlineSegments)}, numbers rounded to 1e-5; with `at`
+    /// (a texture point u, v) also hit: whether it lies inside (core footprintContains). The
+    /// document of `revision` when given. Fails: NotFound "id" (scene), "placement", "revision";
+    /// InvalidArgument "u"/"v" outside [0, 1], "/uv_layout" when the layout cannot be had.
+    Result<nlohmann::json> placementOutline(const std::string& id, const std::string& pid,
+                                            std::optional<std::uint64_t> revision = std::nullopt,
+                                            std::optional<std::array<double, 2>> at = std::nullopt);
     /// What drives each placement at the frame `params` describe (time, revision, camera):
     /// {scene, revision, time, camera: {yaw, pitch, distance} (the renderer's, "auto" resolved),
     /// placements: [{placement, joint, axis, theta, t, enabled}]} — θ in degrees (SPEC §2) and t

@@ -1,5 +1,5 @@
-// Inspection of a stored scene, CPU only (SPEC §6): pick — frame pixel to skin —, probe — why a
-// texel has its height —,
+// Inspection of a stored scene, CPU only (SPEC §6): pick — frame pixel to skin —, a placement's
+// footprint outline in the texture view (SPEC §8), probe — why a texel has its height —,
 // activation — each placement's t over a clip, with flags — and lint. All run on a snapshot,
 // unlocked. Lint and the picks read the model's UV index, rest skin, symmetry plane and clip
 // ranges from its entry (State::derivedOf: built once per model, core ModelDerived), not new ones
@@ -11,7 +11,9 @@
 #include "core/lint.hpp"
 #include "core/pick.hpp"
 #include "core/probe.hpp"
+#include "core/surface_outline.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -182,6 +184,52 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     const auto hit = dermis::pickUv(derived->model(), derived->uvLookup(), {u, v});
     if (!hit) return json{{"hit", false}};
     return pickAnswer(*derived, *hit, nullptr);
+}
+
+Result<json> Service::placementOutline(const std::string& id, const std::string& pid,
+                                       std::optional<std::uint64_t> revision,
+                                       std::optional<std::array<double, 2>> at) {
+    if (at) {
+        if (!std::isfinite((*at)[0]) || (*at)[0] < 0.0 || (*at)[0] > 1.0) return bad("u", "must be in [0, 1]");
+        if (!std::isfinite((*at)[1]) || (*at)[1] < 0.0 || (*at)[1] > 1.0) return bad("v", "must be in [0, 1]");
+    }
+    FrameParams params;
+    params.revision = revision;
+    auto snap = state_->frameSnapshot(id, params);
+    if (!snap) return snap.error();
+    const auto& placements = snap->scene.placements;
+    const auto it = std::find_if(placements.begin(), placements.end(), [&](const Placement& q) { return q.id == pid; });
+    if (it == placements.end()) return notFound("placement", "no placement \"" + pid + "\" in scene " + id);
+    const Placement* p = &*it;
+    // The layout the scene's maps live in (the model's own UVs or the generated one: what the
+    // texture view shows), and the model seen through it (built once per model and layout).
+    const auto derived = state_->derivedOf(*snap);
+    auto layout = state_->layoutFor(snap->scene, *derived);
+    if (!layout) return layout.error();
+    const auto inLayout = *layout == derived->modelLayout() ? derived : derived->throughLayout(*layout);
+    auto outline = surfaceFootprintOutline(inLayout->model(), *p);
+    if (!outline) { // fields of the placement (or the layout) in the scene document
+        Error e = outline.error();
+        e.field = e.field == "uv_layout" ? "/uv_layout"
+                                         : "/placements/" + std::to_string(it - placements.begin()) + "/" + e.field;
+        return e;
+    }
+    auto r5 = [](double x) { return std::round(x * 1e5) / 1e5 + 0.0; }; // + 0.0: no "-0"
+    json segments = json::array();
+    for (const auto& s : outline->segments) segments.push_back({r5(s[0]), r5(s[1]), r5(s[2]), r5(s[3])});
+    json bounds = json::array();
+    for (const OutlinePiece& piece : outline->pieces)
+        bounds.push_back({r5(piece.min.x), r5(piece.min.y), r5(piece.max.x), r5(piece.max.y)});
+    json out{{"placement", pid},
+             {"projection", std::string(toString(p->projection))},
+             {"layout", (*layout)->kind},
+             {"pieces", outline->pieces.size()},
+             {"bounds", std::move(bounds)},
+             {"segments", std::move(segments)},
+             {"truncated", outline->truncated}};
+    if (at)
+        out["hit"] = footprintContains(inLayout->model(), inLayout->uvLookup(), *p, {(*at)[0], (*at)[1]});
+    return out;
 }
 
 Result<json> Service::drivers(const std::string& id, const FrameParams& params) {

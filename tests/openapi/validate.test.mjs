@@ -321,6 +321,22 @@ try {
   const byUv = await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=0.29&v=0.737", expect: 200 });
   assert.equal(byUv.json().hit, true);
   await api("GET", "/scenes/{id}/pick", { params: { id }, query: "u=1.5&v=0.5", expect: 422 });
+  // the texture view's outline of a footprint (SPEC 8): a UV placement's rectangle; a surface decal
+  // at the pick's anchor (added to the small scene, then removed), its hit test; errors
+  const outline = "/scenes/{id}/placements/{pid}/outline";
+  const rect = (await api("GET", outline, { params: { id, pid: "elbow_l" }, expect: 200 })).json();
+  assert.equal(rect.projection, "uv");
+  assert.equal(rect.segments.length, 4);
+  await api("POST", "/scenes/{id}/placements", { params: S, expect: 201, body:
+    { id: "decal", pattern: "round_bulge", joint: "forearm.l", projection: "surface", anchor: byUv.json().anchor, size: [0.1, 0.1] } });
+  const [pu, pv] = byUv.json().uv;
+  const decal = (await api("GET", outline, { params: { ...S, pid: "decal" }, query: `u=${pu}&v=${pv}`, expect: 200 })).json();
+  assert.equal(decal.projection, "surface");
+  assert.ok(decal.pieces >= 1 && decal.segments.length >= 4 && decal.hit === true, JSON.stringify(decal).slice(0, 300));
+  await api("GET", outline, { params: { ...S, pid: "nope" }, expect: 404 });
+  await api("GET", outline, { params: { ...S, pid: "decal" }, query: "u=0.5", expect: 422 });
+  await api("GET", outline, { params: { ...S, pid: "decal" }, query: "revision=99999", expect: 404 });
+  await api("DELETE", "/scenes/{id}/placements/{pid}", { params: { ...S, pid: "decal" }, expect: 200 });
   const drivers = await api("GET", "/scenes/{id}/drivers", { params: { id }, query: "time=0.5", expect: 200 });
   assert.ok(drivers.json().placements.length > 0 && drivers.json().camera.distance > 0);
   await api("GET", "/scenes/{id}/drivers", { params: { id }, query: "revision=99999", expect: 404 });
