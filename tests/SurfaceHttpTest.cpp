@@ -182,8 +182,9 @@ TEST_F(SurfaceHttpTest, PickAnchorThenASurfacePlacementOnTheDefaultCharacter) {
 }
 
 // The texture view's outline (GET /scenes/{id}/placements/{pid}/outline): a surface decal's border
-// in the layout the scene uses, in pieces, inside [0,1]², with its hit test; a UV placement's
-// rotated rectangle; 404 naming the field for an unknown placement or scene.
+// in the layout the scene uses, in pieces, inside [0,1]², with its hit test and its anchor's UV
+// (the pick's); a UV placement's rotated rectangle and centre; 404 naming the field for an
+// unknown placement or scene.
 TEST_F(SurfaceHttpTest, OutlinesOfASurfaceAndAUvPlacement) {
     Http h = http();
     const std::string id = createScene(emptyScene("builtin:default"));
@@ -216,6 +217,11 @@ TEST_F(SurfaceHttpTest, OutlinesOfASurfaceAndAUvPlacement) {
     EXPECT_EQ(o["layout"], h.get("/models/builtin:default/uv-layout").js()["layout"]);
     expectInside(o);
     EXPECT_EQ(o["hit"], true) << "the picked point is inside the decal";
+    // Its anchor in UV: the pick's UV (the decal is anchored where the pick landed).
+    ASSERT_TRUE(o["anchor_uv"].is_array()) << o;
+    ASSERT_EQ(o["anchor_uv"].size(), 2u);
+    EXPECT_NEAR(o["anchor_uv"][0].get<double>(), u, 0.01) << o["anchor_uv"];
+    EXPECT_NEAR(o["anchor_uv"][1].get<double>(), v, 0.01) << o["anchor_uv"];
     // Its piece's bounds hold the picked point; a point far from it is outside.
     bool within = false;
     for (const json& b : o["bounds"])
@@ -240,6 +246,15 @@ TEST_F(SurfaceHttpTest, OutlinesOfASurfaceAndAUvPlacement) {
     EXPECT_EQ(g.js()["layout"], "generated");
     expectInside(g.js());
     EXPECT_NE(g.js()["segments"], o["segments"]);
+    // The anchor's UV in that layout lies within one of its pieces' bounds.
+    const json gj = g.js();
+    ASSERT_TRUE(gj["anchor_uv"].is_array()) << gj;
+    const double gu = gj["anchor_uv"][0], gv = gj["anchor_uv"][1];
+    bool anchorWithin = false;
+    for (const json& b : gj["bounds"])
+        anchorWithin = anchorWithin || (b[0].get<double>() <= gu + 1e-5 && gu - 1e-5 <= b[2].get<double>() &&
+                                        b[1].get<double>() <= gv + 1e-5 && gv - 1e-5 <= b[3].get<double>());
+    EXPECT_TRUE(anchorWithin) << gj["anchor_uv"] << " " << gj["bounds"];
 
     // A UV placement: its rectangle turned by 30° (SPEC: s = R(−rotation)·(p − center)/scale + ½).
     Reply add = h.post(s + "/placements", {{"id", "rect"}, {"pattern", "crease"}, {"joint", pick["suggested"]["joint"]},
@@ -254,6 +269,7 @@ TEST_F(SurfaceHttpTest, OutlinesOfASurfaceAndAUvPlacement) {
     EXPECT_NEAR(rect.js()["segments"][0][0].get<double>(), 0.23840, 1e-5);
     EXPECT_NEAR(rect.js()["segments"][0][1].get<double>(), 0.50670, 1e-5);
     EXPECT_EQ(h.get(s + "/placements/rect/outline?u=0.3&v=0.6").js()["hit"], true);
+    EXPECT_EQ(rect.js()["anchor_uv"], json({0.3, 0.6})) << "a UV placement's anchor is its center";
 
     // Unknown placement or scene: 404 naming the field; half a texture point: 422.
     expectError(h.get(s + "/placements/nope/outline"), 404, "placement");

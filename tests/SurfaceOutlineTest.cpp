@@ -5,8 +5,10 @@
 // falls into two pieces (two open chains ending on the seam), a decal smaller than a triangle is
 // a 4-segment loop inside that triangle, a decal off the body or facing away gives no piece; the
 // hit test agrees; the cap truncates with a flag; errors name the field; a UV placement is its
-// rotated rectangle; on the KayKit Barbarian (../shared) through its generated layout, a decal at a
-// pick anchor on the forearm gives pieces inside [0,1]² holding the picked point.
+// rotated rectangle; the anchor's UV is that of the nearest surface point facing the anchor within
+// the decal's reach (else of the nearest triangle), a UV placement's is its center; on the KayKit
+// Barbarian (../shared) through its generated layout, a decal at a pick anchor on the forearm
+// gives pieces inside [0,1]² holding the picked point, which is its anchor UV.
 #include "core/bake.hpp"
 #include "core/heightmap.hpp"
 #include "core/layout_gen.hpp"
@@ -232,6 +234,10 @@ TEST(SurfaceOutlineTest, ADecalSmallerThanATriangleIsALoopInsideIt) {
     EXPECT_GT(o->pieces[0].max.y, uv.y);
     EXPECT_LT(o->pieces[0].max.x - o->pieces[0].min.x, 1.0 / kSegments);
     EXPECT_TRUE(footprintContains(m, UvLookup(m), p, uv));
+    // Anchored at the triangle's centroid: its anchor UV is the centroid's UV.
+    ASSERT_TRUE(o->anchorUv);
+    EXPECT_NEAR(o->anchorUv->x, uv.x, 1e-9);
+    EXPECT_NEAR(o->anchorUv->y, uv.y, 1e-9);
 }
 
 TEST(SurfaceOutlineTest, ADecalOnNoSurfaceHasNoPiece) {
@@ -321,11 +327,93 @@ TEST(SurfaceOutlineTest, AUvPlacementIsItsRotatedRectangle) {
     EXPECT_NEAR(o->segments[1][0], 0.4116025, 1e-7);
     EXPECT_NEAR(o->segments[1][1], 0.6066987, 1e-7);
     EXPECT_NEAR(o->pieces[0].min.x, 0.3 - 0.1116025, 1e-7);
+    ASSERT_TRUE(o->anchorUv);
+    EXPECT_EQ(*o->anchorUv, glm::dvec2(0.3, 0.6)) << "a UV placement's anchor is its center";
     const Model empty;
     const UvLookup none(empty);
     EXPECT_TRUE(footprintContains(empty, none, p, {0.3, 0.6}));
     EXPECT_TRUE(footprintContains(empty, none, p, {0.39, 0.62})); // along the turned u axis
     EXPECT_FALSE(footprintContains(empty, none, p, {0.39, 0.56}));
+}
+
+// The anchor's UV: the UV of the rest-surface point nearest to the anchor — here a point on the
+// true circle between two vertex columns, which lies just off the faceted mesh: its nearest point
+// is its projection onto the chord's (planar) quad, whose UV the test computes.
+TEST(SurfaceOutlineTest, TheAnchorUvIsTheNearestSurfacePointsUv) {
+    const Model m = cylinder();
+    const double a0 = 2.0 * kPi * 40 / kSegments, a1 = 2.0 * kPi * 41 / kSegments;
+    const double a = a0 + 0.3 * (a1 - a0), y = 0.77;
+    const Placement p = decalOnCylinder(a, y, 0.2, 0.2);
+    auto o = surfaceFootprintOutline(m, p);
+    ASSERT_TRUE(o) << o.error().message;
+    ASSERT_TRUE(o->anchorUv);
+    // In the xz-plane: the parameter of the anchor's projection onto the chord from a0 to a1.
+    const glm::dvec2 A(kRadius * std::cos(a0), kRadius * std::sin(a0));
+    const glm::dvec2 B(kRadius * std::cos(a1), kRadius * std::sin(a1));
+    const glm::dvec2 P(kRadius * std::cos(a), kRadius * std::sin(a));
+    const double t = glm::dot(P - A, B - A) / glm::dot(B - A, B - A);
+    EXPECT_NEAR(o->anchorUv->x, (40 + t) / kSegments, 1e-6);
+    EXPECT_NEAR(o->anchorUv->y, 1.0 - y / kHeight, 1e-6);
+    // On a vertex column: that column's u.
+    auto onColumn = surfaceFootprintOutline(m, decalOnCylinder(kPi, 1.0, 0.4, 0.3));
+    ASSERT_TRUE(onColumn && onColumn->anchorUv);
+    EXPECT_NEAR(onColumn->anchorUv->x, 0.5, 1e-9);
+    EXPECT_NEAR(onColumn->anchorUv->y, 0.5, 1e-9);
+    // Facing away from every surface near it: the nearest triangle all the same.
+    Placement away = decalOnCylinder(kPi, 1.0, 0.4, 0.3);
+    away.anchor.normal = {1.0, 0.0, 0.0};
+    auto back = surfaceFootprintOutline(m, away);
+    ASSERT_TRUE(back && back->anchorUv);
+    EXPECT_TRUE(back->pieces.empty());
+    EXPECT_NEAR(back->anchorUv->x, 0.5, 1e-9);
+    EXPECT_NEAR(back->anchorUv->y, 0.5, 1e-9);
+}
+
+TEST(SurfaceOutlineTest, TheAnchorUvPrefersASurfaceFacingTheAnchorWithinReach) {
+    // Two parallel squares x, y ∈ [−1, 1]: at z = 0 facing −z (u in [0, ½]), at z = −0.1 facing +z
+    // (u in [½, 1]); v = (y + 1)/2 on both — a layer over the skin, seen from its back.
+    Model m;
+    MeshPart part;
+    for (int layer = 0; layer < 2; ++layer)
+        for (int k = 0; k < 4; ++k) {
+            const float x = k == 1 || k == 2 ? 1.0f : -1.0f, y = k >= 2 ? 1.0f : -1.0f;
+            part.positions.emplace_back(x, y, layer == 0 ? 0.0f : -0.1f);
+            part.normals.emplace_back(0.0f, 0.0f, layer == 0 ? -1.0f : 1.0f);
+            part.uvs.emplace_back(0.5f * layer + (x + 1.0f) / 4.0f, (y + 1.0f) / 2.0f);
+        }
+    part.indices = {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7};
+    m.parts.push_back(part);
+    // Anchored 0.02 in front of the first square, looking along +z.
+    Placement p = decalOnCylinder(0.0, 0.0, 0.3, 0.3);
+    p.anchor.position = {0.2, -0.4, 0.02};
+    p.anchor.normal = {0.0, 0.0, 1.0};
+    p.anchor.tangent = {1.0, 0.0, 0.0};
+    p.depth = 0.05;
+    // Reach ≈ 0.22: both squares within it; the nearer one faces away, the other one is taken.
+    auto wide = surfaceFootprintOutline(m, p);
+    ASSERT_TRUE(wide) << wide.error().message;
+    ASSERT_TRUE(wide->anchorUv);
+    EXPECT_NEAR(wide->anchorUv->x, 0.5 + 1.2 / 4.0, 1e-7);
+    EXPECT_NEAR(wide->anchorUv->y, 0.3, 1e-7);
+    // Reach ≈ 0.06: only the square facing away is within it: the nearest triangle all the same.
+    p.size = {0.05, 0.05};
+    auto small = surfaceFootprintOutline(m, p);
+    ASSERT_TRUE(small) << small.error().message;
+    ASSERT_TRUE(small->anchorUv);
+    EXPECT_TRUE(small->pieces.empty());
+    EXPECT_NEAR(small->anchorUv->x, 1.2 / 4.0, 1e-7);
+    EXPECT_NEAR(small->anchorUv->y, 0.3, 1e-7);
+    // Far off both (behind the second square): the nearest triangle's UV, whatever the reach.
+    p.anchor.position = {-5.0, 0.6, -3.0};
+    auto far = surfaceFootprintOutline(m, p);
+    ASSERT_TRUE(far && far->anchorUv);
+    EXPECT_NEAR(far->anchorUv->x, 0.5, 1e-7) << "the second square's corner edge x = −1";
+    EXPECT_NEAR(far->anchorUv->y, 0.8, 1e-7);
+    // No triangle in the layout (every one of zero UV area): no anchor UV.
+    for (glm::vec2& uv : m.parts[0].uvs) uv = glm::vec2(0.25f);
+    auto none = surfaceFootprintOutline(m, p);
+    ASSERT_TRUE(none) << none.error().message;
+    EXPECT_FALSE(none->anchorUv);
 }
 
 // --- a real character --------------------------------------------------------------------------
@@ -377,6 +465,10 @@ TEST(SurfaceOutlineTest, TheBarbariansForearmDecalInItsGeneratedLayout) {
     for (const OutlinePiece& piece : o->pieces)
         within = within || (piece.min.x <= at.x && at.x <= piece.max.x && piece.min.y <= at.y && at.y <= piece.max.y);
     EXPECT_TRUE(within) << at.x << ", " << at.y;
+    // The anchor's UV is the picked point's.
+    ASSERT_TRUE(o->anchorUv);
+    EXPECT_NEAR(o->anchorUv->x, at.x, 1e-3);
+    EXPECT_NEAR(o->anchorUv->y, at.y, 1e-3);
     // The generated layout's charts are separate: every piece's border ends are shared by at most
     // two segments (a piece cut by a chart border is an open chain, never a fork).
     for (const auto& [pt, n] : endCounts(*o)) EXPECT_LE(n, 2) << pt.first << ", " << pt.second;

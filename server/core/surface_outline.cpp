@@ -5,7 +5,9 @@
 // polygon edge labelled with what it lies on: a triangle edge or a clipping plane), the plane
 // edges emitted as segments. Polygon corners between a plane edge and a triangle edge are put at
 // that plane's zero on that edge, computed from the edge's corners in a fixed order (by UV, then
-// position), so that the two triangles sharing the edge give the same point bit for bit.
+// position), so that the two triangles sharing the edge give the same point bit for bit. Along
+// the way, the anchor's UV: each triangle's closest point to the anchor (Ericson's), its normal
+// interpolated there.
 #include "surface_outline.hpp"
 
 #include "bake.hpp"
@@ -123,6 +125,40 @@ struct Touched {
     std::size_t firstSegment = 0, segments = 0; ///< into the collected segments
 };
 
+/// The point of triangle (a, b, c) closest to p, as barycentric weights of a, b, c (Ericson,
+/// Real-Time Collision Detection §5.1.5: the Voronoi region of p among the corners, edges and face).
+glm::dvec3 closestOnTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0) return {1, 0, 0};
+    const glm::dvec3 bp = p - b;
+    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3) return {0, 1, 0};
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        const double v = d1 - d3 != 0.0 ? d1 / (d1 - d3) : 0.0;
+        return {1.0 - v, v, 0.0};
+    }
+    const glm::dvec3 cp = p - c;
+    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6) return {0, 0, 1};
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        const double w = d2 - d6 != 0.0 ? d2 / (d2 - d6) : 0.0;
+        return {1.0 - w, 0.0, w};
+    }
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+        const double den = (d4 - d3) + (d5 - d6);
+        const double w = den != 0.0 ? (d4 - d3) / den : 0.0;
+        return {0.0, 1.0 - w, w};
+    }
+    const double sum = va + vb + vc;
+    if (!(sum != 0.0)) return {1, 0, 0}; // a degenerate triangle: its first corner
+    const double v = vb / sum, w = vc / sum;
+    return {1.0 - v - w, v, w};
+}
+
 bool isFinite(double x) { return std::isfinite(x); }
 
 Result<SurfaceOutline> uvOutline(const Placement& p) {
@@ -145,6 +181,7 @@ Result<SurfaceOutline> uvOutline(const Placement& p) {
     }
     const auto [lo, hi] = f.uvBounds();
     out.pieces.push_back(OutlinePiece{lo, hi, 0});
+    out.anchorUv = f.center;
     return out;
 }
 
@@ -182,6 +219,10 @@ Result<SurfaceOutline> surfaceFootprintOutline(const Model& model, const Placeme
     Polygon poly, scratch;
     poly.reserve(16);
     scratch.reserve(16);
+    // The anchor's UV: the closest rest-surface point among the triangles within reach whose
+    // interpolated normal there faces the anchor normal, else among all triangles.
+    double facingDist2 = INFINITY, anyDist2 = INFINITY;
+    glm::dvec2 facingUv(0.0), anyUv(0.0);
 
     for (const MeshPart& part : model.parts) {
         if (part.positions.empty() || part.uvs.size() < part.positions.size()) continue;
@@ -203,14 +244,38 @@ Result<SurfaceOutline> surfaceFootprintOutline(const Model& model, const Placeme
                 lo = glm::min(lo, c.position[k]);
                 hi = glm::max(hi, c.position[k]);
             }
-            // Far from the anchor: nothing of the decal there.
             const glm::dvec3 gap = frame.c - glm::clamp(frame.c, lo, hi);
-            if (glm::dot(gap, gap) > reach * reach) continue;
+            const double gap2 = glm::dot(gap, gap);
+            const bool inReach = gap2 <= reach * reach;
+            // Neither within reach nor possibly nearer than the nearest triangle so far.
+            if (!inReach && gap2 >= anyDist2) continue;
             const glm::dvec2 e1 = c.uv[1] - c.uv[0], e2 = c.uv[2] - c.uv[0];
             if (e1.x * e2.y - e1.y * e2.x == 0.0) continue; // no UV area
             glm::dvec3 face = glm::cross(c.position[1] - c.position[0], c.position[2] - c.position[0]);
             const double faceLen = glm::length(face);
             face = faceLen > 0.0 ? face / faceLen : glm::dvec3(0, 0, 1);
+            {
+                const glm::dvec3 w = closestOnTriangle(frame.c, c.position[0], c.position[1], c.position[2]);
+                const glm::dvec3 q = w.x * c.position[0] + w.y * c.position[1] + w.z * c.position[2];
+                const double d2 = glm::dot(q - frame.c, q - frame.c);
+                const glm::dvec2 uv = w.x * c.uv[0] + w.y * c.uv[1] + w.z * c.uv[2];
+                if (d2 < anyDist2) {
+                    anyDist2 = d2;
+                    anyUv = uv;
+                }
+                if (d2 <= reach * reach && d2 < facingDist2) {
+                    glm::dvec3 normal = face;
+                    if (hasNormals)
+                        normal = w.x * glm::dvec3(part.normals[v[0]]) + w.y * glm::dvec3(part.normals[v[1]]) +
+                                 w.z * glm::dvec3(part.normals[v[2]]);
+                    if (glm::dot(normal, frame.n) > 0.0) {
+                        facingDist2 = d2;
+                        facingUv = uv;
+                    }
+                }
+            }
+            // Far from the anchor: nothing of the decal there.
+            if (!inReach) continue;
             for (int k = 0; k < 3; ++k) {
                 const glm::dvec3 d = c.position[k] - frame.c;
                 const double x = glm::dot(d, frame.t), y = glm::dot(d, frame.b), z = glm::dot(d, frame.n);
@@ -269,6 +334,9 @@ Result<SurfaceOutline> surfaceFootprintOutline(const Model& model, const Placeme
             touched.push_back(tr);
         }
     }
+
+    if (facingDist2 < INFINITY) out.anchorUv = facingUv;
+    else if (anyDist2 < INFINITY) out.anchorUv = anyUv;
 
     // Pieces, ordered by their first triangle.
     std::unordered_map<std::size_t, std::size_t> pieceOfRoot;

@@ -1,6 +1,7 @@
 // Dermis core — the outline of a placement's footprint in the height-map layout in use (SPEC §8),
 // for the editor's texture view: what to draw (segments in UV), into how many pieces the layout
-// cuts it, where each piece lies, and whether a texture point is inside it (its hit test).
+// cuts it, where each piece lies, where its anchor lies, and whether a texture point is inside it
+// (its hit test).
 //
 // A surface placement's footprint is the set of rest-surface points its decal reaches
 // (SurfaceFrame::toPattern, heightmap.hpp): normal·n > 0, |d·n| ≤ depth and |d·t| ≤ w/2,
@@ -31,6 +32,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 namespace dermis {
@@ -59,6 +61,14 @@ struct SurfaceOutline {
     /// More than `maxSegments` border segments: `segments` holds the first maxSegments (part,
     /// triangle order); `pieces` still counts and bounds every piece.
     bool truncated = false;
+    /// Where the placement sits in the layout. Surface placement: the UV (interpolated
+    /// barycentrically) of the rest-surface point nearest to the anchor position — the closest
+    /// point on a triangle, among the triangles coming within SurfaceFrame::reach of the anchor
+    /// whose interpolated normal at that point faces the anchor normal (dot > 0), else among all
+    /// triangles whatever their facing and distance (ties: the first in part, triangle order);
+    /// only triangles of the layout count (UVs, indices in range, UV area). Empty when there is
+    /// none. UV placement: its center.
+    std::optional<glm::dvec2> anchorUv;
 };
 
 /// The outline of placement `p`'s footprint in the UV space of `model`'s TEXCOORD_0 — the layout
@@ -74,8 +84,11 @@ struct SurfaceOutline {
 /// triangle gives no segment and no piece (not an error: e.g. an anchor off the body or a
 /// decal facing away from every surface).
 ///
+/// Also the anchor's UV (SurfaceOutline::anchorUv), from the same triangles, whether or not the
+/// decal reaches them.
+///
 /// UV placement: the rectangle's 4 edges, corners in the order s = (0,0), (1,0), (1,1), (0,1);
-/// `model` is not read.
+/// anchorUv its center; `model` is not read.
 ///
 /// `maxSegments` (≥ 1) caps the segments (see SurfaceOutline::truncated). Fails
 /// (InvalidArgument) on a surface placement whose anchor is degenerate ("anchor": a zero normal

@@ -206,7 +206,7 @@ Result<json> Service::placementOutline(const std::string& id, const std::string&
     const auto derived = state_->derivedOf(*snap);
     auto layout = state_->layoutFor(snap->scene, *derived);
     if (!layout) return layout.error();
-    const auto inLayout = *layout == derived->modelLayout() ? derived : derived->throughLayout(*layout);
+    const auto inLayout = state_->derivedInLayout(*snap);
     auto outline = surfaceFootprintOutline(inLayout->model(), *p);
     if (!outline) { // fields of the placement (or the layout) in the scene document
         Error e = outline.error();
@@ -226,7 +226,8 @@ Result<json> Service::placementOutline(const std::string& id, const std::string&
              {"pieces", outline->pieces.size()},
              {"bounds", std::move(bounds)},
              {"segments", std::move(segments)},
-             {"truncated", outline->truncated}};
+             {"truncated", outline->truncated},
+             {"anchor_uv", outline->anchorUv ? json{r5(outline->anchorUv->x), r5(outline->anchorUv->y)} : json()}};
     if (at)
         out["hit"] = footprintContains(inLayout->model(), inLayout->uvLookup(), *p, {(*at)[0], (*at)[1]});
     return out;
