@@ -3,7 +3,7 @@
 // Usage: node editor_3d.test.mjs <dermis-server executable>   (exit 0 = pass)
 // Checks: the selection is outlined on the skin (frame `highlight`; the frame without it is the
 // plain frame, byte for byte) and hovering a placement outlines it (`hover`); the place tool shows
-// its brush (`brush`); F frames the selection (camera target = the placement's surface point,
+// its brush (`surface_brush`: a circle on the body; `brush` with Place as: in the texture); F frames the selection (camera target = the placement's surface point,
 // closer); a drag orbits about the selection (its surface point keeps its pixel); Shift+drag and
 // middle drag pan (the picture follows the pointer); the wheel zooms to the cursor (the skin under
 // the pointer stays under it); the permalink carries the target and reproduces the frame byte for
@@ -183,14 +183,27 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       await screenshot(page, "editor-3d-hover.png");
       await page.click("#placeTool");
       await page.mouse.move(x + 2, y + 1);
-      const brush = await until(async () => param("brush"), "a brush in the frame URL");
+      // The brush on the body (a circle: surface_brush, what a click adds by default) …
+      const brush = await until(async () => param("surface_brush"), "a surface brush in the frame URL");
       const b = brush.split(",").map(Number);
-      assert.equal(b.length, 5);
-      assert.ok(Math.abs(b[2] - 0.08) < 1e-9 && Math.abs(b[3] - 0.08) < 1e-9, brush);
+      assert.equal(b.length, 7);
+      assert.ok(b[6] > 0, brush);
+      assert.equal(await param("brush"), null);
       await settledFrameHash(page);
       await screenshot(page, "editor-3d-brush.png");
+      // … or, placing in the texture, the UV footprint a click adds.
+      const placeAs = (v) => page.evaluate((value) => { const s = document.getElementById("placeAs"); s.value = value; s.dispatchEvent(new Event("change")); }, v);
+      await placeAs("uv");
+      await page.mouse.move(x + 1, y + 1);
+      await page.mouse.move(x + 2, y + 1);
+      const uvBrush = await until(async () => param("brush"), "a UV brush in the frame URL");
+      const ub = uvBrush.split(",").map(Number);
+      assert.equal(ub.length, 5);
+      assert.ok(Math.abs(ub[2] - 0.08) < 1e-9 && Math.abs(ub[3] - 0.08) < 1e-9, uvBrush);
+      assert.equal(await param("surface_brush"), null);
+      await placeAs("surface");
       await page.keyboard.press("p");
-      await until(async () => (await param("brush")) === null, "no brush once the tool is off");
+      await until(async () => (await param("brush")) === null && (await param("surface_brush")) === null, "no brush once the tool is off");
       await page.mouse.move(5, 5); // leaves the stage: no hover
       await until(async () => (await param("hover")) === null, "no hover outside");
     }],

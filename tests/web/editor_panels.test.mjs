@@ -109,9 +109,10 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       assert.notEqual(await settledFrameHash(page), hash0);
       await page.selectOption("#viewMode", "shaded");
     }],
-    ["the place tool adds a placement at the clicked skin with the suggested driver", async () => {
+    ["the place tool adds a placement at the clicked skin with the suggested driver (Place as: in the texture)", async () => {
       await settle();
       const n0 = (await doc()).placements.length;
+      await page.evaluate(() => { const s = document.getElementById("placeAs"); s.value = "uv"; s.dispatchEvent(new Event("change")); });
       await page.click("#placeTool");
       const box = await page.$eval("#frame", (i) => { const r = i.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
       const side = Math.min(box[2], box[3]);
@@ -124,6 +125,7 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       assert.equal(added.joint, pick.suggested.joint);
       assert.ok(Math.abs(added.center[0] - pick.uv[0]) < 0.002 && Math.abs(added.center[1] - pick.uv[1]) < 0.002);
       await page.click("#placeTool");
+      await page.evaluate(() => { const s = document.getElementById("placeAs"); s.value = "surface"; s.dispatchEvent(new Event("change")); });
     }],
     ["clicking the model selects the placement there; the wheel zooms", async () => {
       await page.keyboard.press("Escape");

@@ -11,12 +11,19 @@
 // with (its X-Dermis-Camera-Distance / -Target headers: `resolvedCamera`).
 //
 // Hover and brush: pointer moves (no button) pick the skin under the pointer (GET pick, one in
-// flight, the newest position next); the placement whose footprint holds the picked UV is outlined
-// as hovered, and with the place tool on the brush (the footprint a click would add) is outlined
-// there. The pick's surface position is also what the wheel zooms to.
+// flight, the newest position next); the placement under the pick (a UV footprint holding the
+// picked UV, or a surface decal holding the picked rest point) is outlined as hovered, and with the
+// place tool on the brush (what a click would add: a circle on the body, or a UV footprint) is
+// outlined there. The pick's surface position is also what the wheel zooms to.
+//
+// A drag that starts on the selected surface placement's decal moves it over the body (SPEC §8):
+// its anchor follows the picks under the pointer (position and normal; its tangent kept where it
+// can be), previewed in the frames, one edit and one undo step when the drag ends; Esc cancels.
 
 import { store, set, placementById } from "./store.js";
 import * as geo from "./geometry.js";
+import { Stream, patchPlacement } from "./edits.js";
+import { hold, release, withPending } from "./pending.js";
 
 const FOV_Y = (30 * Math.PI) / 180;
 const r4 = (x) => Math.round(x * 1e4) / 1e4;
@@ -126,14 +133,29 @@ export async function frameSelection(params) {
 
 // --- pointer: orbit, pan, wheel, hover, brush -------------------------------------------------
 
-/// Hover and brush state the frames outline: {hover: pid | null, brush: [u, v, su, sv, rot] | null}.
+/// Hover and brush state the frames outline: {hover: pid | null, brush: {uv: [u, v, su, sv, rot]}
+/// | {surface: [x, y, z, nx, ny, nz, diameter]} | null}.
 export const pointer = { hover: null, brush: null, last: null /* {px, hit} of the last pick */ };
 
 /// Wires the stage's pointer. `ctx`: {framePixel(e), displaySide(), pick(x, y), params(),
-/// placeTool(), brushSize(), onClick(e), onChange(), onError(err)} from frame_view.js.
+/// placeTool(), brushFor(pick), onClick(e), onChange(), onError(err)} from frame_view.js.
+let cancelDecal = () => false;
+
+/// Cancels a running decal drag in the 3D view (Esc; keys.js): the placement stays where it was.
+/// True when one ran.
+export const cancelDecalDrag = () => cancelDecal();
+
 export function initCamera(stage, theApi, ctx) {
   api = theApi;
   let drag = null;
+  cancelDecal = () => {
+    if (!drag || !drag.decal) return false;
+    const d = drag.decal;
+    drag = null;
+    stage.classList.remove("moving");
+    endDecalDrag(d, false, ctx);
+    return true;
+  };
   stage.addEventListener("contextmenu", (e) => { if (drag && drag.pan) e.preventDefault(); });
   stage.addEventListener("pointerdown", (e) => {
     if (e.button !== 0 && e.button !== 1) return;
@@ -141,14 +163,17 @@ export function initCamera(stage, theApi, ctx) {
     stage.focus();
     const pan = e.button === 1 || e.shiftKey;
     drag = { x: e.clientX, y: e.clientY, button: e.button, pan, from: explicitCamera(), moved: false, pivot: null };
-    if (!pan) orbitPivot(ctx).then((p) => { if (drag) drag.pivot = p; });
+    const decal = !pan && e.button === 0 && !ctx.placeTool() && decalUnder(ctx.framePixel(e));
+    if (decal) drag.decal = startDecalDrag(decal);
+    else if (!pan) orbitPivot(ctx).then((p) => { if (drag) drag.pivot = p; });
     stage.setPointerCapture(e.pointerId);
   });
   stage.addEventListener("pointermove", (e) => {
     if (!drag) { hoverAt(e, ctx); return; }
     const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
     if (!drag.moved && Math.hypot(dx, dy) < 4) return;
-    if (!drag.moved) { drag.moved = true; stage.classList.add(drag.pan ? "panning" : "orbiting"); }
+    if (!drag.moved) { drag.moved = true; stage.classList.add(drag.decal ? "moving" : drag.pan ? "panning" : "orbiting"); }
+    if (drag.decal) return moveDecal(drag.decal, ctx.framePixel(e), ctx);
     if (drag.pan) return panBy(dx, dy, ctx.displaySide(), drag.from);
     const c0 = drag.from || store.camera;
     const yaw = Math.round(geo.wrapDegrees(c0.yaw - dx * 0.5) * 10) / 10;
@@ -158,7 +183,8 @@ export function initCamera(stage, theApi, ctx) {
   const end = (e) => {
     const d = drag;
     drag = null;
-    stage.classList.remove("panning", "orbiting");
+    stage.classList.remove("panning", "orbiting", "moving");
+    if (d && d.decal) endDecalDrag(d.decal, e.type === "pointerup" && d.moved, ctx);
     if (d && !d.moved && d.button === 0 && !d.pan && e.type === "pointerup") ctx.onClick(e);
   };
   stage.addEventListener("pointerup", end);
@@ -218,9 +244,8 @@ async function pumpPick(ctx) {
     pointer.last = { px: job.px, hit: hit.hit ? hit : null };
     if (!hit.hit) setHover(null, null, ctx);
     else {
-      const p = geo.hit(store.doc.placements, hit.uv);
-      const size = ctx.brushSize();
-      setHover(p ? p.id : null, ctx.placeTool() && size ? [r4(hit.uv[0]), r4(hit.uv[1]), size[0], size[1], 0] : null, ctx);
+      const p = geo.hitPick(store.doc.placements.map(withPending), hit);
+      setHover(p ? p.id : null, ctx.placeTool() ? ctx.brushFor(hit) : null, ctx);
     }
   } catch { /* a pick that fails (scene gone, offline) only loses the hover */ }
   finally {
@@ -233,5 +258,56 @@ function setHover(pid, brush, ctx) {
   if (pid === pointer.hover && JSON.stringify(brush) === JSON.stringify(pointer.brush)) return;
   pointer.hover = pid;
   pointer.brush = brush;
+  ctx.onChange();
+}
+
+// --- dragging a surface placement over the body ------------------------------------------------
+
+/// The selected surface placement under frame pixel `px` (by the last hover pick there), or null.
+function decalUnder(px) {
+  const last = pointer.last;
+  if (!px || !last || !last.hit || Math.hypot(last.px[0] - px[0], last.px[1] - px[1]) > 3) return null;
+  if (store.pinnedRevision !== null) return null; // an old revision is shown: no edits
+  const p = pointer.hover && store.selection.includes(pointer.hover) ? placementById(pointer.hover) : null;
+  return p && p.projection === "surface" ? p.id : null;
+}
+
+function startDecalDrag(id) {
+  const orig = withPending(placementById(id));
+  return { id, orig, value: null, picking: false, wanted: null,
+           stream: new Stream((fields) => patchPlacement(id, fields, { undoable: false }), { what: `move "${orig.label || orig.id}"` }) };
+}
+
+async function moveDecal(d, px, ctx) {
+  if (!px) return;
+  d.wanted = px;
+  if (d.picking) return;
+  d.picking = true;
+  try {
+    while (d.wanted) {
+      const at = d.wanted;
+      d.wanted = null;
+      const hit = await ctx.pick(at[0], at[1]);
+      if (d.ended) return;
+      if (!hit.hit || !hit.anchor) continue; // off the body: the decal stays where it was
+      d.value = { anchor: geo.anchorNear(d.orig, hit.anchor) };
+      d.stream.send(d.value);
+      hold(d.id, d.value); // the frames preview it until the one edit is answered
+      ctx.onChange();
+    }
+  } catch (err) { ctx.onError(err); }
+  finally { d.picking = false; }
+}
+
+async function endDecalDrag(d, commit, ctx) {
+  d.ended = true;
+  if (!commit || !d.value) {
+    release(d.id);
+    await d.stream.cancel();
+    ctx.onChange();
+    return;
+  }
+  await d.stream.finish();
+  release(d.id, d.value);
   ctx.onChange();
 }

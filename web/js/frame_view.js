@@ -1,8 +1,12 @@
 // 3D view: the server's frames of the scene. The camera (orbit, pan, zoom to the cursor, frame
-// the selection, hover and brush outlines) is camera3d.js; click selects the placement under the
-// pointer (pick → UV → footprint), and with the place tool (P, or Alt+click) creates one there with
-// the suggested driver. The selection is outlined on the skin (frame `highlight`), the hovered
-// placement too (`hover`), and the place tool's brush (`brush`). View modes shaded / bump /
+// the selection, hover and brush outlines, dragging a decal) is camera3d.js; click selects the
+// placement under the pointer (pick → UV footprint or surface decal), and with the place tool (P,
+// or Alt+click) creates one there with the suggested driver: a surface placement (SPEC §8: anchor
+// from the hit, tangent across the driver's bone, a square decal the brush's diameter wide in model
+// units; [ and ] size the brush while the tool is on) or, with "Place as: in the texture", a UV
+// placement at the hit's UV. The selection is outlined on the skin (frame `highlight`), the hovered
+// placement too (`hover`), and the place tool's brush (`surface_brush`: a circle on the body, or
+// `brush`: a UV footprint). View modes shaded / bump /
 // displacement / normal; compare with a split slider, flicker, or the diff heat map against
 // "patterns off" or a chosen revision (compare images carry no outlines). The bar's Turntable
 // button shows the selection's range of motion as an animated WebP (GET turntable).
@@ -17,14 +21,16 @@ import { API, query } from "./api.js";
 import * as geo from "./geometry.js";
 import { notify } from "./notice.js";
 import { addPlacement } from "./edits.js";
-import { placementFromPattern } from "./placing.js";
+import { placementFromPattern, surfacePlacementFromPattern } from "./placing.js";
 import { trace } from "./trace.js";
 import { frameFormat } from "./frame_format.js";
-import { initCamera, noteFrameCamera, pointer, frameSelection } from "./camera3d.js";
+import { initCamera, noteFrameCamera, pointer, frameSelection, resolvedCamera } from "./camera3d.js";
 
 let api, stage, img, cmpImg, spinner, splitHandle, sizeSelect;
 let flickerTimer = null;
 let placeTool = false;
+let placeAs = "surface"; // "surface" (on the body, SPEC §8) | "uv" (in the texture)
+let brushDiameter = null; // model units; null until the first frame gives the model's scale
 const FRAME_SIZES = [384, 512, 768, 1024];
 export let frameSize = 512;
 export const frameStats = { shown: 0, requested: 0, times: [] };
@@ -106,6 +112,7 @@ export function initFrameView(section, theApi) {
         <button type="button" id="viewMore" class="morebutton" aria-expanded="false" aria-controls="viewMoreMenu" aria-label="more 3D view settings" title="More: frame size, reset camera, frame the selection, turntable">⋯</button>
         <div class="moremenu" id="viewMoreMenu" role="group" aria-label="more 3D view settings">
           <label><span class="lbl">Size</span> <select id="frameSize" aria-label="frame size" title="Frame size (pixels)">${FRAME_SIZES.map((s) => `<option>${s}</option>`).join("")}</select></label>
+          <label><span class="lbl">Place as</span> <select id="placeAs" aria-label="place as" title="What the place tool adds: a decal on the body (a surface placement: seamless, in model units) or a footprint in the texture (a UV placement)"><option value="surface">on the body</option><option value="uv">in the texture</option></select></label>
           <button type="button" id="resetCamera" title="Reset the camera (orbit about the whole character)">Reset</button>
           <button type="button" id="frameSelection" title="Frame the selection (F): centre and zoom on the selected placement's skin" disabled>Frame</button>
           <button type="button" id="turntable" title="Turntable: the selection's range of motion (θmin → θmax → θmin) while the camera turns, as an animated WebP" disabled>Turntable</button>
@@ -144,13 +151,14 @@ export function initFrameView(section, theApi) {
   $("split").oninput = (e) => { store.compare.split = +e.target.value; layoutCompare(); };
   sizeSelect.onchange = () => { frameSize = +sizeSelect.value; refresh(); };
   $("placeTool").onclick = () => setPlaceTool(!placeTool);
+  $("placeAs").onchange = (e) => { placeAs = e.target.value; pointer.brush = null; showPlaceHint(); refresh(); };
   $("resetCamera").onclick = () => set({ camera: { yaw: 0, pitch: 10, distance: null, target: null } });
   $("frameSelection").onclick = () => frameSelection(frameParams()).catch((e) => notify(`Frame: ${e.message}`, "error"));
   $("turntable").onclick = () => openTurntable();
   initMoreMenu($("viewMoreWrap"));
   initCamera(stage, api, {
     framePixel, displaySide, pick: pickAt, params: frameParams, placeTool: () => placeTool,
-    brushSize: () => (currentPattern() ? [0.08, 0.08] : null), // placementFromPattern's footprint
+    brushFor, // the brush outlined where a pick hit
     onClick: click, onChange: refresh, onError: (e) => notify(`Frame: ${e.message}`, "error"),
   });
   on("selection doc scene", () => {
@@ -202,6 +210,35 @@ export function setFrameSize(n) {
 
 export const placeToolOn = () => placeTool;
 
+/// The surface brush's diameter in model units: set by resizeBrush, else a 40th of the camera's
+/// distance when the whole body is framed (about an elbow crease on a person).
+export function brushSize() {
+  if (brushDiameter === null && resolvedCamera.distance) brushDiameter = roundSize(resolvedCamera.distance / 40);
+  return brushDiameter;
+}
+const roundSize = (x) => Number(x.toPrecision(2));
+
+/// Scales the surface brush by `factor` ([ and ] with the place tool on).
+export function resizeBrush(factor) {
+  const d = brushSize();
+  if (!d) return;
+  brushDiameter = Math.min(Math.max(roundSize(d * factor), 1e-4), 10000);
+  if (pointer.brush && pointer.brush.surface) pointer.brush = { ...pointer.brush, surface: [...pointer.brush.surface.slice(0, 6), brushDiameter] };
+  showPlaceHint();
+  refresh();
+}
+
+/// The place tool's brush at pick answer `hit`: {surface: [x, y, z, nx, ny, nz, diameter]} on the
+/// body, {uv: [u, v, su, sv, rotation]} in the texture, or null (no pattern chosen).
+function brushFor(hit) {
+  if (!currentPattern()) return null;
+  if (placeAs === "surface" && hit.anchor) {
+    const d = brushSize();
+    return d ? { surface: [...hit.anchor.position, ...hit.anchor.normal].map((x) => Math.round(x * 1e5) / 1e5).concat([d]) } : null;
+  }
+  return { uv: [Math.round(hit.uv[0] * 1e4) / 1e4, Math.round(hit.uv[1] * 1e4) / 1e4, 0.08, 0.08, 0] }; // placementFromPattern's footprint
+}
+
 export function setPlaceTool(onOff) {
   placeTool = onOff;
   if (!onOff && pointer.brush) { pointer.brush = null; refresh(); }
@@ -217,7 +254,8 @@ function showPlaceHint() {
   hint.hidden = !placeTool;
   if (!placeTool) return;
   const p = currentPattern();
-  hint.textContent = p ? `Place tool: click the model to add "${p.name || p.id}" there · P or Esc to stop`
+  const how = placeAs === "surface" && brushSize() ? ` (on the body, ${brushSize()} units wide · [ ] size)` : placeAs === "uv" ? " (in the texture)" : "";
+  hint.textContent = p ? `Place tool: click the model to add "${p.name || p.id}" there${how} · P or Esc to stop`
                        : "Place tool: choose a pattern in the library first · P or Esc to stop";
 }
 
@@ -240,7 +278,8 @@ export function frameParams(outlines = true) {
     preview: previewSource() ? JSON.stringify(previewSource()) : undefined,
     highlight: outlines && selected.length ? selected.join(",") : undefined,
     hover: outlines ? hover : undefined,
-    brush: outlines && placeTool && pointer.brush ? pointer.brush.join(",") : undefined,
+    brush: outlines && placeTool && pointer.brush && pointer.brush.uv ? pointer.brush.uv.join(",") : undefined,
+    surface_brush: outlines && placeTool && pointer.brush && pointer.brush.surface ? pointer.brush.surface.join(",") : undefined,
   };
 }
 
@@ -337,11 +376,12 @@ async function click(e) {
   try { hit = await pickAt(px[0], px[1]); } catch (err) { notify(`Pick: ${err.message}`, "error"); return; }
   if (!hit.hit) { if (!placeTool && !e.altKey) set({ selection: [] }); return; }
   if (placeTool || e.altKey) {
-    emit("place-at", { uv: hit.uv, suggested: hit.suggested });
-    await placeAt(hit.uv, hit.suggested);
+    emit("place-at", { uv: hit.uv, suggested: hit.suggested, anchor: hit.anchor });
+    if (placeAs === "surface" && hit.anchor) await placeOnBody(hit.anchor, hit.suggested);
+    else await placeAt(hit.uv, hit.suggested);
     return;
   }
-  const p = geo.hit(store.doc.placements, hit.uv);
+  const p = geo.hitPick(store.doc.placements, hit);
   if (p) set({ selection: [p.id] });
   else notify(`No placement at UV (${hit.uv[0].toFixed(3)}, ${hit.uv[1].toFixed(3)}); skin of ${hit.joints.map((j) => j.name).join(", ")}. Use the place tool (P) to add one here.`, "info");
 }
@@ -379,6 +419,19 @@ let previewSource = () => null;
 /// fn() → {placementId: fields} the frames preview (a drag in the texture view), or null.
 export function setPreviewSource(fn) { previewSource = fn; }
 export function setPatternSource(fn) { currentPattern = fn; }
+
+/// Adds a surface placement of the library's current pattern at a pick's `anchor`, the brush's
+/// diameter wide, driven by `suggested`.
+export async function placeOnBody(anchor, suggested) {
+  const pattern = currentPattern();
+  if (!pattern) return notify("Choose a pattern in the library first.", "warn");
+  const d = brushSize();
+  if (!d) return notify("The 3D view has not shown a frame yet.", "warn");
+  const body = surfacePlacementFromPattern(pattern, anchor, d);
+  if (suggested) Object.assign(body, { joint: suggested.joint, axis: suggested.axis, theta_min: suggested.theta_min, theta_max: suggested.theta_max });
+  const answer = await addPlacement(body);
+  if (answer) set({ selection: [answer.scene.placements[answer.scene.placements.length - 1].id] });
+}
 
 /// Adds a placement of the library's current pattern at `uv` driven by `suggested`.
 export async function placeAt(uv, suggested) {

@@ -91,3 +91,53 @@ export function hit(placements, uv, margin = 0) {
   for (let i = placements.length - 1; i >= 0; --i) if (inTexture(placements[i]) && inside(placements[i], uv, margin)) return placements[i];
   return undefined;
 }
+
+// --- surface placements (SPEC §8) ------------------------------------------------------------
+
+const v3dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const v3cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const v3unit = (a) => { const l = Math.hypot(...a); return l > 0 ? a.map((x) => x / l) : null; };
+
+/// The decal frame of surface placement `p` as core surfaceFrameOf makes it (bake.hpp): unit
+/// normal n, tangent made orthogonal to n and turned by `rotation` about it, b = n × t, size and
+/// depth (default max(size)/2). Null for a degenerate anchor.
+export function surfaceFrame(p) {
+  const n = v3unit(p.anchor.normal);
+  if (!n) return null;
+  const t0 = p.anchor.tangent, k = v3dot(t0, n);
+  const t1 = v3unit([t0[0] - k * n[0], t0[1] - k * n[1], t0[2] - k * n[2]]);
+  if (!t1) return null;
+  const bt = v3cross(n, t1), a = (p.rotation * Math.PI) / 180;
+  const t = v3unit(t1.map((x, i) => Math.cos(a) * x + Math.sin(a) * bt[i]));
+  const depth = typeof p.depth === "number" ? p.depth : Math.max(p.size[0], p.size[1]) / 2;
+  return { c: p.anchor.position, n, t, b: v3cross(n, t), w: p.size[0], h: p.size[1], depth };
+}
+
+/// Whether rest-surface point `position` with normal `normal` (a pick's anchor) lies in surface
+/// placement `p`'s decal (core SurfaceFrame::toPattern), shrunk by `margin` of its size.
+export function insideSurface(p, position, normal, margin = 0) {
+  const f = surfaceFrame(p);
+  if (!f || !(v3dot(normal, f.n) > 0)) return false;
+  const d = [0, 1, 2].map((i) => position[i] - f.c[i]);
+  if (Math.abs(v3dot(d, f.n)) > f.depth) return false;
+  const s = [v3dot(d, f.t) / f.w + 0.5, v3dot(d, f.b) / f.h + 0.5];
+  return s.every((x) => x >= margin && x <= 1 - margin);
+}
+
+/// The topmost placement under a pick answer (GET pick with hit: true): a UV placement whose
+/// footprint holds the pick's UV, or a surface placement whose decal holds its anchor point.
+export function hitPick(placements, pick) {
+  for (let i = placements.length - 1; i >= 0; --i) {
+    const p = placements[i];
+    if (inTexture(p) ? inside(p, pick.uv) : pick.anchor && insideSurface(p, pick.anchor.position, pick.anchor.normal)) return p;
+  }
+  return undefined;
+}
+
+/// A pick's anchor `a` for surface placement `p`: its rest position and normal, `p`'s tangent kept
+/// where it is not (nearly) along the new normal, else the pick's (across the driver's bone).
+export function anchorNear(p, a) {
+  const t = p.anchor.tangent, n = a.normal;
+  const along = Math.abs(v3dot(t, n)) / (Math.hypot(...t) || 1);
+  return { position: a.position, normal: n, tangent: along < 0.95 ? t : a.tangent };
+}

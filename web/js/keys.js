@@ -3,10 +3,11 @@
 
 import { store, set, placementById, heightmapSize } from "./store.js";
 import * as geo from "./geometry.js";
-import { removePlacements, mirrorPlacement, addPlacement, undo, redo } from "./edits.js";
+import { removePlacements, mirrorPlacement, addPlacement, patchPlacement, undo, redo } from "./edits.js";
 import { nudge } from "./pending.js";
 import { cancelDrag, dragging, viewCentreUV, zoomBy, panBy } from "./texture_view.js";
-import { setPlaceTool, placeToolOn } from "./frame_view.js";
+import { setPlaceTool, placeToolOn, resizeBrush } from "./frame_view.js";
+import { cancelDecalDrag } from "./camera3d.js";
 import { currentPattern, choosePattern } from "./panels/library.js";
 import { toggleEnabled, toggleSolo } from "./panels/placements.js";
 import { togglePlay } from "./panels/pose.js";
@@ -17,15 +18,15 @@ export const SHORTCUTS = [
   ["1 – 9", "place the library's n-th pattern at the pointer (texture view)"],
   ["click / Shift+click", "select one / add to the selection (Ctrl or Cmd+click adds too; either view, or the list)"],
   ["N / Shift+N", "select the next / previous placement"],
-  ["← ↑ → ↓", "nudge the selection one texel (Shift: 10); with nothing selected, pan the texture view (Shift: further)"],
-  ["[  ]", "rotate −5° / +5° (Shift: 15°)"],
-  ["+  −", "scale up / down 5%"],
+  ["← ↑ → ↓", "nudge the selection one texel (Shift: 10) in the texture — a placement on the body slides over the body to the texel beside its anchor; with nothing selected, pan the texture view (Shift: further)"],
+  ["[  ]", "rotate −5° / +5° (Shift: 15°); with the place tool on, the brush smaller / larger"],
+  ["+  −", "scale up / down 5% (a placement on the body: its size in model units)"],
   ["Delete", "remove the selection"],
   ["M", "mirror: add the twin on the other side"],
   ["D", "duplicate"],
   ["H", "hide / show (enabled)"],
   ["S", "solo in the 3D view"],
-  ["P", "place tool: click the model in 3D to add a placement there"],
+  ["P", "place tool: click the model in 3D to add a placement there (on the body, the brush wide; ⋯ Place as: in the texture)"],
   ["F", "frame the selection in the 3D view (drag orbits about it; Shift+drag or middle drag pans; the wheel zooms at the pointer)"],
   ["Tab", "switch texture / 3D (in the views)"],
   ["T / V / L", "go to the texture view / the 3D view / the placements list"],
@@ -48,7 +49,7 @@ export function initKeys({ fitTexture }) {
 const typing = (el) => el && (el.tagName === "INPUT" && !["range", "checkbox", "button"].includes(el.type) || el.tagName === "TEXTAREA" || el.tagName === "SELECT" || el.isContentEditable);
 
 function onKey(e, { dlg, fitTexture }) {
-  if (e.key === "Escape" && cancelDrag()) { e.preventDefault(); return; }
+  if (e.key === "Escape" && (cancelDrag() || cancelDecalDrag())) { e.preventDefault(); return; }
   if (document.querySelector("dialog[open]") || document.getElementById("signin").hidden === false) return; // dialogs keep their keys (Esc closes)
   const mod = e.ctrlKey || e.metaKey;
   if (mod && (e.key === "z" || e.key === "Z")) {
@@ -90,16 +91,23 @@ function onKey(e, { dlg, fitTexture }) {
   else if (k.startsWith("Arrow") && sel.length) {
     const step = (e.shiftKey ? 10 : 1) / heightmapSize()[0];
     const d = ARROWS[k].map((c) => c * step);
-    nudge(sel, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }), "move");
+    const uvSel = sel.filter((id) => geo.inTexture(placementById(id)));
+    if (uvSel.length) nudge(uvSel, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }), "move");
+    const onBody = sel.filter((id) => !geo.inTexture(placementById(id)));
+    if (onBody.length) nudgeOnBody(onBody, d);
   } else if (k.startsWith("Arrow") && inTextureView()) {
     const step = e.shiftKey ? 200 : 40; // css px; nothing is selected: the arrows pan
     panBy(...ARROWS[k].map((c) => c * step));
+  } else if ((k === "[" || k === "]" || k === "{" || k === "}") && placeToolOn()) {
+    resizeBrush(k === "[" || k === "{" ? 1 / 1.25 : 1.25); // the place tool's brush
   } else if ((k === "[" || k === "]" || k === "{" || k === "}") && sel.length) {
     const step = (e.shiftKey ? 15 : 5) * (k === "[" || k === "{" ? -1 : 1);
     nudge(sel, (q) => ({ rotation: geo.round4(geo.wrapDegrees(q.rotation + step)) }), "rotate");
   } else if ((k === "+" || k === "=" || k === "-" || k === "_") && sel.length) {
     const f = k === "+" || k === "=" ? 1.05 : 1 / 1.05;
-    nudge(sel, (q) => ({ scale: [geo.round4(q.scale[0] * f), geo.round4(q.scale[1] * f)] }), "scale");
+    const r6 = (x) => Math.round(x * 1e6) / 1e6; // surface sizes are model units (SPEC §8)
+    nudge(sel, (q) => (q.projection === "surface" ? { size: [r6(q.size[0] * f), r6(q.size[1] * f)] }
+                                                   : { scale: [geo.round4(q.scale[0] * f), geo.round4(q.scale[1] * f)] }), "scale");
   } else if ((k === "Delete" || k === "Backspace") && sel.length) {
     removePlacements(sel);
     set({ selection: [] });
@@ -183,7 +191,11 @@ async function duplicate(ids) {
     const p = placementById(id);
     if (!p) continue;
     const { id: _omit, ...copy } = p;
-    copy.center = [geo.round4(p.center[0] + p.scale[0] * 0.25), geo.round4(p.center[1] + p.scale[1] * 0.25)];
+    if (geo.inTexture(p)) copy.center = [geo.round4(p.center[0] + p.scale[0] * 0.25), geo.round4(p.center[1] + p.scale[1] * 0.25)];
+    else { // on the body: a quarter of its width along its tangent (within its depth of the surface)
+      const f = geo.surfaceFrame(p);
+      if (f) copy.anchor = { ...p.anchor, position: p.anchor.position.map((x, i) => Math.round((x + f.t[i] * p.size[0] * 0.25) * 1e6) / 1e6) };
+    }
     const answer = await addPlacement(copy);
     if (answer) added.push(answer.scene.placements[answer.scene.placements.length - 1].id);
   }
@@ -191,3 +203,22 @@ async function duplicate(ids) {
 }
 
 export { currentPattern };
+
+/// Slides placements on the body (SPEC §8) by `d` in the texture: each anchor goes to the body point
+/// at the texel beside its own (GET outline's anchor_uv, then pick by UV), its tangent kept; one
+/// edit each. A step off the charts leaves the placement where it is.
+async function nudgeOnBody(ids, d) {
+  for (const id of ids) {
+    const p = placementById(id);
+    try {
+      const o = await api.get(`/scenes/${store.sceneId}/placements/${encodeURIComponent(id)}/outline`);
+      if (!o.anchor_uv) continue;
+      const uv = [o.anchor_uv[0] + d[0], o.anchor_uv[1] + d[1]];
+      if (!uv.every((x) => x >= 0 && x <= 1)) continue;
+      const q = await api.get(`/scenes/${store.sceneId}/pick?u=${uv[0]}&v=${uv[1]}`);
+      if (!q.hit || !q.anchor) continue;
+      await patchPlacement(id, { anchor: geo.anchorNear(p, q.anchor) }, { what: `move "${p.label || p.id}"` });
+    } catch (err) { notify(`Move: ${err.message}`, "error"); }
+  }
+}
+

@@ -182,7 +182,7 @@ async function start() {
   initImages(api);
   initEdits(api, reloadScene);
   setKeysApi(api);
-  initTextureView($("textureView"));
+  initTextureView($("textureView"), api);
   initFrameView($("frameView"), api);
   setPatternSource(currentPattern);
   setPreviewSource(dragPreview);

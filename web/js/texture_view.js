@@ -2,7 +2,10 @@
 // generated layout), the current bump or displacement map as an optional overlay, and every
 // placement as its pattern image inside its rotated footprint, with handles on the selection (drag
 // inside: move; corners: scale, Shift keeps aspect; the round handle: rotate, Shift snaps to 15°;
-// Esc during a drag cancels it). Wheel zooms about the pointer; dragging empty space (or with the
+// Esc during a drag cancels it). A surface placement (SPEC §8) is drawn as its decal's outline in
+// the layout — every piece, across seams (surface_outlines.js) — with a cross at its anchor; a drag
+// on it slides it over the body (on release its anchor goes to the body point under the anchor's
+// texel moved by the drag: pick by UV); + − [ ] size and turn it as any selection. Wheel zooms about the pointer; dragging empty space (or with the
 // middle button) pans. Lint findings are drawn on the footprints they concern, other people's
 // selections in their colour. Labels are placed so that they never overlap (the selection's first,
 // then the hovered one, then document order; each tries a few spots around its footprint); a label
@@ -18,10 +21,12 @@ import { Stream, patchPlacement } from "./edits.js";
 import { withPending, pendingPreview, hold, release } from "./pending.js";
 import { trace } from "./trace.js";
 import { addsToSelection } from "./selection.js";
+import { initSurfaceOutlines, outlineOf, hitOutline, strokeOutline } from "./surface_outlines.js";
+import { notify } from "./notice.js";
 
 const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26, ZOOM_MIN = 0.2, ZOOM_MAX = 40;
 
-let canvas, ctx, stage, overlaySelect, zoomText;
+let api, canvas, ctx, stage, overlaySelect, zoomText;
 let zoom = 1, ox = 0, oy = 0, fitted = false; // uv → css px: x = ox + u·zoom·S
 let drag = null;  // {kind: move|scale|rotate|pan, id, start, orig, value, stream, corner}
 let hover = null; // id under the pointer
@@ -40,7 +45,9 @@ const pxToUV = (px) => px / (zoom * S());
 /// gesture's edit on its way) on top.
 const shown = withPending;
 
-export function initTextureView(section) {
+export function initTextureView(section, theApi) {
+  api = theApi;
+  initSurfaceOutlines(theApi, () => redraw());
   section.innerHTML = `
     <div class="viewbar">
       <span class="title">Texture</span>
@@ -158,11 +165,12 @@ function draw() {
     drawFootprint(p, { selected, dim, lint: lintBy.get(p.id) || [], hover: hover === p.id });
   }
   drawLabels(dims, w, h);
+  for (const p of store.doc.placements) if (!geo.inTexture(p)) drawSurfaceOutline(p, soloed);
   // Other people's selections, in their colour.
   for (const [client, who] of store.presence) {
     for (const id of who.selection || []) {
       const p = placementById(id);
-      if (!p) continue;
+      if (!p || !geo.inTexture(p)) continue;
       outline(p, who.color || "#f0f", 3, [6, 4]);
       const [x, y] = toScreen(geo.toUV(p, [0, 1]));
       ctx.fillStyle = who.color || "#f0f";
@@ -170,7 +178,29 @@ function draw() {
     }
   }
   const prim = store.selection.length ? placementById(store.selection[0]) : null;
-  if (prim) drawHandles(shown(prim));
+  if (prim && geo.inTexture(prim)) drawHandles(shown(prim));
+}
+
+/// A surface placement's decal outline (all pieces), a cross at its anchor and its label there.
+function drawSurfaceOutline(p, soloed) {
+  const selected = store.selection.includes(p.id), hovered = hover === p.id;
+  const off = drag && drag.kind === "smove" && drag.id === p.id ? drag.delta : [0, 0];
+  ctx.globalAlpha = !p.enabled || (soloed.size && !soloed.has(p.id)) ? 0.35 : 1;
+  ctx.strokeStyle = selected ? "#ffffff" : hovered ? "#c8e1ff" : targetColor(p);
+  ctx.lineWidth = selected || hovered ? 2 : 1.4;
+  ctx.setLineDash(p.enabled ? [] : [4, 3]);
+  const o = strokeOutline(ctx, p, toScreen, off);
+  ctx.setLineDash([]);
+  if (o && o.anchor_uv) {
+    const [x, y] = toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]]);
+    ctx.beginPath();
+    ctx.moveTo(x - 4, y); ctx.lineTo(x + 4, y); ctx.moveTo(x, y - 4); ctx.lineTo(x, y + 4);
+    ctx.stroke();
+    ctx.font = LABEL_FONT;
+    ctx.fillStyle = ctx.strokeStyle;
+    ctx.fillText(p.label || p.id, x + 6, y - 6);
+  }
+  ctx.globalAlpha = 1;
 }
 
 function outline(p, color, width, dash = []) {
@@ -257,7 +287,7 @@ function obstacles() {
   const box = (x0, y0, x1, y1) => boxes.push({ obstacle: true, x: Math.min(x0, x1), y: Math.min(y0, y1), w: Math.abs(x1 - x0), h: Math.abs(y1 - y0) });
   const r = HANDLE_PX / 2 + 1;
   const prim = store.selection.length ? placementById(store.selection[0]) : null;
-  if (prim) {
+  if (prim && geo.inTexture(prim)) {
     const hp = handlePoints(shown(prim));
     for (const [x, y] of hp.corners) box(x - r, y - r, x + r, y + r);
     box(hp.rotate[0] - r - 1, hp.rotate[1] - r - 1, hp.rotate[0] + r + 1, hp.rotate[1] + r + 1);
@@ -333,14 +363,16 @@ function drawHandles(p) {
 /// selection's handles, {kind: move, id} on a footprint, or null.
 function under(x, y) {
   const prim = store.selection.length ? placementById(store.selection[0]) : null;
-  if (prim) {
+  if (prim && geo.inTexture(prim)) {
     const hp = handlePoints(shown(prim));
     const near = (pt, r) => Math.hypot(pt[0] - x, pt[1] - y) <= r;
     if (near(hp.rotate, HANDLE_PX)) return { kind: "rotate", id: prim.id };
     for (let k = 0; k < 4; ++k) if (near(hp.corners[k], HANDLE_PX)) return { kind: "scale", id: prim.id, corner: k };
   }
   const p = geo.hit(store.doc.placements.map(shown), toUV(x, y));
-  return p ? { kind: "move", id: p.id } : null;
+  if (p) return { kind: "move", id: p.id };
+  const q = hitOutline(store.doc.placements, toUV(x, y), pxToUV(3));
+  return q ? { kind: "smove", id: q.id } : null;
 }
 
 function local(e) {
@@ -371,7 +403,7 @@ function pointerDown(e) {
     capture(e);
     return;
   }
-  if (what.kind === "move") {
+  if (what.kind === "move" || what.kind === "smove") {
     if (addsToSelection(e)) {
       const sel = store.selection.includes(what.id) ? store.selection.filter((i) => i !== what.id) : [what.id, ...store.selection];
       set({ selection: sel });
@@ -381,6 +413,11 @@ function pointerDown(e) {
     if (store.selection.length !== 1 || store.selection[0] !== what.id) set({ selection: [what.id] });
   }
   if (store.pinnedRevision !== null) return; // an old revision is shown: no edits until the person leaves it
+  if (what.kind === "smove") {
+    drag = { kind: "smove", id: what.id, start: uv, delta: [0, 0] };
+    capture(e);
+    return;
+  }
   const orig = withPending(placementById(what.id));
   const verb = { move: "move", scale: "scale", rotate: "rotate" }[what.kind];
   drag = { ...what, start: uv, orig, value: null,
@@ -396,9 +433,9 @@ function pointerMove(e) {
   if (!drag) {
     const what = store.doc ? under(x, y) : null;
     const id = what ? what.id : null;
-    canvas.style.cursor = !what ? "crosshair" : what.kind === "move" ? "move" : what.kind === "rotate" ? "alias" : "nwse-resize";
+    canvas.style.cursor = !what ? "crosshair" : what.kind === "move" || what.kind === "smove" ? "move" : what.kind === "rotate" ? "alias" : "nwse-resize";
     if (id !== hover) { hover = id; redraw(); }
-    if (what && what.kind === "move") {
+    if (what && (what.kind === "move" || what.kind === "smove")) {
       const lint = store.lint.filter((f) => f.placement === what.id).map((f) => f.message);
       canvas.title = [what.id, ...lint].join("\n");
     } else canvas.title = "";
@@ -407,6 +444,11 @@ function pointerMove(e) {
   if (drag.kind === "pan") {
     ox = drag.orig[0] + x - drag.start[0];
     oy = drag.orig[1] + y - drag.start[1];
+    redraw();
+    return;
+  }
+  if (drag.kind === "smove") {
+    drag.delta = [uv[0] - drag.start[0], uv[1] - drag.start[1]];
     redraw();
     return;
   }
@@ -426,6 +468,7 @@ async function pointerUp(e) {
   const d = drag;
   drag = null;
   if (d.kind === "pan") return;
+  if (d.kind === "smove") { await slideOnBody(d); return; }
   if (!d.value) { d.stream.done = true; d.stream.end(); return; }
   await d.stream.finish(); // one edit: the gesture's last value
   release(d.id, d.value);
@@ -435,12 +478,28 @@ async function pointerUp(e) {
 /// Cancels a running drag: restores the placement (see Stream.cancel). True when one ran.
 export function cancelDrag() {
   if (!drag || drag.kind === "pan") return false;
+  if (drag.kind === "smove") { drag = null; redraw(); return true; }
   const d = drag;
   drag = null;
   release(d.id);
   d.stream.cancel().then(redraw);
   redraw();
   return true;
+}
+
+/// Ends a drag of surface placement d.id by d.delta UV: its anchor goes to the body point at its
+/// anchor's texel moved by the drag (pick by UV), its tangent kept; one edit, one undo step. Off
+/// the charts it stays where it was (and says so).
+async function slideOnBody(d) {
+  const p = placementById(d.id);
+  const o = p && outlineOf(p);
+  if (!p || !o || !o.anchor_uv || Math.hypot(...d.delta) < 1e-6) { redraw(); return; }
+  const uv = [o.anchor_uv[0] + d.delta[0], o.anchor_uv[1] + d.delta[1]];
+  try {
+    const hit = uv.every((x) => x >= 0 && x <= 1) ? await api.get(`/scenes/${store.sceneId}/pick?u=${uv[0]}&v=${uv[1]}`) : { hit: false };
+    if (!hit.hit || !hit.anchor) notify(`"${p.label || p.id}" stays: no body under that point of the layout.`, "warn");
+    else await patchPlacement(d.id, { anchor: geo.anchorNear(p, hit.anchor) }, { what: `move "${p.label || p.id}"` });
+  } finally { redraw(); }
 }
 
 function wheel(e) {
@@ -480,6 +539,11 @@ export function screenGeometry(id) {
   const p = shown(p0);
   const r = canvas.getBoundingClientRect();
   const abs = ([x, y]) => [r.left + x, r.top + y];
+  if (!geo.inTexture(p)) { // a surface placement: its anchor's texel and its pieces' bounds
+    const o = outlineOf(p0);
+    return o && o.anchor_uv ? { center: abs(toScreen(o.anchor_uv)), bounds: (o.bounds || []).map((b) => [...abs(toScreen([b[0], b[1]])), ...abs(toScreen([b[2], b[3]]))]),
+                                segments: o.segments.length, pxPerUV: zoom * S(), uvAt: (x, y) => toUV(x - r.left, y - r.top) } : null;
+  }
   const hp = handlePoints(p);
   return { center: abs(toScreen(p.center)), corners: hp.corners.map(abs), rotate: abs(hp.rotate),
            pxPerUV: zoom * S(), uvAt: (x, y) => toUV(x - r.left, y - r.top) };

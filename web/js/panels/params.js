@@ -54,6 +54,7 @@ function render() {
     return;
   }
   const joints = store.model ? store.model.joints.map((j) => j.name) : [];
+  const onBody = p.projection === "surface"; // a surface placement (SPEC §8): size and depth in model units
   box.innerHTML = `
     <div class="params">
       ${field("Label", `<input type="text" id="pLabel" maxlength="120" value="${escapeHtml(p.label || "")}" aria-label="label">`)}
@@ -65,8 +66,10 @@ function render() {
       ${field("Model", `<select id="pModel" aria-label="deformation model">${opt(["scale", "bias"], p.model)}</select>`)}
       ${field("Target", `<select id="pTarget" aria-label="target map">${opt(["bump", "displacement"], p.target)}</select>`)}
       ${field("Response", `<select id="pResponse" aria-label="response">${opt(["log2", "ln", "linear", "smoothstep"], p.response)}</select>`)}
-      ${field("Centre", `<span class="pair"><input type="number" id="pU" step="0.001" value="${p.center[0]}" aria-label="centre u"><input type="number" id="pV" step="0.001" value="${p.center[1]}" aria-label="centre v"></span>`)}
-      ${field("Scale", `<span class="pair"><input type="number" id="pSX" step="0.005" value="${p.scale[0]}" aria-label="scale u"><input type="number" id="pSY" step="0.005" value="${p.scale[1]}" aria-label="scale v"></span>`)}
+      ${onBody ? field("Size", `<span class="pair"><input type="number" id="pSX" step="any" min="0" value="${p.size[0]}" aria-label="width (model units)" title="width along the tangent, model units"><input type="number" id="pSY" step="any" min="0" value="${p.size[1]}" aria-label="height (model units)" title="height, model units"></span>`)
+                 + field("Depth", `<input type="number" id="pDepth" step="any" min="0" value="${typeof p.depth === "number" ? p.depth : ""}" placeholder="auto" aria-label="depth (model units; empty: auto)" title="how far from the anchor's tangent plane the decal reaches, model units (empty: auto = half the larger size)">`)
+               : field("Centre", `<span class="pair"><input type="number" id="pU" step="0.001" value="${p.center[0]}" aria-label="centre u"><input type="number" id="pV" step="0.001" value="${p.center[1]}" aria-label="centre v"></span>`)
+                 + field("Scale", `<span class="pair"><input type="number" id="pSX" step="0.005" value="${p.scale[0]}" aria-label="scale u"><input type="number" id="pSY" step="0.005" value="${p.scale[1]}" aria-label="scale v"></span>`)}
       ${field("Rotation", `<input type="number" id="pRot" step="1" value="${p.rotation}" aria-label="rotation (degrees)">`)}
       ${field("Enabled", `<input type="checkbox" id="pEnabled"${p.enabled ? " checked" : ""} aria-label="enabled">`)}
       <div class="wide live"><canvas class="dial" id="dial" width="176" height="176" aria-label="current joint angle"></canvas>
@@ -95,8 +98,13 @@ function render() {
   $("pResponse").onchange = (e) => send({ response: e.target.value });
   $("pEnabled").onchange = (e) => send({ enabled: e.target.checked });
   const pairSend = (a, b, key) => () => { const x = num($(a)), y = num($(b)); if (x !== null && y !== null) send({ [key]: [x, y] }); };
-  $("pU").onchange = $("pV").onchange = pairSend("pU", "pV", "center");
-  $("pSX").onchange = $("pSY").onchange = pairSend("pSX", "pSY", "scale");
+  if (onBody) {
+    $("pSX").onchange = $("pSY").onchange = pairSend("pSX", "pSY", "size");
+    $("pDepth").onchange = (e) => { const v = num(e.target); send({ depth: e.target.value === "" ? "auto" : v }); };
+  } else {
+    $("pU").onchange = $("pV").onchange = pairSend("pU", "pV", "center");
+    $("pSX").onchange = $("pSY").onchange = pairSend("pSX", "pSY", "scale");
+  }
   $("goMin").onclick = () => goToPose(cur(), cur().theta_min);
   $("goMax").onclick = () => goToPose(cur(), cur().theta_max);
   $("clearPose").onclick = () => patchPose({ joints: { [cur().joint]: null } });
@@ -111,11 +119,14 @@ let shownId = null;
 /// being typed in keeps its text unless `all`); another placement, or a vanished one, renders anew.
 function refreshValues(all) {
   const p = primary();
-  if (!p || p.id !== shownId || !box.querySelector("#pH")) { render(); return; }
+  const onBody = p && p.projection === "surface";
+  if (!p || p.id !== shownId || !box.querySelector("#pH") || onBody !== !!box.querySelector("#pDepth")) { render(); return; }
   const set = (id, v) => { const el = box.querySelector("#" + id); if (el && (all || el !== document.activeElement)) el.value = String(v); };
   set("pLabel", p.label || ""); set("pPattern", p.pattern); set("pJoint", p.joint); set("pAxis", p.axis);
   set("pMin", p.theta_min); set("pMax", p.theta_max); set("pH", p.h); set("pModel", p.model); set("pTarget", p.target);
-  set("pResponse", p.response); set("pU", p.center[0]); set("pV", p.center[1]); set("pSX", p.scale[0]); set("pSY", p.scale[1]);
+  set("pResponse", p.response);
+  if (onBody) { set("pSX", p.size[0]); set("pSY", p.size[1]); set("pDepth", typeof p.depth === "number" ? p.depth : ""); }
+  else { set("pU", p.center[0]); set("pV", p.center[1]); set("pSX", p.scale[0]); set("pSY", p.scale[1]); }
   set("pRot", p.rotation);
   const en = box.querySelector("#pEnabled");
   if (en) en.checked = p.enabled;
