@@ -90,6 +90,8 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.ok(menu.left + menu.width <= 1280 && menu.top >= stage.top - 40, "the menu opens under the bar, inside the window");
       await screenshot(page, "editor-3d-more.png");
       await page.keyboard.press("Tab");
+      assert.equal(await page.evaluate(() => document.activeElement.id), "placeAs", "Tab reaches Place as");
+      await page.keyboard.press("Tab");
       assert.equal(await page.evaluate(() => document.activeElement.id), "resetCamera", "Tab reaches Reset");
       await page.evaluate(() => window.dermisEditor.store.camera.yaw = 77);
       await page.keyboard.press("Enter");
@@ -103,8 +105,8 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       // ↓ opens it too; Tab past its last control closes it.
       await page.keyboard.press("ArrowDown");
       assert.equal(await page.evaluate(() => document.activeElement.id), "frameSize");
-      await page.keyboard.press("Tab");
-      await page.keyboard.press("Tab");
+      for (let i = 0; i < 6 && await page.evaluate(() => !!document.activeElement.closest("#viewMoreMenu")); ++i) await page.keyboard.press("Tab");
+      assert.equal(await page.evaluate(() => !!document.activeElement.closest("#viewMoreMenu")), false, "Tab leaves the menu");
       assert.equal(await page.$eval("#viewMore", (b) => b.getAttribute("aria-expanded")), "false", "leaving the menu closes it");
       const wide = await openEditor(context, sceneUrl, { width: 1920, height: 1080 });
       assert.equal(await visible(wide, "#viewMore"), false, "no ⋯ where the bar has room");
