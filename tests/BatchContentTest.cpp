@@ -4,7 +4,8 @@
 // the bytes it renders, and the content cache then serves the same addresses without bytes; bytes
 // that do not match their address, malformed addresses and mixed roles are refused; uploads with
 // the same SHA-256 count; a small cache forgets (LRU) and frees the GPU copies; stored scenes never
-// name content by address. Plus ContentCache itself.
+// name content by address; a cached model keeps its rest-surface map across batches. Plus
+// ContentCache itself.
 #include "ServiceFixture.hpp"
 
 #include "io/sha256.hpp"
@@ -98,6 +99,31 @@ TEST_F(BatchContentTest, WhatIsLackingIsListedThenSentThenCached) {
     ASSERT_FALSE(m);
     EXPECT_EQ(m.error().missing, std::vector<std::string>{addressOf(other)});
     EXPECT_EQ(m.error().field, "/scene/patterns/mine");
+}
+
+// A surface placement (SPEC §8) needs the model's rest-surface map: baked once for the cached
+// model and kept with it (its derived data rides in the content cache), not once per batch or per
+// posed frame.
+TEST_F(BatchContentTest, ACachedModelKeepsItsRestSurfaceMapAcrossBatches) {
+    json doc = scene();
+    doc["placements"][0] = {{"id", "decal"}, {"pattern", "mine"}, {"joint", "leg_joint_L_2"}, {"axis", "y"},
+                            {"theta_min", -360}, {"theta_max", -359}, {"projection", "surface"},
+                            {"anchor", {{"position", {0.1, 0.0, 0.5}}, {"normal", {0, 0, 1}}, {"tangent", {1, 0, 0}}}},
+                            {"size", {0.1, 0.1}}};
+    json b = body(doc);
+    b["frames"].push_back({{"pose", {{"joints", {{"leg_joint_L_2", {{"axis_angles", {{"y", 30}}}}}}}}}});
+    b["frames"].push_back({{"pose", {{"joints", {{"leg_joint_L_2", {{"axis_angles", {{"y", 60}}}}}}}}}});
+    auto first = svc_->batch(b, both());
+    ASSERT_TRUE(first) << first.error().message;
+    ASSERT_EQ(first->frames, 4u);
+    renderAll(*first);
+    EXPECT_EQ(cacheStats()["rest_surface_builds"], 1) << "one rest map for four frames, two of them posed";
+    for (int k = 0; k < 2; ++k) { // by address from the cache, and with the bytes sent again
+        auto again = k == 0 ? svc_->batch(b) : svc_->batch(b, both());
+        ASSERT_TRUE(again) << again.error().message;
+        renderAll(*again);
+    }
+    EXPECT_EQ(cacheStats()["rest_surface_builds"], 1) << "the next batches bake none";
 }
 
 TEST_F(BatchContentTest, PartsMustMatchTheirAddressAndAddressesMustBeWellFormed) {

@@ -55,6 +55,8 @@ ContentCache::Stats ContentCache::stats() const {
     s.misses = misses_;
     s.insertions = insertions_;
     s.evictions = evictions_;
+    for (const auto& [address, e] : entries_)
+        if (e.item.derived) s.restSurfaceBuilds += static_cast<std::uint64_t>(e.item.derived->restSurfaceBuilds());
     return s;
 }
 

@@ -12,6 +12,7 @@
 
 #include "core/heightmap.hpp"
 #include "core/model.hpp"
+#include "core/model_derived.hpp"
 
 #include <cstddef>
 #include <cstdint>
@@ -26,14 +27,19 @@ namespace dermis {
 
 class ContentCache {
 public:
-    /// A cached item: one of `model` / `pattern` is set.
+    /// A cached item: one of `model` / `pattern` is set. A model comes with its derived data
+    /// (its generated layout, rest-surface maps, UV index…: built on first use and kept with the
+    /// model, so that the next batch naming it bakes none of them again).
     struct Item {
         std::shared_ptr<const Model> model;
         std::shared_ptr<const PatternImage> pattern;
+        std::shared_ptr<const ModelDerived> derived; ///< with `model`
     };
     struct Stats {
         std::size_t entries = 0, bytes = 0, budget = 0;
         std::uint64_t hits = 0, misses = 0, insertions = 0, evictions = 0;
+        /// Rest-surface maps baked for the cached models so far (their derived data's count).
+        std::uint64_t restSurfaceBuilds = 0;
     };
 
     /// `budgetBytes` 0 keeps nothing (every put is evicted at once).

@@ -208,12 +208,16 @@ Service::State::Snapshot Service::State::snapshotOf(const Scene& scene, std::sha
     for (const Placement& p : snap.scene.placements)
         if (auto img = find(p.pattern)) snap.images.emplace(p.pattern, std::move(img));
     if (snap.scene.heightmapBase) snap.base = find(*snap.scene.heightmapBase);
-    // The model's derived data (layout, rest maps, UV index…): its entry's, built once per model.
+    // The model's derived data (layout, rest maps, UV index…): its entry's, built once per model;
+    // for a batch's content-addressed model the one the content cache keeps with it.
     if (auto entry = models.find(scene.model);
         entry != models.end() && entry->second.model == snap.model && entry->second.derived)
         snap.derived = entry->second.derived->get(snap.model);
-    else
-        snap.derived = std::make_shared<const ModelDerived>(snap.model);
+    if (!snap.derived && overlay)
+        for (const auto& [address, m] : overlay->models)
+            if (m == snap.model)
+                if (auto d = overlay->derived.find(address); d != overlay->derived.end() && d->second) snap.derived = d->second;
+    if (!snap.derived) snap.derived = std::make_shared<const ModelDerived>(snap.model);
     return snap;
 }
 
@@ -378,7 +382,7 @@ json Service::info() const {
     const ContentCache::Stats c = state_->content->stats();
     out["content_cache"] = {{"entries", c.entries},       {"bytes", c.bytes},       {"budget_bytes", c.budget},
                             {"hits", c.hits},             {"misses", c.misses},     {"insertions", c.insertions},
-                            {"evictions", c.evictions}};
+                            {"evictions", c.evictions}, {"rest_surface_builds", c.restSurfaceBuilds}};
     return out;
 }
 

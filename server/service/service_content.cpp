@@ -84,6 +84,7 @@ Result<ContentOverlay> Service::State::resolveContent(
     ContentOverlay out;
     const auto hold = [&](const std::string& address, const ContentCache::Item& item) {
         if (item.model) out.models[address] = item.model;
+        if (item.model && item.derived) out.derived[address] = item.derived;
         if (item.pattern) out.images[address] = item.pattern;
     };
 
@@ -120,6 +121,7 @@ Result<ContentOverlay> Service::State::resolveContent(
             }
             cost = ContentCache::approxBytes(*model);
             item.model = std::make_shared<const Model>(std::move(*model));
+            item.derived = std::make_shared<const ModelDerived>(item.model);
         } else {
             auto img = decodePatternBytes(bytes, limits, kWhere, address, decodeBudget.get());
             if (!img) {
@@ -150,7 +152,10 @@ Result<ContentOverlay> Service::State::resolveContent(
             const std::string hex = address.substr(std::char_traits<char>::length(kPrefix));
             if (ref->role == Role::Model) {
                 for (const auto& [id, e] : models)
-                    if (e.sha256 == hex) item.model = e.model;
+                    if (e.sha256 == hex) {
+                        item.model = e.model;
+                        if (e.derived) item.derived = e.derived->get(e.model);
+                    }
             } else {
                 for (const auto& [id, e] : patterns)
                     if (e.sha256 == hex)

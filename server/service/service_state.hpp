@@ -62,6 +62,9 @@ struct PatternEntry {
 /// pointers keeps the content alive for the request even if the cache lets it go.
 struct ContentOverlay {
     std::map<std::string, std::shared_ptr<const Model>> models;
+    /// The derived data of `models` (by the same address), where the content cache or a stored
+    /// upload keeps one: snapshots of the model share it instead of baking their own.
+    std::map<std::string, std::shared_ptr<const ModelDerived>> derived;
     PatternImages images;
     bool empty() const { return models.empty() && images.empty(); }
 };
