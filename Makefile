@@ -38,7 +38,7 @@ test-asan: deps
 
 # libFuzzer targets (tests/fuzz: glTF loader, image decoders, scene documents) under ASan + UBSan,
 # in a clang build tree of their own, FUZZ_SECONDS each; fails on any crash, leak or timeout
-# (inputs in $(FUZZ_BUILD)/artifacts). See README "Fuzzing".
+# (inputs in $(FUZZ_BUILD)/artifacts). See docs/reliability.md "Fuzzing".
 fuzz: deps
 	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DDERMIS_FUZZ=ON -DDERMIS_BUILD_TESTS=OFF -DDERMIS_BUILD_BENCHMARKS=OFF $(CMAKE_FLAGS)

@@ -141,7 +141,7 @@ int runServe(ServeArgs a) {
     using namespace dermis;
     if (a.token.empty())
         if (const char* env = std::getenv("DERMIS_TOKEN")) a.token = env;
-    // A short token is guessed quickly even at the throttled rate (README "Reliability").
+    // A short token is guessed quickly even at the throttled rate (docs/reliability.md).
     if (!a.token.empty() && a.token.size() < 16)
         std::cerr << "dermis-server: warning: the token is " << a.token.size()
                   << " characters; use at least 16 random ones (e.g. `openssl rand -hex 16`)\n";

@@ -3,7 +3,7 @@
 // packed into [0,1]² with gutters for bilinear sampling and mip levels at near-uniform texel
 // density. Deterministic: the same model data gives a bit-identical layout.
 //
-// How (README "Generated height-map layout"; layout_gen_internal.hpp has the steps):
+// How (docs/benchmarks.md "Generated height-map layout"; layout_gen_internal.hpp has the steps):
 //   1. per part, vertices welded by bit-equal position; an edge is a chart boundary where it is a
 //      border, non-manifold or inconsistently oriented, where the model's own UVs differ on its
 //      two sides (a UV seam; only where both sides have a UV area, not a palette swatch), where the dihedral angle exceeds creaseDegrees, or next to a

@@ -93,7 +93,7 @@ struct Placement {
 /// Longest placement label, in bytes.
 constexpr std::size_t kMaxLabelLength = 120;
 
-// Ranges of the scene document's numbers (README "Scene documents"; schemas/scene.json agrees).
+// Ranges of the scene document's numbers (docs/scenes.md "Scene documents"; schemas/scene.json agrees).
 // parseScene rejects anything outside with InvalidArgument naming the field; the bounds keep every
 // sum finite: a texel's height is at most kMaxPlacements·h·|L| ≤ 256·100·1 (L = response ∈ [−1, 1]
 // times a pattern value in [−1, 1]), so 1e39 can no longer fill a map with inf.

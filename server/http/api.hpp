@@ -32,7 +32,7 @@ struct ApiOptions {
     /// Event streams one peer address may hold at once; 0: half the streams (so one client can
     /// never take them all). Behind a proxy every stream comes from its address: raise it there.
     int maxStreamsPerAddress = 0;
-    /// Connections (README "Reliability"): one thread each, at most maxConnections at once and
+    /// Connections (docs/reliability.md): one thread each, at most maxConnections at once and
     /// maxConnectionsPerAddress per peer address; a request head must arrive within headSeconds.
     int maxConnections = 1024;
     int maxConnectionsPerAddress = 256;
@@ -43,7 +43,7 @@ struct ApiOptions {
     int maxSessions = 256; ///< browser sessions kept at once; the oldest is forgotten beyond
     int sessionMaxAgeSeconds = 12 * 3600; ///< a session's lifetime (and its cookie's Max-Age)
     /// Failed sign-ins (a wrong bearer token or session cookie, a wrong token on POST /session)
-    /// an address may make before it must wait between attempts (README "Reliability").
+    /// an address may make before it must wait between attempts (docs/reliability.md).
     int authFreeFailures = 10;
 };
 

@@ -23,7 +23,7 @@ namespace dermis {
 constexpr int kMaxWebpSide = 16383;
 
 /// Encodes a frame as lossless WebP with the fastest lossless preset (level 0: no backward-
-/// reference search beyond the basic one; ≈ PNG's size at a similar speed, see README
+/// reference search beyond the basic one; ≈ PNG's size at a similar speed, see docs/benchmarks.md
 /// "Encoders"). keepAlpha = false stores every pixel as opaque (alpha dropped, as encodePng's
 /// keepAlpha = false); RGB are stored as is either way.
 Result<std::vector<std::uint8_t>> encodeWebpLossless(const Image8& img, bool keepAlpha = true);

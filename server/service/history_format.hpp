@@ -32,7 +32,7 @@ struct RevisionInfo {
 
 /// Most revisions in one chunk: a read replays at most kChunkRevisions − 1 patches. 256 keeps a
 /// one-placement edit of a 1,000-placement scene (262 KB snapshot) near 1.2 KB on disk, the
-/// snapshot's share included (README "Scene documents"). Readers rely on it: the chunk holding
+/// snapshot's share included (docs/scenes.md "Scene documents"). Readers rely on it: the chunk holding
 /// revision R starts at most kChunkRevisions − 1 revisions before R.
 inline constexpr std::uint64_t kChunkRevisions = 256;
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# NginxProxyHttpTest — docker/nginx.conf in front of dermis-server (README "Reliability"): nginx
+# NginxProxyHttpTest — docker/nginx.conf in front of dermis-server (docs/reliability.md): nginx
 # in the foreground with a temporary prefix, the config's ports and body size replaced; a frame
 # and an event stream's first event pass through, a body over client_max_body_size is answered
 # 413 by nginx in the API's error shape. Usage: nginx_proxy.test.sh DERMIS_SERVER NGINX_CONF

@@ -1,5 +1,5 @@
 // Which image format the 3D view asks frames in (the frame route's `format`): the fastest one
-// that this browser can show, from the encode times dermis-bench measures (README "Encoders",
+// that this browser can show, from the encode times dermis-bench measures (docs/benchmarks.md "Encoders",
 // 512² frame on the 2-core reference machine).
 //
 // While a gesture runs (a drag, a slider) frames are previews: JPEG (quality 90), 4–15× faster
