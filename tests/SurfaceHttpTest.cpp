@@ -3,13 +3,19 @@
 // picked pixel (frame-diff against patterns=off); PATCHing its anchor to another pick moves the
 // change; the canonical document echoes projection / anchor / size / depth and uv_layout; the
 // probe, lint, maps and the batch route take it; the outline route draws it (and a UV placement's
-// rectangle) in the layout in use; on CesiumMan the same; on RiggedFigure (no UVs) uv_layout
-// "model" refuses it with a clear error naming /uv_layout.
+// rectangle) in the layout in use; on CesiumMan the same, and a decal across a seam of its own
+// UVs shows no cut (one lit region, heights on both charts, the generated layout's frame: issue
+// #22's acceptance); on RiggedFigure (no UVs) uv_layout "model" refuses it with a clear error
+// naming /uv_layout.
 #include "HttpTestFixture.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 using namespace dermis;
 using namespace dermis::test;
@@ -62,6 +68,40 @@ protected:
                     l.y1 = std::max(l.y1, y);
                 }
         return l;
+    }
+
+    /// Per-channel differences of two frames of the same size (RGBA bytes): mean and largest |d|,
+    /// how many channels differ by more than 24 of 255, and how many pixels have a colour channel
+    /// more than 8 off.
+    struct Gap {
+        bool compared = false;
+        double mean = 0;
+        int worst = 0;
+        long far = 0;
+        long pixelsOff8 = 0;
+    };
+    static Gap gapOf(const Reply& one, const Reply& other) {
+        Gap g;
+        auto a = decodeFrame(one.bytes()), b = decodeFrame(other.bytes());
+        EXPECT_TRUE(a && b);
+        if (!a || !b) return g;
+        EXPECT_EQ(a->rgba.size(), b->rgba.size());
+        if (a->rgba.size() != b->rgba.size() || a->rgba.empty()) return g;
+        double sum = 0;
+        for (std::size_t k = 0; k < a->rgba.size(); ++k) {
+            const int d = std::abs(int(a->rgba[k]) - int(b->rgba[k]));
+            sum += d;
+            g.worst = std::max(g.worst, d);
+            g.far += d > 24;
+            if (k % 4 == 3) {
+                int colour = 0;
+                for (std::size_t c = k - 3; c < k; ++c) colour = std::max(colour, std::abs(int(a->rgba[c]) - int(b->rgba[c])));
+                g.pixelsOff8 += colour > 8;
+            }
+        }
+        g.mean = sum / double(a->rgba.size());
+        g.compared = true;
+        return g;
     }
 
     /// The first pixel of a scan (centre column outwards, `rows`) that hits the body: its pick.
@@ -330,24 +370,13 @@ TEST_F(SurfaceHttpTest, CesiumManTakesASurfacePlacement) {
     ASSERT_EQ(h.put(s, doc).status, 200);
     Reply gen = h.get(s + "/frame?format=png");
     ASSERT_EQ(gen.status, 200);
-    auto a = decodeFrame(own.bytes()), b = decodeFrame(gen.bytes());
-    ASSERT_TRUE(a && b);
-    ASSERT_EQ(a->rgba.size(), b->rgba.size());
-    double sum = 0;
-    int worst = 0;
-    long far = 0;
-    for (std::size_t k = 0; k < a->rgba.size(); ++k) {
-        const int d = std::abs(int(a->rgba[k]) - int(b->rgba[k]));
-        sum += d;
-        worst = std::max(worst, d);
-        far += d > 24;
-    }
-    const double mean = sum / double(a->rgba.size());
-    std::printf("CesiumMan decal, model vs generated layout: mean |d| %.4f, max %d, %ld channels > 24\n", mean, worst,
-                far);
-    EXPECT_LT(mean, 0.05);  // seen: 0.0008
-    EXPECT_LE(worst, 8);    // seen: 2 (of 255)
-    EXPECT_EQ(far, 0);
+    const Gap gap = gapOf(own, gen);
+    ASSERT_TRUE(gap.compared);
+    std::printf("CesiumMan decal, model vs generated layout: mean |d| %.4f, max %d, %ld channels > 24\n", gap.mean,
+                gap.worst, gap.far);
+    EXPECT_LT(gap.mean, 0.05); // seen: 0.0008
+    EXPECT_LE(gap.worst, 8);   // seen: 2 (of 255)
+    EXPECT_EQ(gap.far, 0);
     ASSERT_EQ(h.del(s).status, 204);
 }
 
@@ -481,4 +510,224 @@ TEST_F(SurfaceHttpTest, SelectedDecalAndSurfaceBrushAreOutlinedWhereTheyAre) {
         EXPECT_EQ(r.status, 422) << bad << ": " << r;
         EXPECT_EQ(r.js()["error"]["field"], "surface_brush") << bad;
     }
+}
+
+// Issue #22's acceptance: "On CesiumMan: a surface placement across a seam of the model's layout
+// shows no cut." In CesiumMan's own UVs (uv_layout "model") a scan of the frame finds a pick where
+// a surface decal visibly straddles a seam: its outline has two pieces or more, two neighbouring
+// pixels inside it see one stretch of surface (close in 3D, alike normals) whose UVs jump (a
+// seam), and either side shows a good part of the decal. There the probe finds the decal's height
+// on both charts; its change of the frame (frame-diff against off) is one 8-connected region
+// around the picked pixel and the seam; and its frame is the same decal's in the generated layout
+// (no seam there) up to the maps' sampling: the seam cuts nothing.
+TEST_F(SurfaceHttpTest, CesiumManDecalAcrossASeamOfItsOwnUvsShowsNoCut) {
+    Http h = http();
+    const std::string model = uploadModel(kCesiumMan, false); // CesiumManTakesASurfacePlacement may have sent it
+    json doc = emptyScene(model);
+    doc["uv_layout"] = "model";
+    const std::string id = createScene(doc);
+    const std::string s = "/scenes/" + id;
+    const double size = 0.12; // model units, CesiumManTakesASurfacePlacement's (CesiumMan is ~1.5 tall): ~16 px
+
+    auto pickAt = [&](int x, int y) {
+        Reply r = h.get(s + "/pick?x=" + std::to_string(x) + "&y=" + std::to_string(y));
+        EXPECT_EQ(r.status, 200) << r;
+        return r.status == 200 && r.js()["hit"] == true ? r.js() : json();
+    };
+    auto inDecal = [&](const json& at) { // the outline's hit test at the pick's UV
+        Reply o = h.get(s + "/placements/decal/outline?u=" + std::to_string(at["uv"][0].get<double>()) +
+                        "&v=" + std::to_string(at["uv"][1].get<double>()));
+        EXPECT_EQ(o.status, 200) << o;
+        return o.status == 200 && o.js()["hit"] == true;
+    };
+    auto vec = [](const json& a) { return glm::dvec3(a[0].get<double>(), a[1].get<double>(), a[2].get<double>()); };
+    auto uvOf = [](const json& a) { return glm::dvec2(a["uv"][0].get<double>(), a["uv"][1].get<double>()); };
+    // A seam between two picks of 4-neighbour pixels: one stretch of surface — rest positions
+    // within 2 cm (a pixel is ~0.8 cm; where an arm hides the torso the jump is 3 cm or more) and
+    // normals within ~45° — whose UVs jump by more than 0.05 (a pixel's step within a chart: ~0.01).
+    auto seamBetween = [&](const json& a, const json& b) {
+        return glm::distance(vec(a["anchor"]["position"]), vec(b["anchor"]["position"])) < 0.02 &&
+               glm::dot(vec(a["anchor"]["normal"]), vec(b["anchor"]["normal"])) > 0.7 &&
+               glm::distance(uvOf(a), uvOf(b)) > 0.05;
+    };
+    auto within = [](const json& b, const glm::dvec2& uv) { // a piece's UV bounds hold uv
+        return b[0].get<double>() - 1e-4 <= uv.x && uv.x <= b[2].get<double>() + 1e-4 &&
+               b[1].get<double>() - 1e-4 <= uv.y && uv.y <= b[3].get<double>() + 1e-4;
+    };
+
+    // The scan: a grid over the frame, rows from the top; the decal is added at the first hit and
+    // its anchor (and driver) PATCHed to each next one. A pick qualifies when the outline has ≥ 2
+    // pieces and, in the pixels around it (±8, the decal's reach), (a) two neighbours inside the
+    // decal see a seam and (b) the pieces holding those two each hold ≥ 40 of the decal's pixels
+    // there (it covers ~100–300): a straddle the frame shows, not a sliver of a chart at a
+    // silhouette (as at most of the picks with ≥ 2 pieces on CesiumMan's big round head and at its
+    // shoulders, which come first).
+    constexpr int kReach = 8, kSide = 2 * kReach + 1;
+    json pick, outline, sides[2];
+    int px = -1, py = -1, tried = 0, split = 0, scanned = 0, shown[2] = {0, 0};
+    int seam[4] = {-1, -1, -1, -1}; // the pixels either side of the seam: x, y, x, y
+    bool added = false;
+    for (int y = 16; y < 248 && px < 0 && split < 60; y += 8)
+        for (int x = 8; x < 248 && px < 0 && split < 60; x += 8) {
+            const json at = pickAt(x, y);
+            if (at.is_null()) continue;
+            ++tried;
+            if (!added) {
+                ASSERT_EQ(h.post(s + "/placements", decalAt(at, "decal", size)).status, 201);
+                added = true;
+            } else {
+                Reply p = h.patch(s + "/placements/decal", {{"anchor", at["anchor"]}, {"joint", at["suggested"]["joint"]}});
+                ASSERT_EQ(p.status, 200) << p;
+            }
+            Reply o = h.get(s + "/placements/decal/outline");
+            ASSERT_EQ(o.status, 200) << o;
+            const json oj = o.js();
+            if (oj["pieces"].get<int>() < 2) continue;
+            ++split; // bounds the search: at most 60 picks with ≥ 2 pieces
+            // A cheap sieve before (b): the second largest piece's UV bounds are ≥ 1/4 of the
+            // largest's area (else one chart holds most of the decal and (b) would fail).
+            std::vector<double> areas;
+            for (const json& q : oj["bounds"])
+                areas.push_back((q[2].get<double>() - q[0].get<double>()) * (q[3].get<double>() - q[1].get<double>()));
+            std::sort(areas.rbegin(), areas.rend());
+            if (areas[1] < 0.25 * areas[0]) continue;
+            ++scanned;
+            std::vector<json> near(kSide * kSide);
+            for (int dy = -kReach; dy <= kReach; ++dy)
+                for (int dx = -kReach; dx <= kReach; ++dx) {
+                    json n = pickAt(x + dx, y + dy);
+                    if (!n.is_null() && inDecal(n)) near[(dy + kReach) * kSide + dx + kReach] = std::move(n);
+                }
+            // The seam pair nearest to the picked pixel (the decal's middle, where its height is).
+            std::vector<int> order(kSide * kSide);
+            for (int k = 0; k < kSide * kSide; ++k) order[k] = k;
+            std::stable_sort(order.begin(), order.end(), [&](int l, int r) {
+                auto d2 = [&](int k) { return (k % kSide - kReach) * (k % kSide - kReach) + (k / kSide - kReach) * (k / kSide - kReach); };
+                return d2(l) < d2(r);
+            });
+            for (const int k : order) {
+                if (px >= 0) break;
+                const int kx = k % kSide, ky = k / kSide;
+                for (const auto& [nx, ny] : {std::pair{kx + 1, ky}, std::pair{kx, ky + 1}}) {
+                    if (nx >= kSide || ny >= kSide || near[k].is_null() || near[ny * kSide + nx].is_null()) continue;
+                    const json& a = near[k];
+                    const json& b = near[ny * kSide + nx];
+                    if (!seamBetween(a, b)) continue;
+                    int piece[2] = {-1, -1};
+                    for (int side = 0; side < 2; ++side)
+                        for (std::size_t q = 0; q < oj["bounds"].size() && piece[side] < 0; ++q)
+                            if (within(oj["bounds"][q], uvOf(side == 0 ? a : b))) piece[side] = int(q);
+                    if (piece[0] < 0 || piece[1] < 0 || piece[0] == piece[1]) continue;
+                    int count[2] = {0, 0};
+                    for (const json& n : near) {
+                        if (n.is_null()) continue;
+                        const bool in0 = within(oj["bounds"][piece[0]], uvOf(n)), in1 = within(oj["bounds"][piece[1]], uvOf(n));
+                        count[0] += in0 && !in1;
+                        count[1] += in1 && !in0;
+                    }
+                    if (std::min(count[0], count[1]) < 40) continue;
+                    pick = at, outline = oj, px = x, py = y;
+                    sides[0] = a, sides[1] = b;
+                    seam[0] = x + kx - kReach, seam[1] = y + ky - kReach, seam[2] = x + nx - kReach, seam[3] = y + ny - kReach;
+                    shown[0] = count[0], shown[1] = count[1];
+                    break;
+                }
+            }
+        }
+    ASSERT_GE(px, 0) << "no pick of CesiumMan's body (" << tried << " tried, " << split
+                     << " with ≥ 2 pieces) puts a decal visibly across a seam of its own UVs";
+    std::printf("CesiumMan seam: decal at pixel (%d, %d) (pick %d of the scan, %d with >= 2 pieces, %d scanned), joint %s: "
+                "%d pieces, bounds %s; the seam between pixels (%d, %d) and (%d, %d), %d and %d decal pixels "
+                "either side\n",
+                px, py, tried, split, scanned, pick["suggested"]["joint"].dump().c_str(), outline["pieces"].get<int>(),
+                outline["bounds"].dump().c_str(), seam[0], seam[1], seam[2], seam[3], shown[0], shown[1]);
+    EXPECT_EQ(outline["layout"], "model");
+    EXPECT_EQ(outline["truncated"], false);
+
+    // The decal's height is on both charts: the probe at each side's UV names it.
+    for (const json& side : sides) {
+        Reply probe = h.get(s + "/probe?u=" + std::to_string(side["uv"][0].get<double>()) +
+                            "&v=" + std::to_string(side["uv"][1].get<double>()));
+        ASSERT_EQ(probe.status, 200) << probe;
+        const json pj = probe.js();
+        bool named = false;
+        for (const json& c : pj["contributions"]) named = named || c["placement"] == "decal";
+        EXPECT_TRUE(named) << "uv " << side["uv"] << ": " << pj;
+        EXPECT_GT(pj["bump"].get<double>(), 0.0) << pj;
+        std::printf("CesiumMan seam side uv %s: bump %.4f\n", side["uv"].dump().c_str(), pj["bump"].get<double>());
+    }
+
+    // The decal's change of the frame: its lit pixels, in 8-connected regions (a flood fill).
+    Reply diff = h.get(s + "/frame-diff?against=off");
+    ASSERT_EQ(diff.status, 200) << diff;
+    auto heat = decodeFrame(diff.bytes());
+    ASSERT_TRUE(heat);
+    const int W = heat->width, H = heat->height;
+    auto lit = [&](int x, int y) { return heat->rgba[(static_cast<std::size_t>(y) * W + x) * 4] > 0; };
+    std::vector<int> region(static_cast<std::size_t>(W) * H, -1);
+    std::vector<Lit> regions; // each one's pixel count and bounds
+    for (int y0 = 0; y0 < H; ++y0)
+        for (int x0 = 0; x0 < W; ++x0) {
+            if (!lit(x0, y0) || region[static_cast<std::size_t>(y0) * W + x0] >= 0) continue;
+            const int r = int(regions.size());
+            regions.emplace_back();
+            std::vector<std::pair<int, int>> todo{{x0, y0}};
+            region[static_cast<std::size_t>(y0) * W + x0] = r;
+            while (!todo.empty()) {
+                const auto [x, y] = todo.back();
+                todo.pop_back();
+                Lit& b = regions[r];
+                ++b.count;
+                b.x0 = std::min(b.x0, x), b.y0 = std::min(b.y0, y), b.x1 = std::max(b.x1, x), b.y1 = std::max(b.y1, y);
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int nx = x + dx, ny = y + dy;
+                        if (nx < 0 || ny < 0 || nx >= W || ny >= H || !lit(nx, ny)) continue;
+                        int& seen = region[static_cast<std::size_t>(ny) * W + nx];
+                        if (seen >= 0) continue;
+                        seen = r;
+                        todo.emplace_back(nx, ny);
+                    }
+            }
+        }
+    long litCount = 0;
+    std::string sizes;
+    for (const Lit& r : regions) litCount += r.count, sizes += (sizes.empty() ? "" : " ") + std::to_string(r.count);
+    std::printf("CesiumMan seam decal: %ld lit pixels in %zu 8-connected region(s) (%s)\n", litCount, regions.size(),
+                sizes.c_str());
+    EXPECT_EQ(std::to_string(litCount), diff.header("X-Dermis-Changed-Pixels"));
+    ASSERT_EQ(regions.size(), 1u) << "a decal cut at the seam lights separate regions: " << sizes;
+    const Lit& one = regions[0];
+    EXPECT_GT(one.count, 20);
+    // It lies around the picked pixel and over the seam (within its bounds grown by 2 px: the
+    // bulge's flat top and rim change little shading).
+    for (const auto& [x, y] : {std::pair{px, py}, std::pair{seam[0], seam[1]}, std::pair{seam[2], seam[3]}})
+        EXPECT_TRUE(one.x0 - 2 <= x && x <= one.x1 + 2 && one.y0 - 2 <= y && y <= one.y1 + 2)
+            << "(" << x << ", " << y << ") vs " << one.x0 << "," << one.y0 << ".." << one.x1 << "," << one.y1;
+
+    // No cut: the frame is the same decal's in the generated layout, where no seam lies there.
+    // CesiumManTakesASurfacePlacement's tolerance (mean |d| < 0.05, 8 of 255 per channel) holds
+    // but for a few isolated pixels: on the four CesiumMan seams that qualify above (hip and
+    // thighs, 512² maps) 2–3 pixels next to the seam differ by 17–29 — pixels whose shading is
+    // sensitive to the maps' sampling: each layout's own frame moves by as much there between map
+    // sizes 512, 1024 and 2048 (up to 38), so they are sampling, not a cut. A cut decal differs in
+    // many pixels: at the same seams a UV placement (projection uv, center the pick's UV, scale its
+    // largest piece's UV extent, so that its rectangle stops at the chart's border) put 43–79
+    // pixels more than 8 off (max 37–84; here 74, max 65) — seen while writing this test, not kept.
+    Reply own = h.get(s + "/frame?format=png");
+    ASSERT_EQ(own.status, 200) << own;
+    json generated = h.get(s).js()["scene"];
+    generated["uv_layout"] = "generated";
+    ASSERT_EQ(h.put(s, generated).status, 200);
+    Reply gen = h.get(s + "/frame?format=png");
+    ASSERT_EQ(gen.status, 200) << gen;
+    const Gap gap = gapOf(own, gen);
+    ASSERT_TRUE(gap.compared);
+    std::printf("CesiumMan seam decal, model vs generated layout: mean |d| %.4f, max %d, %ld pixels more than 8 off, "
+                "%ld channels > 24\n",
+                gap.mean, gap.worst, gap.pixelsOff8, gap.far);
+    EXPECT_LT(gap.mean, 0.05);    // seen: 0.0020
+    EXPECT_LE(gap.pixelsOff8, 5); // seen: 2
+    EXPECT_LE(gap.worst, 40);     // seen: 24
+    ASSERT_EQ(h.del(s).status, 204);
 }
