@@ -67,13 +67,14 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       await page.mouse.move(x - 3, y);
       await page.mouse.move(x, y);
       // The brush sits at the body point under the pointer (the view's last hover pick there).
-      const lastPick = () => page.evaluate(async () => { const l = (await import("/js/camera3d.js")).pointer.last; return l && l.hit && l.hit.anchor; });
-      const brush = (await until(async () => {
-        const b = await param("surface_brush"), u = await lastPick();
-        return b && u && near(b.split(",").map(Number).slice(0, 3), u.position, 1e-4) && b;
-      }, "a surface brush under the pointer in the frame URL")).split(",").map(Number);
+      // Waits for the pick of the pointer's last pixel (an earlier one may still be answered).
+      const lastPick = () => page.evaluate(async () => { const l = (await import("/js/camera3d.js")).pointer.last; return l && l.hit && { px: l.px, anchor: l.hit.anchor }; });
+      const settledBrush = await until(async () => {
+        const u = await lastPick(), b = await param("surface_brush");
+        return b && u && Math.abs(u.px[0] - px[0]) <= 1 && Math.abs(u.px[1] - px[1]) <= 1 && near(b.split(",").map(Number).slice(0, 3), u.anchor.position, 1e-4) && { b: b.split(",").map(Number), u: u.anchor };
+      }, "a surface brush at the pointer's pixel in the frame URL");
+      const brush = settledBrush.b, under = settledBrush.u;
       assert.equal(brush.length, 7);
-      const under = await lastPick();
       assert.ok(near(brush.slice(0, 3), under.position, 1e-4), `${brush} vs ${under.position}`);
       assert.ok(near(brush.slice(3, 6), under.normal, 1e-4), `${brush} vs ${under.normal}`);
       assert.ok(near(under.position, pick.anchor.position, 0.1), "near the pixel the test picked");

@@ -274,17 +274,21 @@ function decalUnder(px) {
 
 function startDecalDrag(id) {
   const orig = withPending(placementById(id));
-  return { id, orig, value: null, picking: false, wanted: null,
+  return { id, orig, value: null, pump: null, wanted: null, ended: false,
            stream: new Stream((fields) => patchPlacement(id, fields, { undoable: false }), { what: `move "${orig.label || orig.id}"` }) };
 }
 
-async function moveDecal(d, px, ctx) {
-  if (!px) return;
+function moveDecal(d, px, ctx) {
+  if (!px || d.ended) return;
   d.wanted = px;
-  if (d.picking) return;
-  d.picking = true;
+  if (!d.pump) d.pump = pumpDecal(d, ctx).finally(() => { d.pump = null; });
+}
+
+/// Picks under the pointer while a decal drag runs (one in flight, the newest pixel next); each
+/// answer on the body moves the decal (held: the frames preview it).
+async function pumpDecal(d, ctx) {
   try {
-    while (d.wanted) {
+    while (d.wanted && !d.ended) {
       const at = d.wanted;
       d.wanted = null;
       const hit = await ctx.pick(at[0], at[1]);
@@ -296,10 +300,12 @@ async function moveDecal(d, px, ctx) {
       ctx.onChange();
     }
   } catch (err) { ctx.onError(err); }
-  finally { d.picking = false; }
 }
 
+/// Ends a decal drag: `commit` sends the last position (after the picks still on their way: a
+/// quick drag on a slow server still lands where the pointer let go), else puts it back.
 async function endDecalDrag(d, commit, ctx) {
+  if (commit && d.pump) await d.pump;
   d.ended = true;
   if (!commit || !d.value) {
     release(d.id);
