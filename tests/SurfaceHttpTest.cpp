@@ -120,6 +120,15 @@ protected:
         return json();
     }
 
+    /// A default-character scene (its path in `s`) with one 0.12-wide surface placement "decal" at
+    /// the first torso pixel of a scan (`pick` its pick, at frame pixel px, py).
+    static void torsoDecal(std::string& s, json& pick, int& px, int& py) {
+        s = "/scenes/" + createScene(emptyScene("builtin:default"));
+        pick = pickOnBody(s, {110, 120, 100}, px, py);
+        ASSERT_TRUE(pick.is_object()) << "no pixel of the torso hit";
+        ASSERT_EQ(http().post(s + "/placements", decalAt(pick, "decal", 0.12)).status, 201);
+    }
+
     /// Adds a decal at the pick of (px, py) and checks the frame changes only near it.
     static void expectLocalDecal(const std::string& s, const json& pick, int px, int py, double size,
                                  int reach) {
@@ -227,12 +236,10 @@ TEST_F(SurfaceHttpTest, PickAnchorThenASurfacePlacementOnTheDefaultCharacter) {
 // unknown placement or scene.
 TEST_F(SurfaceHttpTest, OutlinesOfASurfaceAndAUvPlacement) {
     Http h = http();
-    const std::string id = createScene(emptyScene("builtin:default"));
-    const std::string s = "/scenes/" + id;
+    std::string s;
     int px = 0, py = 0;
-    const json pick = pickOnBody(s, {110, 120, 100}, px, py);
-    ASSERT_TRUE(pick.is_object()) << "no pixel of the torso hit";
-    ASSERT_EQ(h.post(s + "/placements", decalAt(pick, "decal", 0.12)).status, 201);
+    json pick;
+    ASSERT_NO_FATAL_FAILURE(torsoDecal(s, pick, px, py));
     const double u = pick["uv"][0], v = pick["uv"][1];
     auto expectInside = [](const json& o) {
         ASSERT_GE(o["pieces"].get<int>(), 1) << o;
@@ -456,12 +463,10 @@ TEST_F(SurfaceHttpTest, OneElbowDecalStaysAtThatElbowOnAnyCharacter) {
 // frame without them is unchanged; a bad brush is 422 naming it.
 TEST_F(SurfaceHttpTest, SelectedDecalAndSurfaceBrushAreOutlinedWhereTheyAre) {
     Http h = http();
-    const std::string id = createScene(emptyScene("builtin:default"));
-    const std::string s = "/scenes/" + id;
+    std::string s;
     int px = 0, py = 0;
-    const json pick = pickOnBody(s, {110, 120, 100}, px, py);
-    ASSERT_TRUE(pick.is_object()) << "no pixel of the torso hit";
-    ASSERT_EQ(h.post(s + "/placements", decalAt(pick, "decal", 0.12)).status, 201);
+    json pick;
+    ASSERT_NO_FATAL_FAILURE(torsoDecal(s, pick, px, py));
 
     auto frame = [&](const std::string& extra) {
         Reply r = h.get(s + "/frame?patterns=off" + extra);
