@@ -20,6 +20,7 @@
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
+#include <vector>
 
 using namespace dermis::test;
 using nlohmann::json;
@@ -34,7 +35,8 @@ std::string backend() {
 /// A dermis-server child process serving `dataDir` on a free port.
 class ServerProcess {
 public:
-    explicit ServerProcess(const std::string& dataDir, const std::string& logPath)
+    explicit ServerProcess(const std::string& dataDir, const std::string& logPath,
+                           std::vector<std::string> extra = {})
         : log_(logPath) {
         pid_ = ::fork();
         if (pid_ == 0) {
@@ -46,8 +48,13 @@ public:
             // memory test measures the server, not the sanitizer).
             if (const char* asan = std::getenv("ASAN_OPTIONS"))
                 ::setenv("ASAN_OPTIONS", (std::string(asan) + ":quarantine_size_mb=4").c_str(), 1);
-            ::execl(DERMIS_SERVER_EXE, DERMIS_SERVER_EXE, "serve", "--port", "0", "--data",
-                    dataDir.c_str(), "--gl", gl.c_str(), "--queue", "64", static_cast<char*>(nullptr));
+            std::vector<std::string> args = {DERMIS_SERVER_EXE, "serve", "--port", "0", "--data", dataDir,
+                                             "--gl", gl, "--queue", "64"};
+            args.insert(args.end(), extra.begin(), extra.end());
+            std::vector<char*> argv;
+            for (std::string& x : args) argv.push_back(x.data());
+            argv.push_back(nullptr);
+            ::execv(DERMIS_SERVER_EXE, argv.data());
             ::_exit(127);
         }
         // Wait for "serving http://127.0.0.1:<port>/".
@@ -115,6 +122,42 @@ json createScene(httplib::Client& c) {
     if (!r) return {};
     EXPECT_EQ(r->status, 201) << r->body;
     return json::parse(r->body, nullptr, false);
+}
+
+// Lower limits do not stop a fresh server (issue #25): the default scene breaks
+// --max-render-side 512 and --max-placements 1, so the server starts without it, says why, and
+// serves; without such limits a fresh data folder gets its one default scene.
+TEST(ServerProcessHttpTest, LowerLimitsStartAFreshServerWithoutTheDefaultScene) {
+    struct Case {
+        std::vector<std::string> flags;
+        bool defaultScene;
+    };
+    for (const Case& c : {Case{{"--max-render-side", "512"}, false}, Case{{"--max-placements", "1"}, false},
+                          Case{{}, true}}) {
+        TempDir dir;
+        ServerProcess server(dir / "data", dir / "log.txt", c.flags);
+        const std::string what = c.flags.empty() ? "no limits" : c.flags[0];
+        ASSERT_GT(server.port(), 0) << what << ": the server did not start:\n" << server.log();
+        httplib::Client h = client(server.port());
+        auto health = h.Get("/api/v1/health");
+        ASSERT_TRUE(health) << what;
+        EXPECT_EQ(health->status, 200) << what;
+        auto list = h.Get("/api/v1/scenes");
+        ASSERT_TRUE(list) << what;
+        const json scenes = json::parse(list->body, nullptr, false)["scenes"];
+        EXPECT_EQ(scenes.size(), c.defaultScene ? 1u : 0u) << what << ": " << list->body;
+        const std::string log = server.log();
+        EXPECT_EQ(log.find("warning: no default scene") != std::string::npos, !c.defaultScene) << what << ":\n" << log;
+        EXPECT_EQ(log.find("/frame") != std::string::npos, c.defaultScene) << what << ": the first scene's frame URL";
+        if (!c.defaultScene) { // and a scene within the limits can still be made
+            auto made = h.Post("/api/v1/scenes",
+                               R"({"format": "dermis.scene/1", "model": "builtin:default", "placements": [],
+                                   "heightmap": {"size": [256, 256]}, "render": {"size": [128, 128], "msaa": 1}})",
+                               "application/json");
+            ASSERT_TRUE(made) << what;
+            EXPECT_EQ(made->status, 201) << what << ": " << made->body;
+        }
+    }
 }
 
 TEST(ServerProcessHttpTest, AcknowledgedEditsSurviveKillDashNine) {

@@ -171,12 +171,17 @@ int runServe(ServeArgs a) {
     if (!service) return fail(service.error());
     for (const std::string& w : (*service)->warnings())
         std::cerr << "dermis-server: warning: skipped " << w << "\n";
-    // A fresh data folder starts with one scene: the default character and pattern set.
+    // A fresh data folder starts with one scene: the default character and pattern set — unless
+    // the limits given refuse it (--max-render-side 512, --max-placements 1, …): then the server
+    // starts without it and says why.
     if ((*service)->listScenes()["scenes"].empty()) {
         auto created = (*service)->createScene({{"default_patterns", true}});
-        if (!created) return fail(created.error());
+        if (!created)
+            std::cerr << "dermis-server: warning: no default scene: the limits given refuse it ("
+                      << created.error().message << "); create scenes through the API or the editor\n";
     }
-    const std::string firstScene = (*service)->listScenes()["scenes"][0]["id"].get<std::string>();
+    const nlohmann::json scenes = (*service)->listScenes()["scenes"];
+    const std::string firstScene = scenes.empty() ? "" : scenes[0]["id"].get<std::string>();
     ApiOptions opt = a.api;
     opt.bind = a.bind;
     opt.port = a.port;
@@ -190,9 +195,11 @@ int runServe(ServeArgs a) {
               << a.bind << ":" << *port << "/api/v1 — " << info["backend"].get<std::string>() << ", "
               << info["gl"]["renderer"].get<std::string>() << "; data in " << a.data
               << ", content in " << config.contentDir
-              << (a.token.empty() ? "" : "; token required (bearer, or the page's sign-in)") << "\n"
-              << "dermis-server: scene " << firstScene << ": http://" << a.bind << ":" << *port
-              << "/api/v1/scenes/" << firstScene << "/frame" << std::endl;
+              << (a.token.empty() ? "" : "; token required (bearer, or the page's sign-in)") << "\n";
+    if (!firstScene.empty())
+        std::cout << "dermis-server: scene " << firstScene << ": http://" << a.bind << ":" << *port
+                  << "/api/v1/scenes/" << firstScene << "/frame\n";
+    std::cout << std::flush;
     std::thread waiter([&api, signals] {
         int sig = 0;
         sigwait(&signals, &sig);
