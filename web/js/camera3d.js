@@ -145,8 +145,11 @@ let cancelDecal = () => false;
 /// True when one ran.
 export const cancelDecalDrag = () => cancelDecal();
 
+let stageEl = null;
+
 export function initCamera(stage, theApi, ctx) {
   api = theApi;
+  stageEl = stage;
   let drag = null;
   cancelDecal = () => {
     if (!drag || !drag.decal) return false;
@@ -194,6 +197,7 @@ export function initCamera(stage, theApi, ctx) {
     leaveGeneration++; // a pick still in flight is for a pointer that has gone
     wantedPick = null;
     pointer.last = null;
+    stage.classList.remove("ondecal");
     setHover(null, null, ctx);
   });
   stage.addEventListener("wheel", (e) => {
@@ -247,6 +251,7 @@ async function pumpPick(ctx) {
       const p = geo.hitPick(store.doc.placements.map(withPending), hit);
       setHover(p ? p.id : null, ctx.placeTool() ? ctx.brushFor(hit) : null, ctx);
     }
+    stageEl.classList.toggle("ondecal", !ctx.placeTool() && !!decalUnder(job.px)); // a drag here moves it
   } catch { /* a pick that fails (scene gone, offline) only loses the hover */ }
   finally {
     picking = false;
