@@ -230,6 +230,18 @@ bool intParam(const Req& req, Res& res, const char* name, std::optional<int>& ou
     return true;
 }
 
+bool revisionParam(const Req& req, Res& res, const char* name, std::optional<std::uint64_t>& out) {
+    if (!req.has_param(name)) return true;
+    const auto n = parseRevisionNumber(req.get_param_value(name));
+    if (!n) {
+        sendError(res, 422, "invalid_argument",
+                  std::string("dermis::Api: ") + name + ": must be a revision number >= 1", name);
+        return false;
+    }
+    out = *n;
+    return true;
+}
+
 bool numberParam(const Req& req, Res& res, const char* name, std::optional<double>& out) {
     if (!req.has_param(name)) return true;
     const std::string v = req.get_param_value(name);

@@ -39,19 +39,13 @@ void installInspectRoutes(RouteTable& t) {
         sendJson(res, 200, *r);
     });
     t.add("GET", "/scenes/{id}/placements/{pid}/outline", [](Api::Impl& a, const Req& req, Res& res) {
-        std::optional<double> u, v, revision;
-        if (!numberParam(req, res, "u", u) || !numberParam(req, res, "v", v) ||
-            !numberParam(req, res, "revision", revision))
+        std::optional<double> u, v;
+        std::optional<std::uint64_t> rev;
+        if (!numberParam(req, res, "u", u) || !numberParam(req, res, "v", v) || !revisionParam(req, res, "revision", rev))
             return;
         if (u.has_value() != v.has_value())
             return sendError(res, 422, "invalid_argument", "dermis::Api: u and v go together (a texture point to hit test)",
                              !u ? "u" : "v");
-        std::optional<std::uint64_t> rev;
-        if (revision) {
-            if (*revision < 1 || *revision != std::floor(*revision) || *revision > 1e15)
-                return sendError(res, 422, "invalid_argument", "dermis::Api: revision: must be a revision number >= 1", "revision");
-            rev = static_cast<std::uint64_t>(*revision);
-        }
         std::optional<std::array<double, 2>> at;
         if (u) at = std::array<double, 2>{*u, *v};
         auto r = a.svc.placementOutline(req.matches[1], req.matches[2], rev, at);
@@ -81,17 +75,11 @@ void installInspectRoutes(RouteTable& t) {
     });
     t.add("GET", "/scenes/{id}/drivers", [](Api::Impl& a, const Req& req, Res& res) {
         FrameParams p;
-        std::optional<double> revision;
         if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
             !numberParam(req, res, "yaw", p.yaw) || !numberParam(req, res, "pitch", p.pitch) ||
             !numberParam(req, res, "distance", p.distance) || !numberParam(req, res, "time", p.time) ||
-            !numberParam(req, res, "revision", revision))
+            !revisionParam(req, res, "revision", p.revision))
             return;
-        if (revision) {
-            if (*revision < 1 || *revision != std::floor(*revision) || *revision > 1e15)
-                return sendError(res, 422, "invalid_argument", "dermis::Api: revision: must be a revision number >= 1", "revision");
-            p.revision = static_cast<std::uint64_t>(*revision);
-        }
         auto r = a.svc.drivers(req.matches[1], p);
         if (!r) return sendError(res, r.error());
         sendJson(res, 200, *r);

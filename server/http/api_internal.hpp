@@ -76,6 +76,8 @@ std::vector<std::uint8_t> bytesOf(const std::string& s);
 /// present but malformed.
 bool intParam(const Req& req, Res& res, const char* name, std::optional<int>& out);
 bool numberParam(const Req& req, Res& res, const char* name, std::optional<double>& out);
+/// A revision number ≥ 1 (service parseRevisionNumber: the one parse of a revision number).
+bool revisionParam(const Req& req, Res& res, const char* name, std::optional<std::uint64_t>& out);
 /// The camera's `target=x,y,z` (three finite numbers, comma-separated; api_renders.cpp).
 /// False (and the 422 sent, field "target") when malformed.
 bool targetParam(const Req& req, Res& res, std::optional<std::array<double, 3>>& out);

@@ -156,15 +156,7 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         }
         p.preview = std::move(patch);
     }
-    if (req.has_param("revision")) {
-        std::optional<double> r;
-        if (!numberParam(req, res, "revision", r)) return false;
-        if (!r || *r < 1 || *r != std::floor(*r) || *r > 1e15) {
-            sendError(res, 422, "invalid_argument", "dermis::Api: revision: must be a revision number >= 1", "revision");
-            return false;
-        }
-        p.revision = static_cast<std::uint64_t>(*r);
-    }
+    if (!revisionParam(req, res, "revision", p.revision)) return false;
     return true;
 }
 

@@ -26,24 +26,6 @@ Handler jsonEdit(int status, EditFn edit) {
     };
 }
 
-/// An unsigned query parameter ≥ 1; true when absent or well-formed, else a 422 is sent.
-bool revisionParam(const Req& req, Res& res, const char* name, std::optional<std::uint64_t>& out) {
-    if (!req.has_param(name)) return true;
-    const std::string v = req.get_param_value(name);
-    std::uint64_t n = 0;
-    bool ok = !v.empty() && v.size() <= 18;
-    for (char c : v) {
-        ok = ok && std::isdigit(static_cast<unsigned char>(c));
-        if (ok) n = n * 10 + static_cast<std::uint64_t>(c - '0');
-    }
-    if (!ok || n == 0) {
-        sendError(res, 422, "invalid_argument",
-                  std::string("dermis::Api: ") + name + ": must be a revision number >= 1", name);
-        return false;
-    }
-    out = n;
-    return true;
-}
 
 void installDocumentRoutes(RouteTable& t) {
     t.add("GET", "/scenes",

@@ -92,6 +92,10 @@ struct UploadFile {
 /// and "webp" (lossless, Content-Type image/webp).
 inline bool isFrameFormat(const std::string& f) { return f == "png" || f == "jpeg" || f == "webp"; }
 
+/// A revision number as text: 1 to 18 decimal digits, ≥ 1 (no sign, point or exponent); nothing
+/// otherwise. The one parse of a revision number (query parameters, frame-diff's `against`).
+std::optional<std::uint64_t> parseRevisionNumber(const std::string& text);
+
 /// Query parameters of a frame.
 struct FrameParams {
     std::string format = "png"; ///< png | jpeg | webp (lossless); see isFrameFormat

@@ -147,18 +147,10 @@ Result<Service::State::Snapshot> Service::State::frameSnapshot(const std::string
             doc = std::move(*old);
         }
         if (preview) {
-            json& placements = doc["placements"];
-            for (auto it = p.preview.begin(); it != p.preview.end(); ++it) {
-                json* target = nullptr;
-                for (json& pl : placements)
-                    if (pl.is_object() && pl.value("id", "") == it.key()) target = &pl;
-                if (!target) return bad("preview", "no placement \"" + it.key() + "\" in scene " + id);
-                if (!it.value().is_object())
-                    return bad("preview", "the patch of \"" + it.key() + "\" must be a JSON object");
-                if (auto pid = it.value().find("id"); pid != it.value().end() && *pid != it.key())
-                    return bad("preview", "a placement's id cannot be changed");
-                target->merge_patch(it.value());
-            }
+            // The rules of a placement edit (mergePlacementPatch), every refusal on "preview".
+            for (auto it = p.preview.begin(); it != p.preview.end(); ++it)
+                if (auto s = mergePlacementPatch(doc, id, it.key(), it.value()); !s)
+                    return bad("preview", "\"" + it.key() + "\": " + s.error().message);
         }
         std::shared_lock<std::shared_mutex> lock(mutex);
         framesPrepared.fetch_add(1, std::memory_order_relaxed);
@@ -251,6 +243,17 @@ std::uint64_t Service::framesPrepared() const {
     return state_->framesPrepared.load(std::memory_order_relaxed);
 }
 
+std::optional<std::uint64_t> parseRevisionNumber(const std::string& text) {
+    if (text.empty() || text.size() > 18) return std::nullopt;
+    std::uint64_t n = 0;
+    for (char c : text) {
+        if (c < '0' || c > '9') return std::nullopt;
+        n = n * 10 + static_cast<std::uint64_t>(c - '0');
+    }
+    if (n == 0) return std::nullopt;
+    return n;
+}
+
 Result<EncodedImage> Service::frame(const std::string& id, const FrameParams& p) {
     if (!isFrameFormat(p.format)) return bad("format", "must be png, jpeg or webp");
     QueueSlot slot(state_->inFlight, limits_.queueLength);
@@ -273,14 +276,9 @@ Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams
     if (against == "off") {
         other.patternsOff = true;
     } else {
-        std::uint64_t n = 0;
-        bool ok = !against.empty() && against.size() <= 18;
-        for (char c : against) {
-            ok = ok && c >= '0' && c <= '9';
-            if (ok) n = n * 10 + static_cast<std::uint64_t>(c - '0');
-        }
-        if (!ok || n == 0) return bad("against", "must be off or a revision number");
-        other.revision = n;
+        const auto n = parseRevisionNumber(against);
+        if (!n) return bad("against", "must be off or a revision number");
+        other.revision = *n;
         other.patternsOff = false;
         other.only.clear();
     }

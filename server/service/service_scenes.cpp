@@ -254,17 +254,27 @@ Result<json> Service::addPlacement(const std::string& id, const json& placement,
 
 Result<json> Service::patchPlacement(const std::string& id, const std::string& pid, const json& patch,
                                      const EditContext& ctx) {
-    if (!patch.is_object()) return bad("", "a placement patch must be a JSON object");
-    if (auto i = patch.find("id"); i != patch.end() && (!i->is_string() || i->get<std::string>() != pid))
-        return bad("/id", "a placement's id cannot be changed");
+    if (auto s = checkPlacementPatch(pid, patch); !s) return s.error(); // before the writer lock
     EditInfo info{"placement_updated", "patch placement " + pid, pid};
     const EditScope scope{EditScope::Kind::Placement, pid};
     return state_->edit(id, ctx, info, scope, [&](json& doc) -> Status {
-        const int k = placementIndex(doc, pid);
-        if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + id);
-        doc["placements"][static_cast<std::size_t>(k)].merge_patch(patch);
-        return Ok{};
+        return mergePlacementPatch(doc, id, pid, patch);
     });
+}
+
+Status detail::checkPlacementPatch(const std::string& pid, const json& patch) {
+    if (!patch.is_object()) return bad("", "a placement patch must be a JSON object");
+    if (auto i = patch.find("id"); i != patch.end() && (!i->is_string() || i->get<std::string>() != pid))
+        return bad("/id", "a placement's id cannot be changed");
+    return Ok{};
+}
+
+Status detail::mergePlacementPatch(json& doc, const std::string& sceneId, const std::string& pid, const json& patch) {
+    if (auto s = checkPlacementPatch(pid, patch); !s) return s;
+    const int k = placementIndex(doc, pid);
+    if (k < 0) return notFound("pid", "no placement \"" + pid + "\" in scene " + sceneId);
+    doc["placements"][static_cast<std::size_t>(k)].merge_patch(patch);
+    return Ok{};
 }
 
 Result<json> Service::deletePlacement(const std::string& id, const std::string& pid,

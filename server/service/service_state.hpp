@@ -158,6 +158,14 @@ GltfLimits gltfLimitsOf(const ServerLimits& limits);
 
 Error bad(const std::string& field, const std::string& what);
 Error notFound(const std::string& field, const std::string& what);
+
+/// The one rule of a placement edit (PATCH placement, and a frame's `preview`): `patch` is a JSON
+/// object, it does not change the placement's id, placement `pid` exists in `doc` (scene
+/// `sceneId`); then `patch` is merged into it (RFC 7386). Fails with the edit's fields: "" (not an
+/// object), "/id" (id changed), 404 "pid" (no such placement); `doc` is untouched then.
+Status mergePlacementPatch(json& doc, const std::string& sceneId, const std::string& pid, const json& patch);
+/// The part of that rule that needs no document: the object and id checks.
+Status checkPlacementPatch(const std::string& pid, const json& patch);
 Error queueFull();
 double nowSeconds();
 /// Hands the heap's free pages back to the system (glibc: malloc_trim): after a delete, so that
