@@ -45,11 +45,9 @@ inline std::vector<std::uint8_t> patternPng(int w, int h) {
     return *encodePng(img, false);
 }
 
-/// The SSE message's "type" field ("event: …\ndata: {json}\n\n").
-inline std::string typeOf(const std::string& sse) {
-    const auto d = sse.find("data: ");
-    if (d == std::string::npos) return "";
-    return json::parse(sse.substr(d + 6)).value("type", "");
+/// A live event's "type" field (its JSON data's).
+inline std::string typeOf(const SceneEvent& e) {
+    return json::parse(e.data).value("type", "");
 }
 
 class ServiceFixture : public ::testing::Test {

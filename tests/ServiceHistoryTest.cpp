@@ -26,10 +26,8 @@ const json kEmpty = {{"format", "dermis.scene/1"}, {"model", "builtin:default"}}
 
 class ServiceHistoryTest : public ServiceFixture {
 protected:
-    /// The data of an SSE message as JSON.
-    static json dataOf(const std::string& sse) {
-        return json::parse(sse.substr(sse.find("data: ") + 6));
-    }
+    /// The data of a live event as JSON.
+    static json dataOf(const SceneEvent& e) { return json::parse(e.data); }
     json placement(const std::string& pid, double u) {
         return {{"id", pid}, {"pattern", "crease"}, {"joint", "forearm.l"}, {"center", {u, 0.5}}};
     }
@@ -464,8 +462,8 @@ TEST_F(ServiceHistoryTest, PresenceIsBroadcastListedAndChecked) {
     ASSERT_EQ((*r)["presence"].size(), 1u);
     EXPECT_EQ((*r)["presence"][0]["selection"], json({"a", "b"}));
     EXPECT_NEAR((*r)["presence"][0]["expires_in"].get<double>(), ServerLimits{}.presenceSeconds, 1.0);
-    const std::string sse = *(*sub)->next(1000);
-    EXPECT_EQ(sse.rfind("event: presence\n", 0), 0u) << sse;
+    const SceneEvent sse = *(*sub)->next(1000);
+    EXPECT_EQ(sse.name, "presence") << sse.data;
     EXPECT_EQ(dataOf(sse)["client"], "alice");
     EXPECT_EQ(dataOf(sse)["color"], "#ff8800");
     ASSERT_TRUE(svc_->postPresence(id, {{"client", "bob"}}));

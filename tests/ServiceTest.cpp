@@ -381,18 +381,19 @@ TEST_F(ServiceTest, ModelsDescribeJointsParentsAndUvLayout) {
 TEST(SubscriptionTest, AReaderFarBehindGetsOneResyncInsteadOfUnboundedEvents) {
     Subscription s("s_1");
     for (int k = 0; k < 3 * static_cast<int>(Subscription::kMaxQueued); ++k)
-        s.push("event: change\ndata: {\"type\":\"pose\",\"n\":" + std::to_string(k) + "}\n\n");
-    std::vector<std::string> got;
+        s.push({"change", "{\"type\":\"pose\",\"n\":" + std::to_string(k) + "}"});
+    std::vector<SceneEvent> got;
     while (auto e = s.next(0)) got.push_back(*e);
     ASSERT_FALSE(got.empty());
     EXPECT_LE(got.size(), Subscription::kMaxQueued);
     EXPECT_EQ(typeOf(got.back()), "resync");
-    EXPECT_NE(got.back().find("\"scene\":\"s_1\""), std::string::npos);
+    EXPECT_EQ(got.back().name, "resync");
+    EXPECT_NE(got.back().data.find("\"scene\":\"s_1\""), std::string::npos);
     int resyncs = 0;
-    for (const std::string& e : got) resyncs += typeOf(e) == "resync";
+    for (const SceneEvent& e : got) resyncs += typeOf(e) == "resync";
     EXPECT_EQ(resyncs, 1);
     // Once the reader took the resync, events flow again.
-    s.push("event: change\ndata: {\"type\":\"pose\"}\n\n");
+    s.push({"change", "{\"type\":\"pose\"}"});
     auto next = s.next(0);
     ASSERT_TRUE(next);
     EXPECT_EQ(typeOf(*next), "pose");

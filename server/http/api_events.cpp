@@ -37,7 +37,9 @@ void installEventRoutes(RouteTable& t) {
                     static const std::string ping = ": ping\n\n";
                     return sink.write(ping.data(), ping.size());
                 }
-                return sink.write(e->data(), e->size());
+                // Server-sent-event framing (the service's events are typed: SceneEvent).
+                const std::string text = "event: " + e->name + "\ndata: " + e->data + "\n\n";
+                return sink.write(text.data(), text.size());
             },
             [api, id, ip, subscription](bool) { // runs once, when the response is destroyed
                 api->svc.unsubscribe(id, subscription);

@@ -158,21 +158,29 @@ inline constexpr int kMinTurntableSize = 64, kMaxTurntableSize = 512;
 /// taken. A reader that falls kMaxQueued events behind loses them: the queue is replaced by one
 /// `resync` event ({"type": "resync", "scene"}) telling it to read the scene again, and nothing
 /// more is queued until it has taken that event, so a stalled reader costs bounded memory.
+/// A live change event of a scene, typed: its name ("hello", "change", "presence", "resync") and
+/// its JSON data (as text: serialized once for every subscriber). The HTTP layer frames it as a
+/// server-sent event; the service knows no wire format.
+struct SceneEvent {
+    std::string name;
+    std::string data;
+};
+
 class Subscription {
 public:
     static constexpr std::size_t kMaxQueued = 1000;
 
     explicit Subscription(std::string sceneId = "");
     /// Waits up to `timeoutMs` for an event; nullopt on timeout or when closed.
-    std::optional<std::string> next(int timeoutMs);
-    void push(std::string event);
+    std::optional<SceneEvent> next(int timeoutMs);
+    void push(SceneEvent event);
     void close();
     bool closed() const;
 
 private:
     mutable std::mutex mutex_;
     std::condition_variable cv_;
-    std::deque<std::string> events_;
+    std::deque<SceneEvent> events_;
     std::string sceneId_;
     bool closed_ = false;
     bool resyncQueued_ = false;

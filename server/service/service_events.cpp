@@ -1,4 +1,5 @@
-// Live change events: per-scene subscriptions (server-sent events), bounded per reader.
+// Live change events: per-scene subscriptions of typed events (the HTTP layer frames them as
+// server-sent events), bounded per reader.
 #include "service/service_state.hpp"
 
 #include <chrono>
@@ -9,17 +10,17 @@ using namespace detail;
 
 Subscription::Subscription(std::string sceneId) : sceneId_(std::move(sceneId)) {}
 
-std::optional<std::string> Subscription::next(int timeoutMs) {
+std::optional<SceneEvent> Subscription::next(int timeoutMs) {
     std::unique_lock<std::mutex> lock(mutex_);
     cv_.wait_for(lock, std::chrono::milliseconds(timeoutMs), [&] { return closed_ || !events_.empty(); });
     if (events_.empty()) return std::nullopt;
-    std::string e = std::move(events_.front());
+    SceneEvent e = std::move(events_.front());
     events_.pop_front();
     if (events_.empty()) resyncQueued_ = false; // the resync, if any, was the last one queued
     return e;
 }
 
-void Subscription::push(std::string event) {
+void Subscription::push(SceneEvent event) {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         if (closed_ || resyncQueued_) return; // a reader told to resync re-reads anyway
@@ -27,8 +28,7 @@ void Subscription::push(std::string event) {
             // The reader is too far behind to catch up event by event: drop what it has not read
             // and tell it to read the scene again.
             events_.clear();
-            events_.push_back("event: resync\ndata: " +
-                              json{{"type", "resync"}, {"scene", sceneId_}}.dump() + "\n\n");
+            events_.push_back({"resync", json{{"type", "resync"}, {"scene", sceneId_}}.dump()});
             resyncQueued_ = true;
         } else {
             events_.push_back(std::move(event));
@@ -51,11 +51,11 @@ bool Subscription::closed() const {
 }
 
 void Service::State::publish(const std::string& sceneId, const json& event, const char* name) {
-    const std::string text = std::string("event: ") + name + "\ndata: " + event.dump() + "\n\n";
+    const SceneEvent e{name, event.dump()};
     std::lock_guard<std::mutex> lock(subsMutex);
     auto [a, b] = subs.equal_range(sceneId);
     for (auto it = a; it != b; ++it)
-        it->second->push(text);
+        it->second->push(e);
 }
 
 Result<std::shared_ptr<Subscription>> Service::subscribe(const std::string& id) {
@@ -63,8 +63,7 @@ Result<std::shared_ptr<Subscription>> Service::subscribe(const std::string& id) 
     auto it = state_->scenes.find(id);
     if (it == state_->scenes.end()) return notFound("id", "no scene \"" + id + "\"");
     auto sub = std::make_shared<Subscription>(id);
-    sub->push("event: hello\ndata: " +
-              json{{"type", "hello"}, {"scene", id}, {"revision", it->second.revision}}.dump() + "\n\n");
+    sub->push({"hello", json{{"type", "hello"}, {"scene", id}, {"revision", it->second.revision}}.dump()});
     std::lock_guard<std::mutex> sl(state_->subsMutex);
     state_->subs.emplace(id, sub);
     return sub;
