@@ -6,9 +6,11 @@
 //   api_system.cpp   /health, /info, /openapi.yaml
 //   api_session.cpp  /session (browser sign-in) and the SessionStore
 //   api_models.cpp   /models…            api_patterns.cpp  /patterns…
-//   api_scenes.cpp   /scenes, placements, pose
-//   api_renders.cpp  frames, frame diffs, height maps, sweeps, the stateless batch (/render)
-//   api_events.cpp   /scenes/{id}/events (server-sent events)
+//   api_scenes.cpp   /scenes, placements, pose, history, presence
+//   api_inspect.cpp  pick, drivers, probe, activation, lint, a placement's outline
+//   api_renders.cpp  frames, frame diffs, height maps, sweeps, focus, turntable, the batch (/render)
+//   api_events.cpp   /scenes/{id}/events (the service's typed events framed as server-sent events)
+//   api_connections.cpp  connection limits, request heads and bodies, lingering close
 // Registration with httplib, Api::routes() (checked against openapi.yaml by RoutesHttpTest), the
 // 405 Allow lists and the open-route check of authentication all read that table, so a route
 // exists in all of them or in none.
