@@ -52,6 +52,13 @@ protected:
     struct Lit {
         long count = 0;
         int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+        void add(int x, int y) {
+            ++count;
+            x0 = std::min(x0, x);
+            y0 = std::min(y0, y);
+            x1 = std::max(x1, x);
+            y1 = std::max(y1, y);
+        }
     };
     static Lit litOf(const Reply& diff) {
         Lit l;
@@ -60,13 +67,7 @@ protected:
         if (!heat) return l;
         for (int y = 0; y < heat->height; ++y)
             for (int x = 0; x < heat->width; ++x)
-                if (heat->rgba[(static_cast<std::size_t>(y) * heat->width + x) * 4] > 0) {
-                    ++l.count;
-                    l.x0 = std::min(l.x0, x);
-                    l.y0 = std::min(l.y0, y);
-                    l.x1 = std::max(l.x1, x);
-                    l.y1 = std::max(l.y1, y);
-                }
+                if (heat->rgba[(static_cast<std::size_t>(y) * heat->width + x) * 4] > 0) l.add(x, y);
         return l;
     }
 
@@ -484,11 +485,7 @@ TEST_F(SurfaceHttpTest, SelectedDecalAndSurfaceBrushAreOutlinedWhereTheyAre) {
             for (int x = 0; x < plain.width; ++x) {
                 const std::size_t i = (static_cast<std::size_t>(y) * plain.width + x) * 4;
                 if (std::memcmp(&plain.rgba[i], &other.rgba[i], 3) == 0) continue;
-                ++l.count;
-                l.x0 = std::min(l.x0, x);
-                l.y0 = std::min(l.y0, y);
-                l.x1 = std::max(l.x1, x);
-                l.y1 = std::max(l.y1, y);
+                l.add(x, y);
             }
         return l;
     };
