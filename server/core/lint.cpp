@@ -64,10 +64,12 @@ std::string percent(std::size_t part, std::size_t whole) {
     return std::to_string(static_cast<int>(std::lround(100.0 * ratio))) + "%";
 }
 
-/// Per placement: does any clip sample give t > 0? (true when the model has no clips: nothing
-/// to judge by).
+/// Per placement: does any clip sample give t > 0? (true when the model has no clips, or no clip
+/// turns the placement's joint about its axis by more than half a degree from the rest pose:
+/// nothing to judge by.)
 std::vector<bool> reachable(const Scene& scene, const Model& model) {
     std::vector<bool> out(scene.placements.size(), model.clips.empty());
+    std::vector<bool> moved(scene.placements.size(), false);
     for (const Clip& clip : model.clips) {
         Pose pose;
         pose.animation = clip.name;
@@ -79,10 +81,12 @@ std::vector<bool> reachable(const Scene& scene, const Model& model) {
                 if (out[i]) continue;
                 const Placement& p = scene.placements[i];
                 auto theta = placementAngle(model, *local, p, i);
+                if (theta && std::abs(*theta) > 0.5) moved[i] = true;
                 if (theta && normalizedT(*theta, p.thetaMin, p.thetaMax) > 0.0) out[i] = true;
             }
         }
     }
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = out[i] || !moved[i];
     return out;
 }
 

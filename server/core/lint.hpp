@@ -1,6 +1,6 @@
 // Dermis core — what may be wrong with a scene that still validates (SPEC §6 Lint): footprints
 // hanging off the UV charts (the pattern is lost there) or across a chart seam, footprints
-// overlapping on one target, θ ranges no clip reaches, driver joints with no skin influence under
+// overlapping on one target, θ ranges no clip reaches (a joint no clip turns is not judged), driver joints with no skin influence under
 // their footprint, mirror pairs that are not symmetric; and, from the model's UV diagnosis (SPEC
 // §8, lint_uv.hpp), footprints on texels other regions of the body share (uv_overlap, naming
 // where the pattern also shows) and UV placements on a model without UVs (no_uvs).

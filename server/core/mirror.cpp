@@ -2,6 +2,7 @@
 #include "mirror.hpp"
 
 #include "camera.hpp"
+#include "surface_query.hpp"
 
 #include <glm/gtc/matrix_access.hpp>
 #include <glm/gtc/quaternion.hpp>
@@ -23,38 +24,6 @@ constexpr double kMaxPlacementScaleForMirror = 16.0;
 glm::vec3 reflect(glm::vec3 p, const SymmetryPlane& s) {
     p[s.axis] = 2.0f * s.offset - p[s.axis];
     return p;
-}
-
-/// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5), with
-/// its barycentric weights.
-glm::dvec3 closestBary(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
-    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-    if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
-    const glm::dvec3 bp = p - b;
-    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-    if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        const double v = d1 / (d1 - d3);
-        return {1 - v, v, 0};
-    }
-    const glm::dvec3 cp = p - c;
-    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-    if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        const double w = d2 / (d2 - d6);
-        return {1 - w, 0, w};
-    }
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return {0, 1 - w, w};
-    }
-    const double denom = 1.0 / (va + vb + vc);
-    const double v = vb * denom, w = vc * denom;
-    return {1 - v - w, v, w};
 }
 
 /// UV of the rest-mesh point nearest to world point q (parts with UVs only).
@@ -404,18 +373,27 @@ Status mirrorDriver(const Placement& p, const Model& model, const SymmetryPlane&
     int j = model.findJoint(p.joint);
     if (!inWorld(j)) j = -1; // a RestSkin of another model
     std::string twin = mirrorJointName(model, p.joint);
-    if (twin.empty() && j >= 0) {
+    if (j >= 0) {
+        // The joint nearest the reflected rest position: the twin when the names give none, and
+        // instead of the name twin when that lies elsewhere (CesiumMan's left elbow is
+        // "arm_joint_L__3_", its right one "arm_joint_R__2_"; "R__3_" is the right wrist).
         const glm::vec3 at = reflect(glm::vec3(world[static_cast<std::size_t>(j)][3]), plane);
         const Bounds& b = restSkin.bounds;
-        float best = 0.05f * glm::length(b.max - b.min);
+        const float tolerance = 0.05f * glm::length(b.max - b.min);
+        float best = tolerance;
+        std::string nearest;
         for (int n : model.joints) {
             if (!inWorld(n)) continue;
             const float d = glm::length(glm::vec3(world[static_cast<std::size_t>(n)][3]) - at);
             if (d < best) {
                 best = d;
-                twin = model.nodes[static_cast<std::size_t>(n)].name;
+                nearest = model.nodes[static_cast<std::size_t>(n)].name;
             }
         }
+        const int named = twin.empty() ? -1 : model.findJoint(twin);
+        const bool namedFar = named >= 0 && inWorld(named) &&
+                              glm::length(glm::vec3(world[static_cast<std::size_t>(named)][3]) - at) > tolerance;
+        if (twin.empty() || (namedFar && !nearest.empty())) twin = nearest;
     }
     if (twin.empty() || j < 0)
         return makeError(ErrorCode::NotFound, where, "joint",
@@ -449,62 +427,6 @@ Status mirrorDriver(const Placement& p, const Model& model, const SymmetryPlane&
 namespace dermis {
 
 namespace {
-
-/// A point on a part's triangle: part, first index of the triangle in `indices`, barycentrics.
-struct SurfacePoint {
-    std::size_t part = 0, base = 0;
-    glm::dvec3 bary{1, 0, 0};
-};
-
-/// The surface point of `m`'s triangles (with positions `positions[part]`) nearest to q.
-std::optional<SurfacePoint> nearestSurfacePoint(const Model& m,
-                                                const std::vector<const std::vector<glm::vec3>*>& positions,
-                                                glm::dvec3 q) {
-    double best = std::numeric_limits<double>::max();
-    std::optional<SurfacePoint> out;
-    for (std::size_t pi = 0; pi < m.parts.size() && pi < positions.size(); ++pi) {
-        const MeshPart& p = m.parts[pi];
-        const auto& pos = *positions[pi];
-        for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-            const std::uint32_t i[3] = {p.indices[t], p.indices[t + 1], p.indices[t + 2]};
-            if (i[0] >= pos.size() || i[1] >= pos.size() || i[2] >= pos.size() ||
-                i[0] >= p.positions.size() || i[1] >= p.positions.size() || i[2] >= p.positions.size())
-                continue;
-            const glm::dvec3 a(pos[i[0]]), b(pos[i[1]]), c(pos[i[2]]);
-            const glm::dvec3 w = closestBary(q, a, b, c);
-            const double d = glm::length(w.x * a + w.y * b + w.z * c - q);
-            if (d < best) {
-                best = d;
-                out = SurfacePoint{pi, t, w};
-            }
-        }
-    }
-    return out;
-}
-
-/// The rest skinning at surface point `sp` (bind space → rest world): Σ over the triangle's
-/// corners and their influences of bary · weight · world(node) · inverseBind.
-glm::dmat4 restSkinningAt(const Model& m, const RestSkin& rest, const SurfacePoint& sp) {
-    const MeshPart& p = m.parts[sp.part];
-    glm::dmat4 sum(0.0);
-    double total = 0.0;
-    for (int c = 0; c < 3; ++c) {
-        const std::uint32_t v = p.indices[sp.base + static_cast<std::size_t>(c)];
-        const bool weighted = v < p.joints.size() && v < p.weights.size();
-        for (int k = 0; k < (weighted ? 4 : 1); ++k) {
-            const std::size_t inf = weighted ? p.joints[v][k] : 0;
-            const double w = sp.bary[c] * (weighted ? p.weights[v][k] : 1.0);
-            if (!(w > 0.0) || inf >= p.influences.size()) continue;
-            const int node = p.influences[inf].node;
-            const glm::dmat4 world = node >= 0 && static_cast<std::size_t>(node) < rest.world.size()
-                                         ? glm::dmat4(rest.world[static_cast<std::size_t>(node)])
-                                         : glm::dmat4(1.0);
-            sum += w * (world * glm::dmat4(p.influences[inf].inverseBind));
-            total += w;
-        }
-    }
-    return total > 0.0 ? sum / total : glm::dmat4(1.0);
-}
 
 glm::dvec3 reflectD(glm::dvec3 p, const SymmetryPlane& s) {
     p[s.axis] = 2.0 * s.offset - p[s.axis];

@@ -11,9 +11,10 @@
 //                   times how much each step stretched (a reflection cannot flip an image: the
 //                   twin keeps the same pattern, rotated);
 //   joint:          by name pairs (_l/_r, .l/.r, .L/.R, Left/Right, L_/R_, _L_/_R_ inside, any
-//                   case), else the
-//                   joint nearest the reflected rest position of the joint (within 5% of the
-//                   body's size; none → NotFound);
+//                   case), else the joint nearest the reflected rest position of the joint
+//                   (within 5% of the body's size; none → NotFound); a name twin farther than
+//                   that from the reflected position gives way to the nearest joint there
+//                   (names that do not pair the same places: CesiumMan's arm joints);
 //   axis:           an axial vector: world a_w = Q_j·a, mirrored a_w' = −R·a_w (R the
 //                   reflection), twin-local a' = Q_t⁻¹·a_w' (Q the joints' rest world rotations),
 //                   so a pose and its mirror image give both twins the same θ, hence the same t;

@@ -45,6 +45,24 @@ const UvDiagnosis& ModelDerived::uvDiagnosis() const {
     return diagnosis_;
 }
 
+const BodyMap& ModelDerived::bodyMap() const {
+    std::call_once(bodyOnce_, [this] { body_ = mapBody(*model_, restSkin(), symmetryPlane()); });
+    return body_;
+}
+
+const MotionAnalysis& ModelDerived::motion() const {
+    std::call_once(motionOnce_, [this] { motion_ = analyzeMotion(*model_, restSkin(), bodyMap()); });
+    return motion_;
+}
+
+const std::vector<Proposal>& ModelDerived::proposals() const {
+    std::call_once(proposalsOnce_, [this] {
+        proposals_ = proposePatterns(*model_, restSkin(), symmetryPlane(), bodyMap(), motion());
+        proposalBuilds_.fetch_add(1);
+    });
+    return proposals_;
+}
+
 SuggestedDriver
 ModelDerived::suggestDriver(const std::vector<std::pair<int, float>>& joints) const {
     const Model& model = *model_;

@@ -20,8 +20,11 @@
 // (lint's clip sampling against the placements' ranges, mirror's nearest-point search).
 #pragma once
 
+#include "body_map.hpp"
 #include "mirror.hpp"
 #include "model.hpp"
+#include "motion.hpp"
+#include "propose.hpp"
 #include "pick.hpp"
 #include "uv_diagnosis.hpp"
 #include "texture_layout.hpp"
@@ -69,6 +72,16 @@ public:
     /// not skin joints, an empty list and a model without clips go to suggestDriver itself.
     SuggestedDriver suggestDriver(const std::vector<std::pair<int, float>>& joints) const;
 
+    /// mapBody(model(), restSkin(), symmetryPlane()) (what each joint is), on the first call.
+    const BodyMap& bodyMap() const;
+    /// analyzeMotion(model(), restSkin(), bodyMap()) (the range-of-motion analysis), on the
+    /// first call.
+    const MotionAnalysis& motion() const;
+    /// proposePatterns(…) of this model (SPEC §8 proposals; bind space, so the same for every
+    /// layout), on the first call.
+    const std::vector<Proposal>& proposals() const;
+    int proposalBuilds() const { return proposalBuilds_.load(); }
+
     /// modelTextureLayout(model()) (SPEC §8: the model's own UVs as a height-map layout), built
     /// on the first call; the same object for the lifetime of this one (a stable key for the
     /// renderer's per-layout vertex arrays and for restSurface below).
@@ -109,6 +122,11 @@ private:
     mutable std::vector<bool> ranged_;                      ///< by node: a skin joint, in ranges_
     mutable std::atomic<int> lookupBuilds_{0}, restBuilds_{0}, planeBuilds_{0}, rangesBuilds_{0},
         diagnosisBuilds_{0};
+    mutable std::once_flag bodyOnce_, motionOnce_, proposalsOnce_;
+    mutable BodyMap body_;
+    mutable MotionAnalysis motion_;
+    mutable std::vector<Proposal> proposals_;
+    mutable std::atomic<int> proposalBuilds_{0};
     mutable std::once_flag layoutOnce_;
     mutable std::shared_ptr<const TextureLayout> layout_;
     struct RestEntry {

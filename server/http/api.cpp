@@ -230,6 +230,19 @@ bool intParam(const Req& req, Res& res, const char* name, std::optional<int>& ou
     return true;
 }
 
+bool boolParam(const Req& req, Res& res, const char* name, std::optional<bool>& out) {
+    if (!req.has_param(name)) return true;
+    const std::string v = req.get_param_value(name);
+    if (v == "true" || v == "1") out = true;
+    else if (v == "false" || v == "0") out = false;
+    else {
+        sendError(res, 422, "invalid_argument",
+                  std::string("dermis::Api: ") + name + ": must be true or false, not \"" + v + "\"", name);
+        return false;
+    }
+    return true;
+}
+
 bool revisionParam(const Req& req, Res& res, const char* name, std::optional<std::uint64_t>& out) {
     if (!req.has_param(name)) return true;
     const auto n = parseRevisionNumber(req.get_param_value(name));

@@ -78,6 +78,8 @@ std::vector<std::uint8_t> bytesOf(const std::string& s);
 /// present but malformed.
 bool intParam(const Req& req, Res& res, const char* name, std::optional<int>& out);
 bool numberParam(const Req& req, Res& res, const char* name, std::optional<double>& out);
+/// "true" / "false" (also "1" / "0").
+bool boolParam(const Req& req, Res& res, const char* name, std::optional<bool>& out);
 /// A revision number ≥ 1 (service parseRevisionNumber: the one parse of a revision number).
 bool revisionParam(const Req& req, Res& res, const char* name, std::optional<std::uint64_t>& out);
 /// The camera's `target=x,y,z` (three finite numbers, comma-separated; api_renders.cpp).

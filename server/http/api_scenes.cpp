@@ -1,5 +1,5 @@
 // Dermis HTTP shell — scene routes: documents (list, create, get, replace, delete), placements
-// (add, reorder, patch, remove), the pose (replace, merge), history (revisions, a revision's
+// (add, reorder, patch, remove, mirror, propose, transfer), the pose (replace, merge), history (revisions, a revision's
 // document, revert) and presence. Every edit answers {"id", "revision", "scene"} with
 // `ETag: "r<revision>"`, honours `If-Match` (412 stale_revision with the current revision) and
 // records `X-Dermis-Client`; a failed edit changes nothing (the Service validates first).
@@ -98,6 +98,30 @@ void installPlacementRoutes(RouteTable& t) {
         if (!r) return sendDocError(res, r.error());
         setEtag(res, *r);
         sendJson(res, 201, *r);
+    });
+    // SPEC §8: a pattern set proposed for the character (?apply=true adds it in one revision),
+    // and another scene's placements carried over onto it.
+    t.add("POST", "/scenes/{id}/propose", [](Api::Impl& a, const Req& req, Res& res) {
+        EditContext ctx;
+        if (!editContext(req, res, ctx)) return;
+        std::optional<bool> apply;
+        if (!boolParam(req, res, "apply", apply)) return;
+        auto r = a.svc.propose(req.matches[1], apply.value_or(false), ctx);
+        if (!r) return sendDocError(res, r.error());
+        if (apply.value_or(false)) setEtag(res, *r);
+        sendJson(res, apply.value_or(false) ? 201 : 200, *r);
+    });
+    t.add("POST", "/scenes/{id}/transfer", [](Api::Impl& a, const Req& req, Res& res) {
+        EditContext ctx;
+        if (!editContext(req, res, ctx)) return;
+        std::optional<bool> apply;
+        if (!boolParam(req, res, "apply", apply)) return;
+        json body;
+        if (!jsonBody(req, res, body)) return;
+        auto r = a.svc.transfer(req.matches[1], body, apply.value_or(true), ctx);
+        if (!r) return sendDocError(res, r.error());
+        if (apply.value_or(true)) setEtag(res, *r);
+        sendJson(res, apply.value_or(true) ? 201 : 200, *r);
     });
     t.add("PUT", "/scenes/{id}/pose",
           jsonEdit(200, [](Service& s, const Req& req, const json& body, const EditContext& ctx) {

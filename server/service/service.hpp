@@ -301,6 +301,28 @@ public:
     /// the twin is in the scene already (core findMirrorTwin) or `pid` is its own twin.
     Result<nlohmann::json> mirrorPlacement(const std::string& id, const std::string& pid,
                                            const EditContext& ctx = {});
+    /// A full pattern set for the scene's character (SPEC §8 proposals; core proposePatterns,
+    /// cached per model): {id, proposals: [{placement (canonical, surface), kind ("crease" |
+    /// "bone" | "bulge"), joint, score, twin (the twin proposal's id, or null), existing (the
+    /// scene's placement that already is this proposal, or null), why: {joint, role, axis,
+    /// neutral, peak, peak_clip, peak_time, synthetic, planarity, compression, stretch,
+    /// correlation, radius}}], applied: []}. With `apply`, the proposals not in the scene yet
+    /// are added in one revision (op "propose"; ids made unique, twins renamed with them) and
+    /// the answer is the edit's ({id, revision, scene}) plus `applied` (the new ids) and
+    /// `proposals`. Fails: NotFound (scene); Conflict ("placements") when every proposal is in
+    /// the scene already; like any edit (If-Match: a whole-document edit, never rebased).
+    Result<nlohmann::json> propose(const std::string& id, bool apply, const EditContext& ctx = {});
+    /// Another scene's placements carried onto this scene's character (SPEC §8 transfer; core
+    /// transferPlacements): `body` = {"from": scene id, "joint_map": {source joint: this
+    /// character's joint}?}. Answers {id, from, transferred: [{from (source id), placement
+    /// (canonical, surface)}], unmapped: [{placement, field, reason}], joints: {source: target}};
+    /// with `apply` the transferred placements are added in one revision (op "transfer from
+    /// <scene>"; ids made unique) and the answer is the edit's ({id, revision, scene}) plus
+    /// those members. Fails: InvalidArgument for a malformed body ("/from", "/joint_map",
+    /// unknown members) or when nothing could follow (with apply); NotFound ("/from") for an
+    /// unknown source scene; like any edit.
+    Result<nlohmann::json> transfer(const std::string& id, const nlohmann::json& body, bool apply,
+                                    const EditContext& ctx = {});
     /// `order`: every placement id once, in the new order.
     Result<nlohmann::json> reorderPlacements(const std::string& id, const nlohmann::json& order,
                                              const EditContext& ctx = {});

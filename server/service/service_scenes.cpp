@@ -23,16 +23,21 @@ const SceneVersion* SceneEntry::recentVersion(std::uint64_t r) const {
     return nullptr;
 }
 
-namespace {
-
-/// Index of placement `pid` in doc["placements"], or −1.
-int placementIndex(const json& doc, const std::string& pid) {
+int detail::placementIndex(const json& doc, const std::string& pid) {
     const auto pl = doc.find("placements");
     if (pl == doc.end() || !pl->is_array()) return -1;
     for (std::size_t i = 0; i < pl->size(); ++i)
         if ((*pl)[i].is_object() && (*pl)[i].value("id", "") == pid) return static_cast<int>(i);
     return -1;
 }
+
+std::string detail::uniquePlacementId(const json& doc, const std::string& base) {
+    std::string id = base;
+    for (int k = 2; placementIndex(doc, id) >= 0; ++k) id = base + "_" + std::to_string(k);
+    return id;
+}
+
+namespace {
 
 /// Placement `pid` of `doc`, or null when it has none.
 json placementOf(const json& doc, const std::string& pid) {
@@ -335,9 +340,7 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
         }
         // The twin's id: the source's with its side swapped (elbow_l → elbow_r), else from the
         // twin joint's side or "<pid>_twin"; "_2", "_3"… only when that is taken.
-        const std::string base = mirrorPlacementId(pid, twin->joint);
-        std::string newId = base;
-        for (int k = 2; placementIndex(doc, newId) >= 0; ++k) newId = base + "_" + std::to_string(k);
+        const std::string newId = uniquePlacementId(doc, mirrorPlacementId(pid, twin->joint));
         info.placement = newId;
         // toJson of a one-placement scene gives the placement's canonical form.
         Scene one;

@@ -156,6 +156,11 @@ struct PresenceEntry {
 /// textures' decoded bytes at most 4 × maxImageSide² × 4 (four full-size RGBA8 textures).
 GltfLimits gltfLimitsOf(const ServerLimits& limits);
 
+/// Index of placement `pid` in doc["placements"], or −1.
+int placementIndex(const json& doc, const std::string& pid);
+/// `base`, or `base` + "_2", "_3"… : the first that no placement of `doc` has.
+std::string uniquePlacementId(const json& doc, const std::string& base);
+
 Error bad(const std::string& field, const std::string& what);
 Error notFound(const std::string& field, const std::string& what);
 
