@@ -12,6 +12,7 @@
 #include "TestFiles.hpp"
 #include "core/lint.hpp"
 #include "core/model_derived.hpp"
+#include "core/propose.hpp"
 #include "core/pick.hpp"
 #include "gl/renderer.hpp"
 #include "io/gltf_loader.hpp"
@@ -377,11 +378,24 @@ TEST(ModelDerivedTest, ServiceRoutesAnswerAsFreshDataAndADeletedModelIsFreed) {
         EXPECT_EQ((*pick)["triangle"], hit->triangle);
         EXPECT_FLOAT_EQ((*pick)["position"][0].get<float>(), hit->position.x);
         EXPECT_FLOAT_EQ((*pick)["position"][2].get<float>(), hit->position.z);
-        const SuggestedDriver d = suggestDriver(model, hit->joints);
-        EXPECT_EQ((*pick)["suggested"]["joint"], d.joint);
-        EXPECT_EQ((*pick)["suggested"]["axis"], d.axis);
-        EXPECT_EQ((*pick)["suggested"]["theta_min"], d.thetaMin);
-        EXPECT_EQ((*pick)["suggested"]["theta_max"], d.thetaMax);
+        // The suggestion: core suggestFromMotion from a fresh analysis (SPEC §8).
+        const RestSkin rest = restSkin(model);
+        const BodyMap body = mapBody(model, rest, plane);
+        const MotionAnalysis motion = analyzeMotion(model, rest, body);
+        const MotionSuggestion d = suggestFromMotion(model, rest, plane, body, motion,
+                                                     proposePatterns(model, rest, plane, body, motion),
+                                                     hit->joints, glm::dvec3(hit->position));
+        EXPECT_EQ((*pick)["suggested"]["joint"], d.driver.joint);
+        if (d.axisVector) {
+            ASSERT_TRUE((*pick)["suggested"]["axis"].is_array());
+            for (int k = 0; k < 3; ++k)
+                EXPECT_NEAR((*pick)["suggested"]["axis"][k].get<double>(), (*d.axisVector)[k], 1e-9);
+        } else {
+            EXPECT_EQ((*pick)["suggested"]["axis"], d.driver.axis);
+        }
+        EXPECT_EQ((*pick)["suggested"]["theta_min"], d.driver.thetaMin);
+        EXPECT_EQ((*pick)["suggested"]["theta_max"], d.driver.thetaMax);
+        EXPECT_EQ((*pick)["suggested"]["role"], d.role);
 
         // Mirror: the twin core mirrorPlacement makes with a fresh lookup and plane.
         auto mirrored = s.mirrorPlacement(id, "knee_l", {});

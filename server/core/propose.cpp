@@ -426,4 +426,79 @@ std::vector<Proposal> proposePatterns(const Model& model, const RestSkin& rest, 
     return out;
 }
 
+MotionSuggestion suggestFromMotion(const Model& model, const RestSkin& rest, const SymmetryPlane& plane,
+                                   const BodyMap& body, const MotionAnalysis& motion,
+                                   const std::vector<Proposal>& proposals,
+                                   const std::vector<std::pair<int, float>>& joints, glm::dvec3 position) {
+    MotionSuggestion out;
+    const auto setAxis = [&](glm::dvec3 a) {
+        a = glm::normalize(a);
+        for (int k = 0; k < 3; ++k)
+            if (std::abs(a[k] - 1.0) < 1e-4) {
+                out.driver.axis = std::string(1, static_cast<char>('x' + k));
+                out.axisVector.reset();
+                return;
+            }
+        out.driver.axis.clear();
+        out.axisVector = glm::dvec3(round6(a.x), round6(a.y), round6(a.z));
+    };
+    // A proposal's decal holding the point.
+    double bestArea = std::numeric_limits<double>::max();
+    for (const Proposal& pr : proposals) {
+        const Placement& p = pr.placement;
+        const glm::dvec3 c(p.anchor.position[0], p.anchor.position[1], p.anchor.position[2]);
+        const glm::dvec3 n(p.anchor.normal[0], p.anchor.normal[1], p.anchor.normal[2]);
+        const glm::dvec3 t(p.anchor.tangent[0], p.anchor.tangent[1], p.anchor.tangent[2]);
+        const glm::dvec3 d = position - c;
+        const double area = p.size[0] * p.size[1];
+        if (std::abs(glm::dot(d, n)) > p.depthOrDefault() || std::abs(glm::dot(d, t)) > 0.5 * p.size[0] ||
+            std::abs(glm::dot(d, glm::cross(n, t))) > 0.5 * p.size[1] || area >= bestArea)
+            continue;
+        bestArea = area;
+        out.driver.joint = p.joint;
+        out.driver.thetaMin = p.thetaMin;
+        out.driver.thetaMax = p.thetaMax;
+        setAxis(glm::dvec3(p.axis[0], p.axis[1], p.axis[2]));
+        out.role = pr.why.role;
+        out.proposal = p.id;
+    }
+    if (!out.proposal.empty()) return out;
+    // The weighted joint the clips move most.
+    int best = -1;
+    double bestScore = 0.0;
+    for (auto [node, weight] : joints) {
+        const JointMotion* jm = motion.motion(node);
+        if (!jm || jm->synthetic) continue;
+        const double score = weight * (jm->peak - jm->neutral);
+        if (score > bestScore) {
+            bestScore = score;
+            best = node;
+        }
+    }
+    if (best < 0) {
+        out.driver = suggestDriver(model, joints);
+        const int n = model.findJoint(out.driver.joint);
+        if (n >= 0) out.role = describeJoint(model, body, n);
+        return out;
+    }
+    JointMotion jm = *motion.motion(best);
+    const JointInfo* info = body.info(best);
+    if (info && info->side == 'r') {
+        const int left = body.find(info->role, 'l');
+        const JointMotion* lm = motion.motion(left);
+        if (left >= 0 && lm && !lm->synthetic && info->role != JointRole::Other) {
+            const glm::vec3 mirrored = mirrorAxis(model, left, best, glm::vec3(lm->axis), plane.axis);
+            const JointMotion about = motionAbout(model, motion, best, glm::dvec3(mirrored));
+            if (about.peak > about.neutral) jm = about;
+        }
+    }
+    (void)rest;
+    out.driver.joint = model.nodes[static_cast<std::size_t>(best)].name;
+    out.driver.thetaMin = roundHalf(jm.neutral);
+    out.driver.thetaMax = roundHalf(jm.peak);
+    setAxis(jm.axis);
+    out.role = describeJoint(model, body, best);
+    return out;
+}
+
 } // namespace dermis

@@ -37,6 +37,7 @@
 
 #include "body_map.hpp"
 #include "motion.hpp"
+#include "pick.hpp"
 #include "scene.hpp"
 
 #include <string>
@@ -71,5 +72,22 @@ struct Proposal {
 /// Never fails; a model without joints gets none.
 std::vector<Proposal> proposePatterns(const Model& model, const RestSkin& rest, const SymmetryPlane& plane,
                                       const BodyMap& body, const MotionAnalysis& motion);
+
+/// A pick's driver from the same analysis (SPEC §8 pick `suggested`; issue #23): the driver of
+/// the proposal whose decal holds `position` (bind space: within its depth and its footprint;
+/// the smallest such) — a point on the biceps gets the elbow; else, of the weighted `joints`,
+/// the one whose clips move it most (weight × (peak − neutral)), with its principal axis (on a
+/// right joint whose left twin moves too: the mirror image of the left's axis, so both sides
+/// agree) and θ from its neutral angle to its peak; else core suggestDriver's answer.
+struct MotionSuggestion {
+    SuggestedDriver driver;            ///< axis "x"/"y"/"z", or "" with `axisVector`
+    std::optional<glm::dvec3> axisVector;
+    std::string role;                  ///< describeJoint of the driver ("left elbow")
+    std::string proposal;              ///< the id of the proposal it came from ("" none)
+};
+MotionSuggestion suggestFromMotion(const Model& model, const RestSkin& rest, const SymmetryPlane& plane,
+                                   const BodyMap& body, const MotionAnalysis& motion,
+                                   const std::vector<Proposal>& proposals,
+                                   const std::vector<std::pair<int, float>>& joints, glm::dvec3 position);
 
 } // namespace dermis

@@ -12,6 +12,8 @@
 #include "core/pick.hpp"
 #include "core/probe.hpp"
 #include "core/surface_outline.hpp"
+#include "core/surface_query.hpp"
+#include "core/propose.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -29,19 +31,29 @@ double rounded(double x) {
 }
 
 /// The pick answer of a hit (shared by the frame and texture picks); the suggestion from the
-/// model's cached clip ranges (ModelDerived::suggestDriver, equal to core suggestDriver). `uv` is
+/// range-of-motion analysis of `analysis` (the model's own derived data, cached: core
+/// suggestFromMotion — a proposal's driver where one covers the hit). `uv` is
 /// in `layout` (the scene's height-map layout, SPEC §8) when given and covering the hit;
 /// `anchor` is where a surface placement would sit there (bind space; tangent across the
 /// suggested joint's bone).
-json pickAnswer(const ModelDerived& derived, const PickHit& h, const TextureLayout* layout) {
+json pickAnswer(const ModelDerived& derived, const PickHit& h, const TextureLayout* layout,
+                const ModelDerived& analysis) {
     const Model& m = derived.model();
     json joints = json::array();
     for (auto [node, weight] : h.joints)
         joints.push_back({{"name", m.nodes[static_cast<std::size_t>(node)].name}, {"weight", weight}});
-    const SuggestedDriver d = derived.suggestDriver(h.joints);
     glm::vec2 uv = h.uv;
     if (layout)
         if (auto l = layoutUv(*layout, h)) uv = *l;
+    // The driver from the range-of-motion analysis (SPEC §8; core suggestFromMotion), cached
+    // per model with the proposals it reads.
+    const glm::dvec3 bind = [&] {
+        if (h.part < 0 || static_cast<std::size_t>(h.part) >= m.parts.size()) return glm::dvec3(0.0);
+        return bindPositionAt(m, SurfacePoint{static_cast<std::size_t>(h.part), 3 * static_cast<std::size_t>(h.triangle), glm::dvec3(h.bary)});
+    }();
+    const MotionSuggestion s = suggestFromMotion(m, analysis.restSkin(), analysis.symmetryPlane(), analysis.bodyMap(),
+                                                 analysis.motion(), analysis.proposals(), h.joints, bind);
+    const SuggestedDriver& d = s.driver;
     const PickAnchor a = pickAnchor(m, h, d.joint.empty() ? -1 : findPosable(m, d.joint), derived.restSkin().world);
     const auto vec = [](glm::dvec3 v) { return json::array({v.x, v.y, v.z}); };
     return json{{"hit", true},
@@ -51,8 +63,12 @@ json pickAnswer(const ModelDerived& derived, const PickHit& h, const TextureLayo
                 {"part", h.part},
                 {"triangle", h.triangle},
                 {"joints", std::move(joints)},
-                {"suggested", {{"joint", d.joint}, {"axis", d.axis}, {"theta_min", d.thetaMin},
-                               {"theta_max", d.thetaMax}}}};
+                {"suggested", {{"joint", d.joint},
+                               {"axis", s.axisVector ? vec(*s.axisVector) : json(d.axis)},
+                               {"theta_min", d.thetaMin},
+                               {"theta_max", d.thetaMax},
+                               {"role", s.role},
+                               {"proposal", s.proposal.empty() ? json() : json(s.proposal)}}}};
 }
 
 } // namespace
@@ -168,7 +184,8 @@ Result<json> Service::pick(const std::string& id, const FrameParams& params, dou
     auto hit = pickFrame(*plan, *snap->model, x, y);
     if (!hit) return hit.error();
     if (!*hit) return json{{"hit", false}};
-    return pickAnswer(*state_->derivedOf(*snap), **hit, plan->heights.layout.get());
+    const auto derived = state_->derivedOf(*snap);
+    return pickAnswer(*derived, **hit, plan->heights.layout.get(), *derived);
 }
 
 
@@ -183,7 +200,7 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     if (!derived->model().hasUVs()) return bad("u", "the model has no UVs: nothing lies at a texture point");
     const auto hit = dermis::pickUv(derived->model(), derived->uvLookup(), {u, v});
     if (!hit) return json{{"hit", false}};
-    return pickAnswer(*derived, *hit, nullptr);
+    return pickAnswer(*derived, *hit, nullptr, *state_->derivedOf(*snap));
 }
 
 Result<json> Service::placementOutline(const std::string& id, const std::string& pid,

@@ -295,6 +295,20 @@ try {
   // The default set has elbow_l's twin already: 409 naming it; the small scene gets one (201).
   await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { id, pid: "elbow_l" }, expect: 409 });
   await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { ...S, pid: "elbow_l" }, expect: 201 });
+  // SPEC 8: proposals (a preview, then applied on an empty scene of the default character) and a
+  // transfer of the default set onto it (a preview, then applied).
+  const empty = { format: "dermis.scene/1", model: "builtin:default", heightmap: { size: [128, 128] }, placements: [] };
+  const P = { id: (await api("POST", "/scenes", { body: empty, expect: 201 })).json().id };
+  const proposed = (await api("POST", "/scenes/{id}/propose", { params: P, expect: 200 })).json();
+  assert.ok(proposed.proposals.length > 0, "proposals for the default character");
+  const applied = (await api("POST", "/scenes/{id}/propose", { params: P, query: "apply=true", expect: 201 })).json();
+  assert.equal(applied.applied.length, proposed.proposals.length);
+  await api("POST", "/scenes/{id}/propose", { params: P, query: "apply=true", expect: 409 });
+  await api("POST", "/scenes/{id}/propose", { params: P, query: "apply=maybe", expect: 422 });
+  await api("POST", "/scenes/{id}/transfer", { params: P, query: "apply=false", body: { from: id }, expect: 200 });
+  await api("POST", "/scenes/{id}/transfer", { params: P, body: { from: id, joint_map: { "forearm.l": "forearm.l" } }, expect: 201 });
+  await api("POST", "/scenes/{id}/transfer", { params: P, body: { from: "s_0000000000000000" }, expect: 404 });
+  await api("POST", "/scenes/{id}/transfer", { params: P, body: { from: id, bogus: 1 }, invalidRequest: true, expect: 422 });
   await api("PATCH", "/scenes/{id}/pose", { params: { id }, body: { time: 0.25 }, expect: 200 });
   await api("POST", "/scenes/{id}/presence", { params: S, body: { client: "ben", selection: ["elbow_l"], color: "#0af" }, expect: 200 });
   await api("GET", "/scenes/{id}/presence", { params: S, expect: 200 });
