@@ -46,19 +46,6 @@ glm::dvec3 skinVertex(const MeshPart& p, std::uint32_t v, const std::vector<glm:
     return glm::dvec3(m * glm::dvec4(glm::dvec3(p.positions[v]), 1.0));
 }
 
-/// Whether some corner of the triangle weighs ≥ 0.1 on one of `nodes`.
-bool weighsOn(const MeshPart& p, std::size_t base, const std::set<int>& nodes) {
-    for (int c = 0; c < 3; ++c) {
-        const std::uint32_t v = p.indices[base + static_cast<std::size_t>(c)];
-        if (v >= p.joints.size() || v >= p.weights.size()) continue;
-        for (int k = 0; k < 4; ++k) {
-            const std::size_t inf = p.joints[v][k];
-            if (p.weights[v][k] >= 0.1f && inf < p.influences.size() && nodes.count(p.influences[inf].node)) return true;
-        }
-    }
-    return false;
-}
-
 /// Triangles of `nodes` whose rest centroid is within `radius` of x and whose rest normal faces
 /// `dir` (cosine > 0.2).
 std::vector<Tri> regionNear(const Ctx& c, glm::dvec3 x, glm::dvec3 dir, double radius, const std::set<int>& nodes) {
@@ -73,7 +60,7 @@ std::vector<Tri> regionNear(const Ctx& c, glm::dvec3 x, glm::dvec3 dir, double r
             if (glm::length((a + b + cc) / 3.0 - x) > radius) continue;
             const glm::dvec3 n = glm::cross(b - a, cc - a);
             if (!(glm::length(n) > 0.0) || glm::dot(glm::normalize(n), dir) < 0.2) continue;
-            if (!weighsOn(p, t, nodes)) continue;
+            if (!triangleWeighsOn(p, t, nodes)) continue;
             out.push_back({pi, t});
         }
     }
@@ -227,7 +214,7 @@ void proposeAt(const Ctx& c, int j, const JointMotion& jm, const std::vector<Sit
     d = glm::normalize(d);
     const double maxRay = 0.5 * c.body.height;
     const auto accept = [&](std::size_t part, int tri) {
-        return weighsOn(c.model.parts[part], static_cast<std::size_t>(tri) * 3, nodes);
+        return triangleWeighsOn(c.model.parts[part], static_cast<std::size_t>(tri) * 3, nodes);
     };
     const std::vector<std::vector<glm::dvec3>> posedAll = [&] {
         std::vector<std::vector<glm::dvec3>> p(c.model.parts.size());

@@ -173,6 +173,20 @@ glm::dvec3 restNormalAt(const Model& m, const RestSkin& rest, const SurfacePoint
     return normalAt(rest.parts[sp.part].positions, rest.parts[sp.part].normals, m.parts[sp.part], sp);
 }
 
+bool triangleWeighsOn(const MeshPart& p, std::size_t base, const std::set<int>& nodes, float minWeight) {
+    for (int c = 0; c < 3; ++c) {
+        const std::size_t at = base + static_cast<std::size_t>(c);
+        if (at >= p.indices.size()) return false;
+        const std::uint32_t v = p.indices[at];
+        if (v >= p.joints.size() || v >= p.weights.size()) continue;
+        for (int k = 0; k < 4; ++k) {
+            const std::size_t inf = p.joints[v][k];
+            if (p.weights[v][k] >= minWeight && inf < p.influences.size() && nodes.count(p.influences[inf].node)) return true;
+        }
+    }
+    return false;
+}
+
 std::vector<const std::vector<glm::vec3>*> bindPositions(const Model& m) {
     std::vector<const std::vector<glm::vec3>*> out;
     for (const MeshPart& p : m.parts) out.push_back(&p.positions);

@@ -14,6 +14,7 @@
 
 #include <functional>
 #include <optional>
+#include <set>
 #include <vector>
 
 namespace dermis {
@@ -62,6 +63,10 @@ glm::dvec3 bindNormalAt(const Model& m, const SurfacePoint& sp);
 /// The same in rest world space, from `rest`'s skinned parts.
 glm::dvec3 restPositionAt(const Model& m, const RestSkin& rest, const SurfacePoint& sp);
 glm::dvec3 restNormalAt(const Model& m, const RestSkin& rest, const SurfacePoint& sp);
+
+/// Whether some corner of the triangle at `base` (first index in `p.indices`) has a skin weight
+/// ≥ `minWeight` on one of `nodes`.
+bool triangleWeighsOn(const MeshPart& p, std::size_t base, const std::set<int>& nodes, float minWeight = 0.1f);
 
 /// Pointers to each part's bind-space positions / `rest`'s rest-world positions, for the
 /// queries above.

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 namespace dermis {
 
@@ -187,13 +188,41 @@ TransferResult transferPlacements(const std::vector<Placement>& placements, cons
         }
         const double along = glm::dot(x - s.a, s.d) / s.length;
         const glm::dvec3 radial = x - (s.a + along * s.length * s.d);
-        const double phi = std::atan2(glm::dot(radial, s.e2), glm::dot(radial, s.e1));
+        // The angle around the bone from the surface normal there (⟂ the bone): the side of the
+        // limb the anchor is on, also where a rig puts its joints near the skin (the default
+        // character's clavicles), where the radial vector from the bone says little.
+        const glm::dvec3 nw = glm::normalize(glm::transpose(glm::inverse(lin)) *
+                                             glm::dvec3(p.anchor.normal[0], p.anchor.normal[1], p.anchor.normal[2]));
+        glm::dvec3 side = nw - glm::dot(nw, s.d) * s.d;
+        if (!(glm::length(side) > 0.2)) side = radial;
+        const double phi = std::atan2(glm::dot(side, s.e2), glm::dot(side, s.e1));
         const double ratio = t.length / s.length;
         const glm::dvec3 q = t.a + along * t.length * t.d;
-        const glm::dvec3 dir = std::cos(phi) * t.e1 + std::sin(phi) * t.e2;
+        // A limb's segment (both ends off the symmetry plane) turns with the limb (a T-pose arm
+        // onto an A-pose one): the angle around the bone. A segment from the trunk (the chest to
+        // a shoulder without a clavicle) runs through the body: the world direction of the
+        // normal is kept instead.
+        const auto sided = [&](int node) {
+            const JointInfo* i = to.body.info(node);
+            return i && i->side != 0;
+        };
+        const bool limb = useIn ? sided(boneParent(to.model, to.body, tj)) && sided(tj)
+                                : sided(tj) && sided(boneChild(to.model, to.body, tj));
+        const glm::dvec3 dir = limb ? std::cos(phi) * t.e1 + std::sin(phi) * t.e2 : nw;
+        // The skin of the bone's joints first (not a prop, the beard or another limb in the way).
+        std::vector<int> twists;
+        std::set<int> near{tj};
+        if (const int bp = boneParent(to.model, to.body, tj, &twists); bp >= 0) near.insert(bp);
+        if (const int bc = boneChild(to.model, to.body, tj, &twists); bc >= 0) near.insert(bc);
+        near.insert(twists.begin(), twists.end());
+        const double reach = 4.0 * std::max(t.length, glm::length(radial) * ratio);
         std::optional<SurfacePoint> hitPoint;
-        if (auto hit = castRay(to.model, dstRest, q, dir, 4.0 * std::max(t.length, glm::length(radial) * ratio)))
+        if (auto hit = castRay(to.model, dstRest, q, dir, reach, [&](std::size_t part, int tri) {
+                return triangleWeighsOn(to.model.parts[part], 3 * static_cast<std::size_t>(tri), near);
+            }))
             hitPoint = hit->point;
+        else if (auto any = castRay(to.model, dstRest, q, dir, reach))
+            hitPoint = any->point;
         else
             hitPoint = nearestSurfacePoint(to.model, dstRest, q + glm::length(radial) * ratio * dir);
         if (!hitPoint) {
@@ -203,7 +232,7 @@ TransferResult transferPlacements(const std::vector<Placement>& placements, cons
         // Back to the target's bind space.
         const glm::dvec3 pos = bindPositionAt(to.model, *hitPoint), n = bindNormalAt(to.model, *hitPoint);
         const glm::dmat3 lin2(restSkinningAt(to.model, to.rest, *hitPoint));
-        const glm::dvec3 twTarget = fromFrame(t, toFrame(s, tw));
+        const glm::dvec3 twTarget = limb ? fromFrame(t, toFrame(s, tw)) : tw;
         glm::dvec3 tb = std::abs(glm::determinant(lin2)) > 1e-12 ? glm::inverse(lin2) * twTarget : twTarget;
         tb -= glm::dot(tb, n) * n;
         if (!(glm::length(tb) > 1e-9)) tb = std::abs(n.x) < 0.9 ? glm::cross(n, glm::dvec3(1, 0, 0)) : glm::cross(n, glm::dvec3(0, 1, 0));

@@ -6,10 +6,13 @@
 //            joints of one role (spine_01…chest) the one at the same fraction of that run.
 //   anchor:  re-expressed relative to the driver's bone — of the segments into and out of the
 //            driver joint (twist helpers skipped), the one nearest to the anchor: position along
-//            it (a fraction of its length), angle around it (from the body's forward direction,
-//            +z) and distance from it — then cast from the same place of the matching segment
-//            of the target, outward at that angle, onto the target's rest surface; taken to bind
-//            space through the rest skinning there.
+//            it (a fraction of its length) and angle around it (from the body's forward direction,
+//            +z, to the anchor's normal made ⟂ the bone; to the anchor itself where the normal
+//            runs along the bone) — then cast from the same place of the matching segment
+//            of the target, outward at that angle, onto the target's rest surface (the skin of
+//            the bone's joints first); taken to bind space through the rest skinning there. A
+//            segment from the trunk (chest → shoulder where the target has no clavicle) runs
+//            through the body: there the normal's world direction is cast along instead.
 //   size:    scaled by the segments' length ratio (depth too, when set); the tangent and the
 //            driver axis keep their angles to the bone's frame (so a T-pose and an A-pose
 //            character get the same bend).
