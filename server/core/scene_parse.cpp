@@ -437,6 +437,9 @@ Status parseJointPose(const Reader& rd, const json& v, const std::string& ptr, J
         if (auto s = rd.object(*axisAngles, p); !s) return s;
         std::array<double, 3> angles{0, 0, 0};
         static constexpr const char* kNames[3] = {"x", "y", "z"};
+        for (auto e = axisAngles->begin(); e != axisAngles->end(); ++e)
+            if (e.key() != "x" && e.key() != "y" && e.key() != "z")
+                return rd.bad(p + "/" + e.key(), "not an axis: the angles are about x, y and z");
         for (std::size_t i = 0; i < 3; ++i) {
             if (const json* a = Reader::find(*axisAngles, kNames[i])) {
                 auto d = rd.numberIn(*a, p + "/" + kNames[i], -kMaxAngle, kMaxAngle);

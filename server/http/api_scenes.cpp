@@ -94,10 +94,12 @@ void installPlacementRoutes(RouteTable& t) {
     t.add("POST", "/scenes/{id}/placements/{pid}/mirror", [](Api::Impl& a, const Req& req, Res& res) {
         EditContext ctx;
         if (!editContext(req, res, ctx)) return;
-        auto r = a.svc.mirrorPlacement(req.matches[1], req.matches[2], ctx);
+        std::optional<bool> update;
+        if (!boolParam(req, res, "update", update)) return;
+        auto r = a.svc.mirrorPlacement(req.matches[1], req.matches[2], ctx, update.value_or(false));
         if (!r) return sendDocError(res, r.error());
         setEtag(res, *r);
-        sendJson(res, 201, *r);
+        sendJson(res, update.value_or(false) ? 200 : 201, *r);
     });
     // SPEC §8: a pattern set proposed for the character (?apply=true adds it in one revision),
     // and another scene's placements carried over onto it.

@@ -298,9 +298,11 @@ public:
     /// unique ("_2"…), label from mirrorLabel. Computed under the writer lock from the current
     /// document. Fails: InvalidArgument when the footprint centre is on no chart or the joint
     /// has no twin by name or position; Conflict (field "placement", the message naming it) when
-    /// the twin is in the scene already (core findMirrorTwin) or `pid` is its own twin.
+    /// the twin is in the scene already (core findMirrorTwin) or `pid` is its own twin — unless
+    /// `update`: then that twin is replaced by the new mirror image in place (its id and place
+    /// in the order kept; event placement_updated, op "mirror placement <pid> onto <twin>").
     Result<nlohmann::json> mirrorPlacement(const std::string& id, const std::string& pid,
-                                           const EditContext& ctx = {});
+                                           const EditContext& ctx = {}, bool update = false);
     /// A full pattern set for the scene's character (SPEC §8 proposals; core proposePatterns,
     /// cached per model): {id, proposals: [{placement (canonical, surface), kind ("crease" |
     /// "bone" | "bulge"), joint, score, twin (the twin proposal's id, or null), existing (the

@@ -295,7 +295,7 @@ Result<json> Service::deletePlacement(const std::string& id, const std::string& 
 }
 
 Result<json> Service::mirrorPlacement(const std::string& id, const std::string& pid,
-                                      const EditContext& ctx) {
+                                      const EditContext& ctx, bool update) {
     // The model's derived data (UV index, rest skin, symmetry plane) is built here, before the
     // writer lock, so that a first mirror on a large model holds no other edit back meanwhile.
     if (auto warm = state_->snapshot(id)) {
@@ -329,6 +329,19 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
         // Mirroring twice stacks nothing: a placement that already is the twin answers 409.
         if (const int k = findMirrorTwin(snap->scene, *twin); k >= 0) {
             const std::string& existing = snap->scene.placements[static_cast<std::size_t>(k)].id;
+            const int there = placementIndex(doc, existing);
+            if (update && existing != pid && there >= 0) {
+                // The twin is brought up to date in place: its id and order kept.
+                info.type = "placement_updated";
+                info.op = "mirror placement " + pid + " onto " + existing;
+                info.placement = existing;
+                Scene one;
+                one.placements.push_back(*twin);
+                one.placements[0].id = existing;
+                one.placements[0].pattern = doc["placements"][static_cast<std::size_t>(at)]["pattern"];
+                doc["placements"][static_cast<std::size_t>(there)] = dermis::toJson(one)["placements"][0];
+                return Ok{};
+            }
             const std::string why =
                 existing == pid ? "placement \"" + pid + "\" is its own mirror twin (it lies on "
                                   "the model's symmetry plane)"

@@ -295,6 +295,7 @@ try {
   // The default set has elbow_l's twin already: 409 naming it; the small scene gets one (201).
   await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { id, pid: "elbow_l" }, expect: 409 });
   await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { ...S, pid: "elbow_l" }, expect: 201 });
+  await api("POST", "/scenes/{id}/placements/{pid}/mirror", { params: { ...S, pid: "elbow_l" }, query: "update=true", expect: 200 });
   // SPEC 8: proposals (a preview, then applied on an empty scene of the default character) and a
   // transfer of the default set onto it (a preview, then applied).
   const empty = { format: "dermis.scene/1", model: "builtin:default", heightmap: { size: [128, 128] }, placements: [] };

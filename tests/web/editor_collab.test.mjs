@@ -6,8 +6,8 @@
 // notice and leaves the first person's change intact; a permalink opened in a fresh context gives
 // the identical frame (SHA-256 of the bytes); killing the server shows the offline banner, which
 // clears when it is back (same port, same data) and the editor re-syncs; the scene document
-// downloads; a dropped .glb makes a new scene; copying another scene's placements lists those
-// whose joints the model lacks.
+// downloads; a dropped .glb makes a new scene; Transfer from… another scene previews what comes
+// over (and what does not) and applies it in one revision.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, runSuite, until, sleep } from "./editor_lib.mjs";
@@ -124,24 +124,28 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       assert.equal(s.doc.placements.length, 0);
       assert.equal((await api("GET", `/scenes/${s.sceneId}`)).status, 200);
     }],
-    ["copy another scene's placements: those whose joints this model lacks are listed", async () => {
-      await a.click("#copyFrom");
-      await a.selectOption("#copySource", sceneId);
-      await a.click("#copyGo");
-      await a.waitForFunction(() => /Copied 0\./.test(document.getElementById("copyResult").textContent), null, { timeout: 10000 });
-      const listed = await a.$$eval("#copyResult li", (l) => l.map((e) => e.textContent));
-      const source = (await api("GET", `/scenes/${sceneId}`)).body.scene.placements;
-      assert.equal(listed.length, source.length);
+    ["Transfer from… another scene: the preview lists what comes over and what does not; Transfer applies it", async () => {
+      const here = (await state(a)).sceneId;
+      const preview = (await api("POST", `/scenes/${here}/transfer?apply=false`, { from: sceneId })).body;
+      await a.click("#transferFrom");
+      await a.selectOption("#transferSource", sceneId);
+      await a.waitForFunction((n) => /come over/.test(document.getElementById("transferResult").textContent) && document.querySelectorAll("#transferList li").length === n, preview.transferred.length, { timeout: 10000 });
+      assert.equal(await a.$$eval("#transferUnmapped li", (l) => l.length), preview.unmapped.length);
+      await a.click("#transferGo");
+      await a.waitForFunction((n) => document.getElementById("transferResult").textContent.includes(`Transferred ${n} in one revision`), preview.transferred.length, { timeout: 10000 });
+      assert.equal((await api("GET", `/scenes/${here}`)).body.scene.placements.length, preview.transferred.length);
       await a.keyboard.press("Escape");
-      // Onto a new scene of the default character every placement maps.
+      // Onto a new scene of the default character every placement maps, with its id.
+      const source = (await api("GET", `/scenes/${sceneId}`)).body.scene.placements;
       const empty = await api("POST", "/scenes", { format: "dermis.scene/1", model: "builtin:default", placements: [] });
       assert.equal(empty.status, 201);
       await a.goto(`${server.base}/?scene=${empty.body.id}`);
       await a.waitForFunction((id) => window.dermisEditor && window.dermisEditor.store.sceneId === id, empty.body.id, { timeout: 30000 });
-      await a.click("#copyFrom");
-      await a.selectOption("#copySource", sceneId);
-      await a.click("#copyGo");
-      await a.waitForFunction((n) => document.getElementById("copyResult").textContent.startsWith(`Copied ${n}.`), source.length, { timeout: 10000 });
+      await a.click("#transferFrom");
+      await a.selectOption("#transferSource", sceneId);
+      await a.waitForFunction((n) => document.getElementById("transferGo").textContent === `Transfer ${n}`, source.length, { timeout: 10000 });
+      await a.click("#transferGo");
+      await a.waitForFunction((n) => document.getElementById("transferResult").textContent.includes(`Transferred ${n} in one revision`), source.length, { timeout: 10000 });
       const copied = (await api("GET", `/scenes/${empty.body.id}`)).body.scene.placements;
       assert.deepEqual(copied.map((p) => p.id), source.map((p) => p.id));
       await a.keyboard.press("Escape");

@@ -6,10 +6,11 @@
 // units; [ and ] size the brush while the tool is on) or, with "Place as: in the texture", a UV
 // placement at the hit's UV. The selection is outlined on the skin (frame `highlight`), the hovered
 // placement too (`hover`), and the place tool's brush (`surface_brush`: a circle on the body, or
-// `brush`: a UV footprint). View modes shaded / bump /
-// displacement / normal; compare with a split slider, flicker, or the diff heat map against
-// "patterns off" or a chosen revision (compare images carry no outlines). The bar's Turntable
-// button shows the selection's range of motion as an animated WebP (GET turntable).
+// `brush`: a UV footprint) — with the tool off, `surface_brush` outlines the Propose… panel's
+// current proposal instead (its ghost). View modes shaded / bump / displacement / normal; compare
+// with a split slider, flicker, or the diff heat map against "patterns off" or a chosen revision
+// (compare images carry no outlines). The bar's Turntable button shows the selection's range of
+// motion as an animated WebP (GET turntable).
 //
 // While a drag runs in the texture view, frames preview the dragged placement (the frame route's
 // `preview`: nothing stored) at each pointer move, with MSAA off; the edits go to the server at
@@ -21,7 +22,7 @@ import { API, query } from "./api.js";
 import * as geo from "./geometry.js";
 import { notify } from "./notice.js";
 import { addPlacement } from "./edits.js";
-import { placementFromPattern, surfacePlacementFromPattern } from "./placing.js";
+import { placementFromPattern, surfacePlacementFromPattern, applySuggested } from "./placing.js";
 import { trace } from "./trace.js";
 import { frameFormat } from "./frame_format.js";
 import { initCamera, noteFrameCamera, pointer, frameSelection, resolvedCamera } from "./camera3d.js";
@@ -166,7 +167,7 @@ export function initFrameView(section, theApi) {
     $("frameSelection").disabled = !has;
     $("turntable").disabled = !has;
   });
-  on("doc revision camera view compare solo time pinnedRevision gestures drag selection", () => {
+  on("doc revision camera view compare solo time pinnedRevision gestures drag selection ghost", () => {
     $("viewMode").value = store.view;
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
@@ -279,7 +280,7 @@ export function frameParams(outlines = true) {
     highlight: outlines && selected.length ? selected.join(",") : undefined,
     hover: outlines ? hover : undefined,
     brush: outlines && placeTool && pointer.brush && pointer.brush.uv ? pointer.brush.uv.join(",") : undefined,
-    surface_brush: outlines && placeTool && pointer.brush && pointer.brush.surface ? pointer.brush.surface.join(",") : undefined,
+    surface_brush: !outlines ? undefined : placeTool && pointer.brush && pointer.brush.surface ? pointer.brush.surface.join(",") : ghostBrush(),
   };
 }
 
@@ -416,6 +417,14 @@ export function openTurntable() {
 
 let currentPattern = () => null;
 let previewSource = () => null;
+let ghostSource = () => null;
+/// fn() → [x, y, z, nx, ny, nz, diameter]: a ghost outlined on the body as the surface brush's
+/// dashed circle while the place tool is off (a proposal of the Propose… panel), or null.
+export function setGhostSource(fn) { ghostSource = fn; }
+function ghostBrush() {
+  const g = ghostSource();
+  return g ? g.map((x) => Math.round(x * 1e5) / 1e5).join(",") : undefined;
+}
 /// fn() → {placementId: fields} the frames preview (a drag in the texture view), or null.
 export function setPreviewSource(fn) { previewSource = fn; }
 export function setPatternSource(fn) { currentPattern = fn; }
@@ -427,8 +436,7 @@ export async function placeOnBody(anchor, suggested) {
   if (!pattern) return notify("Choose a pattern in the library first.", "warn");
   const d = brushSize();
   if (!d) return notify("The 3D view has not shown a frame yet.", "warn");
-  const body = surfacePlacementFromPattern(pattern, anchor, d);
-  if (suggested) Object.assign(body, { joint: suggested.joint, axis: suggested.axis, theta_min: suggested.theta_min, theta_max: suggested.theta_max });
+  const body = applySuggested(surfacePlacementFromPattern(pattern, anchor, d), suggested, pattern);
   const answer = await addPlacement(body);
   if (answer) set({ selection: [answer.scene.placements[answer.scene.placements.length - 1].id] });
 }
@@ -437,8 +445,7 @@ export async function placeOnBody(anchor, suggested) {
 export async function placeAt(uv, suggested) {
   const pattern = currentPattern();
   if (!pattern) return notify("Choose a pattern in the library first.", "warn");
-  const body = placementFromPattern(pattern, uv);
-  if (suggested) Object.assign(body, { joint: suggested.joint, axis: suggested.axis, theta_min: suggested.theta_min, theta_max: suggested.theta_max });
+  const body = applySuggested(placementFromPattern(pattern, uv), suggested, pattern);
   const answer = await addPlacement(body);
   if (answer) set({ selection: [answer.scene.placements[answer.scene.placements.length - 1].id] });
 }

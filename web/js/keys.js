@@ -11,8 +11,9 @@ import { cancelDecalDrag } from "./camera3d.js";
 import { currentPattern, choosePattern } from "./panels/library.js";
 import { toggleEnabled, toggleSolo } from "./panels/placements.js";
 import { togglePlay } from "./panels/pose.js";
-import { placementFromPattern } from "./placing.js";
+import { placementFromPattern, applySuggested } from "./placing.js";
 import { notify } from "./notice.js";
+import { openPropose, closePropose, proposeOpen } from "./propose.js";
 
 export const SHORTCUTS = [
   ["1 – 9", "place the library's n-th pattern at the pointer (texture view)"],
@@ -27,6 +28,7 @@ export const SHORTCUTS = [
   ["H", "hide / show (enabled)"],
   ["S", "solo in the 3D view"],
   ["P", "place tool: click the model in 3D to add a placement there (on the body, the brush wide; ⋯ Place as: in the texture)"],
+  ["A", "Propose…: the pattern set the server proposes for this character (↑ ↓ walk it, Space ticks, Esc closes)"],
   ["F", "frame the selection in the 3D view (drag orbits about it; Shift+drag or middle drag pans; the wheel zooms at the pointer)"],
   ["Tab", "switch texture / 3D (in the views)"],
   ["T / V / L", "go to the texture view / the 3D view / the placements list"],
@@ -116,6 +118,8 @@ function onKey(e, { dlg, fitTexture }) {
   else if ((k === "h" || k === "H") && sel.length) toggleEnabled(sel);
   else if ((k === "s" || k === "S") && sel.length) toggleSolo(sel);
   else if (k === "p" || k === "P") setPlaceTool(!placeToolOn());
+  else if ((k === "a" || k === "A") && proposeOpen()) closePropose();
+  else if (k === "a" || k === "A") openPropose().then(() => document.getElementById("proposalList")?.focus());
   else if (k === "t" || k === "T") focusView("texture");
   else if (k === "v" || k === "V") focusView("3d");
   else if (k === "l" || k === "L") document.querySelector('#placementList button[tabindex="0"]')?.focus();
@@ -176,7 +180,7 @@ async function placeNth(n) {
   const body = placementFromPattern(pattern, uv);
   try {
     const q = await api.get(`/scenes/${store.sceneId}/pick?u=${uv[0]}&v=${uv[1]}`);
-    if (q.hit && q.suggested) Object.assign(body, { joint: q.suggested.joint, axis: q.suggested.axis, theta_min: q.suggested.theta_min, theta_max: q.suggested.theta_max });
+    if (q.hit && q.suggested) applySuggested(body, q.suggested, pattern);
   } catch { /* no surface there (off the charts): the pattern's defaults stay */ }
   const answer = await addPlacement(body);
   if (answer) set({ selection: [answer.scene.placements[answer.scene.placements.length - 1].id] });

@@ -1,7 +1,8 @@
 // Dermis editor entry: builds the API client, the views and the panels, loads the scene the URL
 // (or the first scene) names, and wires the toolbar: scene switch, undo/redo, layout, new scene
-// from a dropped or chosen .glb, download / load of the scene document, copying another scene's
-// placements, and "Copy link".
+// from a dropped or chosen .glb, download / load of the scene document, "Propose…" (the pattern
+// set the server proposes for the character), "Transfer from…" (another scene's placements carried
+// onto this character), and "Copy link".
 
 import { Api, makeClientName, ApiError } from "./api.js";
 import { store, set, on, emit, whenIdle, placementById } from "./store.js";
@@ -20,7 +21,8 @@ import { initActivation } from "./panels/activation.js";
 import { initKeys, setKeysApi } from "./keys.js";
 import { initLive, connect, disconnect } from "./live.js";
 import { initPermalink, readLink, copyLink } from "./permalink.js";
-import { openCopyDialog } from "./copy_placements.js";
+import { openTransferDialog } from "./transfer.js";
+import { initPropose } from "./propose.js";
 import { trace, clearTrace } from "./trace.js";
 import { bursting, withPending } from "./pending.js";
 
@@ -108,7 +110,7 @@ function wireToolbar() {
   $("download").onclick = downloadScene;
   $("load").onclick = () => $("loadFile").click();
   $("loadFile").onchange = () => { const f = $("loadFile").files[0]; if (f) loadSceneFile(f); $("loadFile").value = ""; };
-  $("copyFrom").onclick = () => openCopyDialog(api);
+  $("transferFrom").onclick = () => openTransferDialog(api);
   $("copyLink").onclick = async () => { await copyLink(); notify("Link copied: it opens this exact view.", "info"); };
   on("pinnedRevision revision", () => {
     const b = $("pinned");
@@ -119,6 +121,8 @@ function wireToolbar() {
     $("unpin").onclick = () => set({ pinnedRevision: null });
     $("revertPinned").onclick = () => revert(store.pinnedRevision);
   });
+  // The scene menu counts placements: it follows once things are quiet.
+  on("revision", () => whenIdle("scene-list", () => refreshSceneList(store.sceneId).catch(() => {}), 400));
   on("revision", () => whenIdle("lint", () => {
     forget(`/scenes/${store.sceneId}/heightmaps/`);
     store.overlayRevision = store.revision; // the overlay follows once things are quiet
@@ -193,6 +197,7 @@ async function start() {
   initPose($("posePanel"));
   initActivation($("activationPanel"), api);
   initKeys({ fitTexture: fit });
+  initPropose(api, $("propose"));
   initLive(api, reloadScene);
   initPermalink();
   wireToolbar();

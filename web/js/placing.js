@@ -1,6 +1,7 @@
 // New placements: a library pattern's defaults (model, target, axis, θ range) at a UV point, or on
 // the body (a surface placement, SPEC §8: the 3D view's place tool), with a driver suggested by the
-// server for the skin there (pick) when it can.
+// server for the skin there (pick) when it can, and then a label from that joint's side and role
+// ("left elbow crease").
 
 import { store } from "./store.js";
 import { round4 } from "./geometry.js";
@@ -28,4 +29,26 @@ export function surfacePlacementFromPattern(pattern, anchor, diameter) {
   const r6 = (x) => Math.round(x * 1e6) / 1e6;
   return { ...body, projection: "surface", anchor: { position: anchor.position.map(r6), normal: anchor.normal.map(r6), tangent: anchor.tangent.map(r6) },
            size: [r6(diameter), r6(diameter)] };
+}
+
+/// Takes the driver the server suggests for the skin under a pick (`suggested`: {joint, axis,
+/// theta_min, theta_max, role?}) into placement `body` of `pattern`; where the suggestion names the
+/// joint's role ("left elbow"), the placement is labelled by it and the pattern ("left elbow crease",
+/// "left elbow round bulge"). Without a suggestion the body is left as it is.
+export function applySuggested(body, suggested, pattern) {
+  if (!suggested) return body;
+  Object.assign(body, { joint: suggested.joint, axis: suggested.axis, theta_min: suggested.theta_min, theta_max: suggested.theta_max });
+  const label = labelFor(suggested.role, pattern);
+  if (label) body.label = label;
+  return body;
+}
+
+/// "left elbow crease": a joint's role and the pattern's name (underscores as spaces), at most 120
+/// bytes (the scene's limit on labels); null without a role.
+export function labelFor(role, pattern) {
+  if (typeof role !== "string" || !role.trim()) return null;
+  const name = pattern ? String(pattern.name || pattern.id || "").replace(/_/g, " ").trim() : "";
+  let label = name ? `${role.trim()} ${name}` : role.trim();
+  while (new TextEncoder().encode(label).length > 120) label = label.slice(0, -1);
+  return label;
 }

@@ -1,6 +1,8 @@
 // The sweep contact sheet (GET sweep) of a placement in a dialog, seen with the 3D view's camera
 // (yaw, pitch, distance, target), or zoomed on the placement's skin ("Zoom to placement": the
-// camera target and distance of GET focus, larger cells) so that a crease is big enough to see.
+// camera target and distance of GET focus, larger cells) so that a crease is big enough to see;
+// or of a clip (GET sweep?clip=: its time from 0 to its duration, each cell labelled with the t of
+// the placements most active then) — every pattern of a scene at work at once.
 
 import { store, shownTime } from "./store.js";
 import { API, query } from "./api.js";
@@ -32,5 +34,17 @@ export async function openSweep(p) {
       image.src = sweepUrl(p, zoom);
     } catch (err) { notify(`Sweep: ${err.message}`, "error"); e.target.checked = false; }
   };
+  dlg.showModal();
+}
+
+/// Opens the sweep dialog of clip `clip` (6 cells of the clip's time, the 3D view's camera).
+export function openClipSweep(clip) {
+  const c = store.camera;
+  const url = `${API}/scenes/${store.sceneId}/sweep${query({ clip, steps: 6, size: 352, yaw: c.yaw, pitch: c.pitch,
+    distance: c.distance ?? undefined, target: c.target ? c.target.join(",") : undefined, revision: store.pinnedRevision ?? undefined })}`;
+  const dlg = document.getElementById("sweepDialog");
+  dlg.innerHTML = `<h2>Sweep of the clip ${escapeHtml(clip)}: every placement over its time</h2>
+    <div><img id="sweepSheet" alt="sweep contact sheet of the clip ${escapeHtml(clip)}" src="${url}"></div><form method="dialog"><button>Close</button></form>`;
+  dlg.querySelector("img").onerror = () => notify("The sweep could not be rendered.", "error");
   dlg.showModal();
 }

@@ -11,6 +11,7 @@ import { escapeHtml } from "./library.js";
 import { query } from "../api.js";
 import { openSweep } from "../sweep_view.js";
 import { notify } from "../notice.js";
+import { overrideAt, axisLabel } from "../joint_angles.js";
 
 let api, box, drivers = new Map(), driversKey = "";
 
@@ -44,6 +45,8 @@ export const driverOf = (id) => drivers.get(id);
 
 function field(label, html) { return `<label>${label}</label>${html}`; }
 const opt = (values, cur) => values.map((v) => `<option${v === cur ? " selected" : ""}>${v}</option>`).join("");
+/// x, y, z, and a vector axis (proposals, transfers, mirror twins) as itself, chosen.
+const axisOptions = (axis) => (Array.isArray(axis) ? `<option value="vector" selected title="an axis in the joint's rest frame">${axisLabel(axis)}</option>` : "") + opt(["x", "y", "z"], axis);
 
 function render() {
   const p = primary();
@@ -60,7 +63,7 @@ function render() {
       ${field("Label", `<input type="text" id="pLabel" maxlength="120" value="${escapeHtml(p.label || "")}" aria-label="label">`)}
       ${field("Pattern", `<select id="pPattern" aria-label="pattern">${store.patterns.map((q) => `<option value="${escapeHtml(q.id)}"${q.id === p.pattern ? " selected" : ""}>${escapeHtml(q.name || q.id)}</option>`).join("")}</select>`)}
       ${field("Joint", `<input type="search" id="pJoint" list="jointList" value="${escapeHtml(p.joint)}" aria-label="driver joint" autocomplete="off"><datalist id="jointList">${joints.map((j) => `<option value="${escapeHtml(j)}">`).join("")}</datalist>`)}
-      ${field("Axis", `<select id="pAxis" aria-label="axis">${opt(["x", "y", "z"], p.axis)}</select>`)}
+      ${field("Axis", `<select id="pAxis" aria-label="axis">${axisOptions(p.axis)}</select>`)}
       ${field("θ min / max", `<span class="pair"><input type="number" id="pMin" step="1" value="${p.theta_min}" aria-label="theta min"><input type="number" id="pMax" step="1" value="${p.theta_max}" aria-label="theta max"></span>`)}
       ${field("h", `<input type="number" id="pH" step="0.05" value="${p.h}" aria-label="h (gain)">`)}
       ${field("Model", `<select id="pModel" aria-label="deformation model">${opt(["scale", "bias"], p.model)}</select>`)}
@@ -90,7 +93,7 @@ function render() {
     if (!joints.includes(e.target.value)) { notify(`The model has no joint named "${e.target.value}".`, "error"); e.target.value = cur().joint; return; }
     send({ joint: e.target.value });
   };
-  $("pAxis").onchange = (e) => send({ axis: e.target.value });
+  $("pAxis").onchange = (e) => { if (e.target.value !== "vector") send({ axis: e.target.value }); };
   for (const [id, key] of [["pMin", "theta_min"], ["pMax", "theta_max"], ["pH", "h"], ["pRot", "rotation"]])
     $(id).onchange = (e) => { const v = num(e.target); if (v !== null) send({ [key]: v }); };
   $("pModel").onchange = (e) => send({ model: e.target.value });
@@ -122,7 +125,7 @@ function refreshValues(all) {
   const onBody = p && p.projection === "surface";
   if (!p || p.id !== shownId || !box.querySelector("#pH") || onBody !== !!box.querySelector("#pDepth")) { render(); return; }
   const set = (id, v) => { const el = box.querySelector("#" + id); if (el && (all || el !== document.activeElement)) el.value = String(v); };
-  set("pLabel", p.label || ""); set("pPattern", p.pattern); set("pJoint", p.joint); set("pAxis", p.axis);
+  set("pLabel", p.label || ""); set("pPattern", p.pattern); set("pJoint", p.joint); set("pAxis", Array.isArray(p.axis) ? "vector" : p.axis);
   set("pMin", p.theta_min); set("pMax", p.theta_max); set("pH", p.h); set("pModel", p.model); set("pTarget", p.target);
   set("pResponse", p.response);
   if (onBody) { set("pSX", p.size[0]); set("pSY", p.size[1]); set("pDepth", typeof p.depth === "number" ? p.depth : ""); }
@@ -133,12 +136,11 @@ function refreshValues(all) {
   drawLive();
 }
 
-/// Poses the placement's driver joint at `theta` about its axis (other axes of that joint kept).
+/// Poses the placement's driver joint at `theta` about its axis (other letter axes of that joint
+/// kept; about a vector axis the joint's rotation is set: joint_angles.js).
 export function goToPose(p, theta) {
   const cur = (store.doc.pose.joints || {})[p.joint];
-  const angles = cur && cur.axis_angles ? { ...cur.axis_angles } : {};
-  angles[p.axis] = theta;
-  return patchPose({ joints: { [p.joint]: { axis_angles: angles } } });
+  return patchPose({ joints: { [p.joint]: overrideAt(p.joint, p.axis, theta, cur) } });
 }
 
 /// The current θ and t of placement p: from the server's drivers answer when it has one.

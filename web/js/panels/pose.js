@@ -5,6 +5,7 @@
 import { store, on, set, clipByName, shownTime } from "../store.js";
 import { patchPose, Stream } from "../edits.js";
 import { escapeHtml } from "./library.js";
+import { overrideAngle, overrideAt, axisLabel } from "../joint_angles.js";
 
 let clipSel, playBtn, slider, timeText, jointsBox, playing = false, last = 0;
 
@@ -88,20 +89,19 @@ function renderJoints() {
   const overrides = store.doc.pose.joints || {};
   jointsBox.innerHTML = "";
   for (const d of drivers()) {
-    const cur = overrides[d.joint] && overrides[d.joint].axis_angles ? overrides[d.joint].axis_angles[d.axis] : undefined;
+    const cur = overrideAngle(overrides[d.joint], d.joint, d.axis);
+    const axisName = axisLabel(d.axis), axisKey = Array.isArray(d.axis) ? d.axis.join(",") : d.axis;
     const span = Math.max(d.hi - d.lo, 10);
     const lo = Math.max(-180, Math.floor(d.lo - span * 0.25)), hi = Math.min(180, Math.ceil(d.hi + span * 0.25));
     const label = document.createElement("label");
-    label.innerHTML = `${escapeHtml(d.joint)} ${d.axis}
-      <input type="range" min="${lo}" max="${hi}" step="0.5" value="${cur ?? 0}" aria-label="${escapeHtml(d.joint)} ${d.axis} angle" data-joint="${escapeHtml(d.joint)}" data-axis="${d.axis}">
+    label.innerHTML = `${escapeHtml(d.joint)} ${escapeHtml(axisName)}
+      <input type="range" min="${lo}" max="${hi}" step="0.5" value="${cur ?? 0}" aria-label="${escapeHtml(d.joint)} ${escapeHtml(axisName)} angle" data-joint="${escapeHtml(d.joint)}" data-axis="${escapeHtml(axisKey)}">
       <span class="badge">${cur === undefined ? "anim" : cur.toFixed(1) + "°"}</span>`;
     const input = label.querySelector("input"), badge = label.querySelector(".badge");
     input.oninput = () => {
-      if (!jointStream) jointStream = new Stream((v) => patchPose(v, { undoable: false }), { live: true, what: `pose ${d.joint} ${d.axis}` });
-      const base = overrides[d.joint] && overrides[d.joint].axis_angles ? { ...overrides[d.joint].axis_angles } : {};
-      base[d.axis] = +input.value;
+      if (!jointStream) jointStream = new Stream((v) => patchPose(v, { undoable: false }), { live: true, what: `pose ${d.joint} ${axisName}` });
       badge.textContent = `${(+input.value).toFixed(1)}°`;
-      jointStream.send({ joints: { [d.joint]: { axis_angles: base } } });
+      jointStream.send({ joints: { [d.joint]: overrideAt(d.joint, d.axis, +input.value, overrides[d.joint]) } });
     };
     input.onchange = async () => {
       const s = jointStream;
