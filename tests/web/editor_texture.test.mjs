@@ -296,6 +296,19 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       const left = doc.placements.find((q) => q.id === "elbow_l");
       assert.equal(twin.joint, left.joint.replace(/\.l$/, ".r"));
       assert.ok(twin.center[0] !== left.center[0]);
+      // M again: the twin is there; the notice asks to bring it up to date instead of stacking a
+      // second one (POST …/mirror?update=true).
+      await settle();
+      const r0 = (await api("GET", `/scenes/${sceneId}`)).body.revision;
+      await page.keyboard.press("m");
+      const ask = await until(async () => {
+        for (const b of await page.$$("#notices .notice button")) if ((await b.textContent()) === "Update twin") return b;
+        return null;
+      }, "the notice asks whether to update the twin");
+      await ask.click();
+      const updated = await until(async () => { const d = (await api("GET", `/scenes/${sceneId}`)).body; return d.revision > r0 && d; }, "the twin brought up to date");
+      assert.equal(updated.scene.placements.length, n0 + 1, "no second twin");
+      assert.ok(updated.scene.placements.some((q) => q.id === twin.id), "the twin keeps its id");
       await settle();
       await screenshot(page, "editor-texture-mirror.png");
       // Texture view alone (Tab from the texture view switches to 3D when one view is shown).

@@ -66,7 +66,7 @@ export function edit(method, path, body, opts = {}) {
   return run;
 }
 
-async function send(method, path, body, { undoable = true, quiet = false, what = null } = {}) {
+async function send(method, path, body, { undoable = true, quiet = false, what = null, onRefused = null } = {}) {
   const before = store.revision;
   const payload = typeof body === "function" ? body(store.doc) : body;
   if (payload === null) return null;
@@ -80,6 +80,7 @@ async function send(method, path, body, { undoable = true, quiet = false, what =
     if (undoable) pushUndo(before, words);
     return answer;
   } catch (e) {
+    if (onRefused && onRefused(e)) { emit("refused"); return null; } // the caller says what now
     await refused(e, quiet);
     return null;
   }
@@ -138,7 +139,20 @@ export async function removePlacements(ids) {
   } });
 }
 export const addPlacement = (placement) => edit("POST", "/placements", placement);
-export const mirrorPlacement = (id) => edit("POST", `/placements/${encodeURIComponent(id)}/mirror`, {});
+/// Adds the mirror twin of placement `id`. Where the twin is in the scene already (409) the
+/// notice asks whether to bring that twin up to date instead (SPEC §8: ?update=true replaces it in
+/// place, its id kept) rather than stacking a second one.
+export function mirrorPlacement(id) {
+  const path = `/placements/${encodeURIComponent(id)}/mirror`;
+  return edit("POST", path, {}, { onRefused: (e) => {
+    if (e.code !== "conflict" || /its own mirror twin/.test(e.message || "")) return false;
+    const p = store.doc.placements.find((q) => q.id === id);
+    const twin = /placement "([^"]+)" already is/.exec(e.message || "");
+    notify(`${twin ? `"${twin[1]}"` : "Its twin"} is the mirror twin of "${(p && p.label) || id}" already. Bring it up to date with this side?`, "warn",
+      { label: "Update twin", run: () => edit("POST", `${path}?update=true`, {}, { what: `update the mirror twin of "${(p && p.label) || id}"` }) });
+    return true;
+  } });
+}
 export const patchPose = (fields, opts) => edit("PATCH", "/pose", fields, opts);
 export const putScene = (doc) => edit("PUT", "", doc);
 
