@@ -1,4 +1,5 @@
-// scene create|list|get|put|export|apply|rm|history|revert, pose set, placement add|set|rm|mirror.
+// scene create|list|get|put|export|apply|rm|history|revert|propose|transfer, pose set, placement
+// add|set|rm|mirror.
 // Edits print "<scene id> r<revision>" (or the server's answer with --json); --if-revision sends
 // If-Match so a stale edit is refused (412, exit 1).
 #include "commands.hpp"
@@ -16,7 +17,9 @@ namespace {
 struct SceneOptions {
     std::string id, file, pid, out, model = "builtin:default", clip;
     std::vector<std::string> ids, fields, joints;
-    bool defaultPatterns = false, replace = false;
+    bool defaultPatterns = false, replace = false, apply = false, dryRun = false, update = false;
+    std::string from;
+    std::vector<std::string> jointMap;
     int revision = 0, ifRevision = 0, limit = 50;
     double time = -1;
 };
@@ -87,7 +90,7 @@ nlohmann::json jointsObject(const std::vector<std::string>& joints) {
 
 void addSceneCommands(CLI::App& app, Context& ctx) {
     auto o = std::make_shared<SceneOptions>();
-    CLI::App* scene = app.add_subcommand("scene", "Scene documents: create, list, get, put, export, apply, rm, history, revert");
+    CLI::App* scene = app.add_subcommand("scene", "Scene documents: create, list, get, put, export, apply, rm, history, revert, propose, transfer");
     scene->require_subcommand(1);
 
     CLI::App* create = scene->add_subcommand("create", "Create a scene from a dermis.scene/1 document (or the default character with its patterns); prints the id");
@@ -218,6 +221,67 @@ void addSceneCommands(CLI::App& app, Context& ctx) {
         };
     });
 
+    // --- SPEC §8: proposals and transfer
+    CLI::App* propose = scene->add_subcommand("propose", "A pattern set for the scene's character from its range of motion (creases, bone ends, bulges; twins paired); --apply adds it in one revision");
+    propose->add_option("id", o->id, "Scene id")->required();
+    propose->add_flag("--apply", o->apply, "Add the proposals not in the scene yet (one revision)");
+    propose->callback([&ctx, o] {
+        ctx.action = [&ctx, o] {
+            const auto j = ctx.http().sendJson("POST", scenePath(o->id) + "/propose" + (o->apply ? "?apply=true" : ""),
+                                               nlohmann::json::object(), ifMatch(o->ifRevision));
+            if (ctx.global.json) {
+                printJson(j);
+                return kExitOk;
+            }
+            std::vector<std::vector<std::string>> rows;
+            for (const auto& p : j["proposals"]) {
+                const auto& pl = p["placement"];
+                std::ostringstream theta;
+                theta << pl["theta_min"].get<double>() << ".." << pl["theta_max"].get<double>();
+                rows.push_back({cell(pl["id"]), cell(p["kind"]), cell(pl["label"]), cell(pl["joint"]), theta.str(),
+                                cell(p["score"]), p["existing"].is_null() ? "-" : cell(p["existing"])});
+            }
+            printTable({"ID", "KIND", "LABEL", "JOINT", "THETA", "SCORE", "IN SCENE AS"}, rows);
+            if (o->apply) std::cout << j.value("id", "") << " r" << j.value("revision", 0) << " (added " << j["applied"].size() << ")\n";
+            return kExitOk;
+        };
+    });
+    propose->add_option("--if-revision", o->ifRevision, "Refuse unless the scene is at this revision (If-Match)");
+    CLI::App* transfer = scene->add_subcommand("transfer", "Carry another scene's placements onto this scene's character (joints matched across naming conventions, anchors re-projected); one revision");
+    transfer->add_option("id", o->id, "Scene id (the character to carry onto)")->required();
+    transfer->add_option("--from", o->from, "The scene whose placements to carry over")->required();
+    transfer->add_option("--map", o->jointMap, "SOURCE_JOINT=THIS_JOINT: a joint match to use first (repeatable)");
+    transfer->add_flag("--dry-run", o->dryRun, "Show what would be carried over and what not; change nothing");
+    transfer->add_option("--if-revision", o->ifRevision, "Refuse unless the scene is at this revision (If-Match)");
+    transfer->callback([&ctx, o] {
+        ctx.action = [&ctx, o] {
+            nlohmann::json body = {{"from", o->from}};
+            if (!o->jointMap.empty()) {
+                body["joint_map"] = nlohmann::json::object();
+                for (const auto& m : o->jointMap) {
+                    const auto eq = m.find('=');
+                    if (eq == std::string::npos || eq == 0 || eq + 1 == m.size())
+                        throw usageError("expected SOURCE_JOINT=THIS_JOINT, got \"" + m + "\"", m);
+                    body["joint_map"][m.substr(0, eq)] = m.substr(eq + 1);
+                }
+            }
+            const auto j = ctx.http().sendJson("POST", scenePath(o->id) + "/transfer" + (o->dryRun ? "?apply=false" : ""),
+                                               body, ifMatch(o->ifRevision));
+            if (ctx.global.json) {
+                printJson(j);
+                return kExitOk;
+            }
+            std::vector<std::vector<std::string>> rows;
+            for (const auto& t : j["transferred"])
+                rows.push_back({cell(t["from"]), cell(t["placement"]["id"]), cell(t["placement"]["joint"])});
+            printTable({"FROM", "PLACEMENT", "JOINT"}, rows);
+            for (const auto& u : j["unmapped"])
+                std::cout << "not carried over: " << u.value("placement", "") << " (" << u.value("reason", "") << ")\n";
+            if (!o->dryRun) std::cout << j.value("id", "") << " r" << j.value("revision", 0) << "\n";
+            return kExitOk;
+        };
+    });
+
     // --- pose
     CLI::App* pose = app.add_subcommand("pose", "A scene's pose");
     pose->require_subcommand(1);
@@ -290,9 +354,10 @@ void addSceneCommands(CLI::App& app, Context& ctx) {
     CLI::App* mirror = placement->add_subcommand("mirror", "Add the mirror twin of a placement (left ↔ right)");
     mirror->add_option("id", o->id, "Scene id")->required();
     mirror->add_option("placement", o->pid, "Placement id")->required();
+    mirror->add_flag("--update", o->update, "Where the twin is in the scene already, bring it up to date in place (else: refused, 409)");
     mirror->callback([&ctx, o] {
         ctx.action = [&ctx, o] {
-            printEdit(ctx, ctx.http().sendJson("POST", scenePath(o->id) + "/placements/" + httplib::detail::encode_query_param(o->pid) + "/mirror", nullptr));
+            printEdit(ctx, ctx.http().sendJson("POST", scenePath(o->id) + "/placements/" + httplib::detail::encode_query_param(o->pid) + "/mirror" + (o->update ? "?update=true" : ""), nullptr));
             return kExitOk;
         };
     });

@@ -330,6 +330,42 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
     EXPECT_EQ(dermis({"scene", "get", sid}).code, 1);
 }
 
+TEST_F(ClientHttpTest, ProposeTransferAndMirrorUpdate) {
+    // An empty scene of the default character: propose lists, --apply adds them in one revision.
+    const std::string file = *dir_ / "empty.scene.json";
+    writeText(file, R"({"format": "dermis.scene/1", "model": "builtin:default", "placements": []})");
+    ClientRun made = dermis({"scene", "create", file});
+    ASSERT_EQ(made.code, 0) << made;
+    const std::string sid = made.firstLine();
+    ClientRun listed = dermis({"scene", "propose", sid});
+    ASSERT_EQ(listed.code, 0) << listed;
+    EXPECT_NE(listed.out.find("left elbow crease"), std::string::npos) << listed;
+    EXPECT_NE(listed.out.find("right knee crease"), std::string::npos) << listed;
+    const std::size_t count = dermis({"--json", "scene", "propose", sid}).js()["proposals"].size();
+    ClientRun applied = dermis({"scene", "propose", sid, "--apply"});
+    ASSERT_EQ(applied.code, 0) << applied;
+    EXPECT_NE(applied.out.find(sid + " r2 (added " + std::to_string(count) + ")"), std::string::npos) << applied;
+    EXPECT_EQ(dermis({"scene", "get", sid}).js()["placements"].size(), count);
+    EXPECT_EQ(dermis({"scene", "propose", sid, "--apply"}).code, 1) << "all there already: 409";
+    // The twin is there: mirror refuses, --update brings it up to date in place.
+    EXPECT_EQ(dermis({"placement", "mirror", sid, "elbow_crease_l"}).code, 1);
+    EXPECT_EQ(dermis({"placement", "mirror", sid, "elbow_crease_l", "--update"}).out, sid + " r3\n");
+    // Transfer: a dry run changes nothing; then the default set comes over in one revision.
+    const std::string from = newScene();
+    ClientRun dry = dermis({"scene", "transfer", sid, "--from", from, "--dry-run"});
+    ASSERT_EQ(dry.code, 0) << dry;
+    EXPECT_NE(dry.out.find("elbow_l"), std::string::npos) << dry;
+    EXPECT_EQ(dermis({"--json", "scene", "get", sid}).js()["revision"], 3);
+    ClientRun moved = dermis({"scene", "transfer", sid, "--from", from, "--map", "neck_01=neck_02"});
+    ASSERT_EQ(moved.code, 0) << moved;
+    EXPECT_NE(moved.out.find(sid + " r4"), std::string::npos) << moved;
+    const json doc = dermis({"scene", "get", sid}).js();
+    EXPECT_EQ(doc["placements"].size(), count + 18);
+    for (const auto& p : doc["placements"])
+        if (p["id"] == "neck") EXPECT_EQ(p["joint"], "neck_02") << "--map is used first";
+    EXPECT_EQ(dermis({"scene", "transfer", sid, "--from", from, "--map", "bad"}).code, 2);
+}
+
 TEST_F(ClientHttpTest, FramesMapsLintAndWatch) {
     const std::string sid = newScene();
     const std::string png = *dir_ / "frames/one.png", jpg = *dir_ / "frames/one.jpg";
