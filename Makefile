@@ -10,7 +10,7 @@ export CCACHE_BASEDIR ?= $(CURDIR)
 export CCACHE_NOHASHDIR ?= 1
 CMAKE_FLAGS ?=
 
-.PHONY: all deps build test test-asan fuzz run offline bench loadbench authorbench layoutbench patterns character clean format
+.PHONY: all deps build test test-asan fuzz run offline bench loadbench authorbench layoutbench proposebench patterns character clean format
 
 all: build
 
@@ -69,6 +69,10 @@ authorbench: build
 
 layoutbench: build
 	$(BUILD)/bench/dermis-layoutbench $(BENCH_ARGS)
+
+# SPEC §8 proposals and transfer per model (JSON; docs/benchmarks.md).
+proposebench: build
+	$(BUILD)/bench/dermis-proposebench $(BENCH_ARGS)
 
 # Regenerates the built-in pattern library (patterns/*.png, manifest.json, contact sheet).
 patterns: build
