@@ -10,9 +10,12 @@
 // interpolated there.
 #include "surface_outline.hpp"
 
+#include "surface_query.hpp"
+
 #include "bake.hpp"
 #include "disjoint_sets.hpp"
 #include "heightmap.hpp"
+#include "surface_query.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -125,40 +128,6 @@ struct Touched {
     std::size_t firstSegment = 0, segments = 0; ///< into the collected segments
 };
 
-/// The point of triangle (a, b, c) closest to p, as barycentric weights of a, b, c (Ericson,
-/// Real-Time Collision Detection §5.1.5: the Voronoi region of p among the corners, edges and face).
-glm::dvec3 closestOnTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-    if (d1 <= 0.0 && d2 <= 0.0) return {1, 0, 0};
-    const glm::dvec3 bp = p - b;
-    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-    if (d3 >= 0.0 && d4 <= d3) return {0, 1, 0};
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-        const double v = d1 - d3 != 0.0 ? d1 / (d1 - d3) : 0.0;
-        return {1.0 - v, v, 0.0};
-    }
-    const glm::dvec3 cp = p - c;
-    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-    if (d6 >= 0.0 && d5 <= d6) return {0, 0, 1};
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-        const double w = d2 - d6 != 0.0 ? d2 / (d2 - d6) : 0.0;
-        return {1.0 - w, 0.0, w};
-    }
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
-        const double den = (d4 - d3) + (d5 - d6);
-        const double w = den != 0.0 ? (d4 - d3) / den : 0.0;
-        return {0.0, 1.0 - w, w};
-    }
-    const double sum = va + vb + vc;
-    if (!(sum != 0.0)) return {1, 0, 0}; // a degenerate triangle: its first corner
-    const double v = vb / sum, w = vc / sum;
-    return {1.0 - v - w, v, w};
-}
-
 bool isFinite(double x) { return std::isfinite(x); }
 
 Result<SurfaceOutline> uvOutline(const Placement& p) {
@@ -255,7 +224,7 @@ Result<SurfaceOutline> surfaceFootprintOutline(const Model& model, const Placeme
             const double faceLen = glm::length(face);
             face = faceLen > 0.0 ? face / faceLen : glm::dvec3(0, 0, 1);
             {
-                const glm::dvec3 w = closestOnTriangle(frame.c, c.position[0], c.position[1], c.position[2]);
+                const glm::dvec3 w = closestBary(frame.c, c.position[0], c.position[1], c.position[2]);
                 const glm::dvec3 q = w.x * c.position[0] + w.y * c.position[1] + w.z * c.position[2];
                 const double d2 = glm::dot(q - frame.c, q - frame.c);
                 const glm::dvec2 uv = w.x * c.uv[0] + w.y * c.uv[1] + w.z * c.uv[2];

@@ -9,31 +9,33 @@ namespace dermis {
 glm::dvec3 closestBary(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
     const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
     const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-    if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+    if (d1 <= 0.0 && d2 <= 0.0) return {1, 0, 0};
     const glm::dvec3 bp = p - b;
     const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-    if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+    if (d3 >= 0.0 && d4 <= d3) return {0, 1, 0};
     const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-        const double v = d1 / (d1 - d3);
-        return {1 - v, v, 0};
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+        const double v = d1 - d3 != 0.0 ? d1 / (d1 - d3) : 0.0;
+        return {1.0 - v, v, 0.0};
     }
     const glm::dvec3 cp = p - c;
     const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-    if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+    if (d6 >= 0.0 && d5 <= d6) return {0, 0, 1};
     const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        const double w = d2 / (d2 - d6);
-        return {1 - w, 0, w};
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+        const double w = d2 - d6 != 0.0 ? d2 / (d2 - d6) : 0.0;
+        return {1.0 - w, 0.0, w};
     }
     const double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return {0, 1 - w, w};
+    if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0) {
+        const double den = (d4 - d3) + (d5 - d6);
+        const double w = den != 0.0 ? (d4 - d3) / den : 0.0;
+        return {0.0, 1.0 - w, w};
     }
-    const double denom = 1.0 / (va + vb + vc);
-    const double v = vb * denom, w = vc * denom;
-    return {1 - v - w, v, w};
+    const double sum = va + vb + vc;
+    if (!(sum != 0.0)) return {1, 0, 0}; // a degenerate triangle: its first corner
+    const double v = vb / sum, w = vc / sum;
+    return {1.0 - v - w, v, w};
 }
 
 namespace {

@@ -27,8 +27,9 @@ struct SurfacePoint {
     int triangle() const { return static_cast<int>(base / 3); }
 };
 
-/// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5), as
-/// barycentric weights.
+/// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5: the
+/// Voronoi region of p among the corners, edges and face), as barycentric weights; a degenerate
+/// triangle gives its first corner. Never divides by zero.
 glm::dvec3 closestBary(glm::dvec3 p, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c);
 
 /// The surface point of `m`'s triangles, with positions `positions[part]` (the parts' own, bind
