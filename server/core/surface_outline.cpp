@@ -10,8 +10,6 @@
 // interpolated there.
 #include "surface_outline.hpp"
 
-#include "surface_query.hpp"
-
 #include "bake.hpp"
 #include "disjoint_sets.hpp"
 #include "heightmap.hpp"
