@@ -1,6 +1,7 @@
 // ProposeHttpTest — SPEC §8 proposals and transfer through the HTTP API on characters uploaded
 // as a user would (CesiumMan, the KayKit Barbarian, RiggedFigure): POST /scenes/{id}/propose
-// lists a set (creases at elbows and knees), ?apply=true adds it in one revision (op propose),
+// lists a set (creases at elbows and knees, bulges on the biceps, thighs and calves, each with
+// its outline in the scene's layout), ?apply=true adds it in one revision (op propose),
 // lint-clean; the mirror route agrees with the twins (409 naming them; ?update=true replaces in
 // place); each non-synthetic crease reaches t ≥ 0.8 in its peak clip (GET activation); applying
 // twice is 409; a pick on a proposal's decal suggests its driver; POST /scenes/{id}/transfer
@@ -39,14 +40,19 @@ TEST_F(ProposeHttpTest, ProposesAppliesInOneRevisionLintCleanWithTwinsTheMirrorA
         Reply listed = http().post(s + "/propose", json::object());
         ASSERT_EQ(listed.status, 200) << listed.body;
         const json proposals = listed.js()["proposals"];
-        std::set<std::string> creases;
+        std::set<std::string> creases, bulges;
         for (const json& p : proposals) {
             if (p["kind"] == "crease") creases.insert(p["placement"]["label"].get<std::string>());
+            if (p["kind"] == "bulge") bulges.insert(p["placement"]["label"].get<std::string>());
+            EXPECT_TRUE(p["outline"].is_object() && !p["outline"]["segments"].empty()) << p["placement"]["id"];
             EXPECT_EQ(p["placement"]["projection"], "surface");
             EXPECT_TRUE(p["existing"].is_null());
         }
         for (const char* label : {"left elbow crease", "right elbow crease", "left knee crease", "right knee crease"})
             EXPECT_TRUE(creases.count(label)) << label;
+        // Bulges on the flexing muscles: biceps with the elbow, thigh with the knee, calf with the ankle.
+        for (const char* label : {"left biceps", "right biceps", "left thigh bulge", "right thigh bulge", "left calf", "right calf"})
+            EXPECT_TRUE(bulges.count(label)) << label;
         // Nothing changed yet.
         EXPECT_TRUE(http().get(s).js()["scene"]["placements"].empty());
 

@@ -176,6 +176,7 @@ struct Site {
     const char* label;    ///< elbow crease
     DeformModel model;
     Target target;
+    double along = 0.5;   ///< bulge: where on the parent bone, from the parent joint (0..1)
 };
 
 /// The proposals for bending joint `j` with motion `jm` (see the header's table).
@@ -236,7 +237,7 @@ void proposeAt(const Ctx& c, int j, const JointMotion& jm, const std::vector<Sit
         const std::string kind = site.kind;
         glm::dvec3 origin = P, dir = d;
         if (kind == "bone") dir = -d;
-        if (kind == "bulge") origin = parentPos + (std::string(site.pattern) == "round_bulge" ? 0.55 : 0.5) * (P - parentPos);
+        if (kind == "bulge") origin = parentPos + site.along * (P - parentPos);
         const auto hit = castRay(c.model, c.restPos, origin, dir, maxRay, accept);
         if (!hit) continue;
         const double r = hit->distance;
@@ -321,11 +322,25 @@ std::vector<Proposal> proposePatterns(const Model& model, const RestSkin& rest, 
     const std::vector<Site> elbow = {
         {"crease", "crease", "elbow_crease", "elbow crease", DeformModel::Scale, Target::Bump},
         {"bone", "round_bulge", "elbow_bone", "elbow tip", DeformModel::Bias, Target::Bump},
-        {"bulge", "round_bulge", "biceps", "biceps", DeformModel::Scale, Target::Displacement}};
+        {"bulge", "round_bulge", "biceps", "biceps", DeformModel::Scale, Target::Displacement, 0.55}};
     const std::vector<Site> knee = {
         {"crease", "crease", "knee_crease", "knee crease", DeformModel::Scale, Target::Bump},
         {"bone", "round_bulge", "knee_bone", "knee cap", DeformModel::Bias, Target::Bump},
-        {"bulge", "elongated_bulge", "thigh", "thigh bulge", DeformModel::Scale, Target::Displacement}};
+        {"bulge", "elongated_bulge", "thigh", "thigh bulge", DeformModel::Scale, Target::Displacement, 0.5}};
+    // The calf swells as the ankle points the foot (plantar flexion): on the back of the shin, a
+    // third of the way down from the knee.
+    const std::vector<Site> ankle = {
+        {"bulge", "elongated_bulge", "calf", "calf", DeformModel::Scale, Target::Displacement, 0.35}};
+    // The ankle's angle turned so that pointing the foot is positive: the toe tip moves away from
+    // the knee (along the shin) at the positive peak.
+    const auto pointing = [&](int j, const JointMotion& jm) {
+        const int child = boneChild(model, body, j), parent = boneParent(model, body, j);
+        if (child < 0 || parent < 0) return jm;
+        const auto bent = worldMatrices(model, bendPose(model, j, jm.axis, std::max(10.0, jm.peak)));
+        const glm::dvec3 moved = glm::dvec3(bent[static_cast<std::size_t>(child)][3]) - restJointPosition(rest, child);
+        const glm::dvec3 shin = restJointPosition(rest, j) - restJointPosition(rest, parent);
+        return glm::dot(moved, shin) >= 0.0 ? jm : motionAbout(model, motion, j, -jm.axis);
+    };
     // Spine and neck: the joint of that role that bends forward most, its crease on the front.
     const auto forwardBend = [&](JointRole role, const Site& site) {
         int best = -1;
@@ -352,8 +367,8 @@ std::vector<Proposal> proposePatterns(const Model& model, const RestSkin& rest, 
     forwardBend(JointRole::Spine, {"crease", "stomach_wrinkles", "stomach_crease", "stomach crease", DeformModel::Scale, Target::Bump});
     forwardBend(JointRole::Neck, {"crease", "neck_rings", "neck_crease", "neck crease", DeformModel::Scale, Target::Bump});
     // Limbs: left first; a right joint whose left twin has proposals gets their mirror images.
-    for (const JointRole role : {JointRole::Elbow, JointRole::Knee}) {
-        const std::vector<Site>& sites = role == JointRole::Elbow ? elbow : knee;
+    for (const JointRole role : {JointRole::Elbow, JointRole::Knee, JointRole::Ankle}) {
+        const std::vector<Site>& sites = role == JointRole::Elbow ? elbow : role == JointRole::Knee ? knee : ankle;
         std::vector<int> done;
         for (const char side : {'l', 'r', '\0'}) {
             for (int j : model.joints) {
@@ -361,10 +376,12 @@ std::vector<Proposal> proposePatterns(const Model& model, const RestSkin& rest, 
                 if (!info || info->role != role || info->side != side || !info->deforms) continue;
                 if (std::find(done.begin(), done.end(), j) != done.end()) continue;
                 done.push_back(j);
-                const JointMotion* jm = motion.motion(j);
-                if (!usable(jm)) continue;
+                const JointMotion* found = motion.motion(j);
+                if (!found) continue;
+                const JointMotion jm = role == JointRole::Ankle ? pointing(j, *found) : *found;
+                if (!usable(&jm)) continue;
                 const std::size_t first = out.size();
-                proposeAt(c, j, *jm, sites, out);
+                proposeAt(c, j, jm, sites, out);
                 if (side != 'l') continue;
                 // The right twin: by mirror image.
                 const int twin = body.find(role, 'r');

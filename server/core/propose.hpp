@@ -8,6 +8,9 @@
 //           tip, bulge (round_bulge, displacement) on the biceps: 55 % down the upper arm;
 //   knee    crease on the back of the knee, bone on the knee cap, bulge (elongated_bulge) on the
 //           back of the thigh, half-way down;
+//   ankle   bulge (elongated_bulge) on the calf, a third of the way down the shin, driven by
+//           the ankle's angle turned so that pointing the foot (the toe tip moving away from the
+//           knee) is positive;
 //   spine   the spine joint the clips bend forward most: stomach_wrinkles on the belly;
 //   neck    the neck joint the clips bend forward most: neck_rings on the throat (both by
 //           kMinMotionDegrees at least; synthetic only on a model without clips).

@@ -308,7 +308,9 @@ public:
     /// "bone" | "bulge"), joint, score, twin (the twin proposal's id, or null), existing (the
     /// scene's placement that already is this proposal, or null), why: {joint, role, axis,
     /// neutral, peak, peak_clip, peak_time, synthetic, planarity, compression, stretch,
-    /// correlation, radius}}], applied: []}. With `apply`, the proposals not in the scene yet
+    /// correlation, radius}, outline (in the layout the scene's maps live in, as the outline
+    /// route answers it — layout, pieces, bounds, segments (≤ 4000), truncated, anchor_uv — or
+    /// null: the texture view's ghosts)}], applied: []}. With `apply`, the proposals not in the scene yet
     /// are added in one revision (op "propose"; ids made unique, twins renamed with them) and
     /// the answer is the edit's ({id, revision, scene}) plus `applied` (the new ids) and
     /// `proposals`. Fails: NotFound (scene); Conflict ("placements") when every proposal is in

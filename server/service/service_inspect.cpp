@@ -203,6 +203,20 @@ Result<json> Service::pickUv(const std::string& id, double u, double v) {
     return pickAnswer(*derived, *hit, nullptr, *state_->derivedOf(*snap));
 }
 
+json detail::outlineMembers(const SurfaceOutline& outline) {
+    auto r5 = [](double x) { return std::round(x * 1e5) / 1e5 + 0.0; }; // + 0.0: no "-0"
+    json segments = json::array();
+    for (const auto& s : outline.segments) segments.push_back({r5(s[0]), r5(s[1]), r5(s[2]), r5(s[3])});
+    json bounds = json::array();
+    for (const OutlinePiece& piece : outline.pieces)
+        bounds.push_back({r5(piece.min.x), r5(piece.min.y), r5(piece.max.x), r5(piece.max.y)});
+    return json{{"pieces", outline.pieces.size()},
+                {"bounds", std::move(bounds)},
+                {"segments", std::move(segments)},
+                {"truncated", outline.truncated},
+                {"anchor_uv", outline.anchorUv ? json{r5(outline.anchorUv->x), r5(outline.anchorUv->y)} : json()}};
+}
+
 Result<json> Service::placementOutline(const std::string& id, const std::string& pid,
                                        std::optional<std::uint64_t> revision,
                                        std::optional<std::array<double, 2>> at) {
@@ -231,20 +245,8 @@ Result<json> Service::placementOutline(const std::string& id, const std::string&
                                          : "/placements/" + std::to_string(it - placements.begin()) + "/" + e.field;
         return e;
     }
-    auto r5 = [](double x) { return std::round(x * 1e5) / 1e5 + 0.0; }; // + 0.0: no "-0"
-    json segments = json::array();
-    for (const auto& s : outline->segments) segments.push_back({r5(s[0]), r5(s[1]), r5(s[2]), r5(s[3])});
-    json bounds = json::array();
-    for (const OutlinePiece& piece : outline->pieces)
-        bounds.push_back({r5(piece.min.x), r5(piece.min.y), r5(piece.max.x), r5(piece.max.y)});
-    json out{{"placement", pid},
-             {"projection", std::string(toString(p->projection))},
-             {"layout", (*layout)->kind},
-             {"pieces", outline->pieces.size()},
-             {"bounds", std::move(bounds)},
-             {"segments", std::move(segments)},
-             {"truncated", outline->truncated},
-             {"anchor_uv", outline->anchorUv ? json{r5(outline->anchorUv->x), r5(outline->anchorUv->y)} : json()}};
+    json out{{"placement", pid}, {"projection", std::string(toString(p->projection))}, {"layout", (*layout)->kind}};
+    out.update(outlineMembers(*outline));
     if (at)
         out["hit"] = footprintContains(inLayout->model(), inLayout->uvLookup(), *p, {(*at)[0], (*at)[1]});
     return out;

@@ -7,6 +7,7 @@
 #include "core/mirror.hpp"
 #include "core/propose.hpp"
 #include "core/scene_json.hpp"
+#include "core/surface_outline.hpp"
 #include "core/transfer.hpp"
 
 #include <cmath>
@@ -18,6 +19,9 @@ using namespace detail;
 namespace {
 
 double r3(double x) { return std::round(x * 1000.0) / 1000.0 + 0.0; }
+
+/// Segments of a proposal's outline in the answer at most (a ghost, not an edit: coarser is fine).
+constexpr std::size_t kProposalOutlineSegments = 4000;
 
 /// The placement's canonical JSON (toJson of a one-placement scene).
 json placementJson(const Placement& p) {
@@ -60,9 +64,20 @@ Result<json> Service::propose(const std::string& id, bool apply, const EditConte
     // The analysis (cached per model) is made here, unlocked, before any writer lock.
     const auto derived = state_->derivedOf(*snap);
     const std::vector<Proposal>& proposals = derived->proposals();
+    // Each proposal's outline in the layout the scene's maps live in: the texture view's ghosts.
+    std::vector<json> outlines(proposals.size());
+    if (auto layout = state_->layoutFor(snap->scene, *derived)) {
+        const auto inLayout = state_->derivedInLayout(*snap);
+        for (std::size_t i = 0; i < proposals.size(); ++i)
+            if (auto o = surfaceFootprintOutline(inLayout->model(), proposals[i].placement, kProposalOutlineSegments)) {
+                outlines[i] = outlineMembers(*o);
+                outlines[i]["layout"] = (*layout)->kind;
+            }
+    }
     const auto answer = [&](const Scene& scene, const std::map<std::string, std::string>& ids) {
         json list = json::array();
-        for (const Proposal& p : proposals) {
+        for (std::size_t i = 0; i < proposals.size(); ++i) {
+            const Proposal& p = proposals[i];
             Placement placed = p.placement;
             if (auto it = ids.find(placed.id); it != ids.end()) placed.id = it->second;
             const std::string existing = existingFor(scene, p.placement);
@@ -74,7 +89,8 @@ Result<json> Service::propose(const std::string& id, bool apply, const EditConte
                             {"score", p.score},
                             {"twin", twin.empty() ? json() : json(twin)},
                             {"existing", existing.empty() || ids.count(p.placement.id) ? json() : json(existing)},
-                            {"why", whyJson(p.why)}});
+                            {"why", whyJson(p.why)},
+                            {"outline", outlines[i]}});
         }
         return list;
     };

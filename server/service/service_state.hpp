@@ -33,6 +33,8 @@ namespace dermis {
 
 using json = nlohmann::json;
 
+struct SurfaceOutline;
+
 namespace detail {
 
 inline constexpr const char* kBuiltinDefault = "builtin:default";
@@ -155,6 +157,10 @@ struct PresenceEntry {
 /// limits: its triangle and joint limits; base-colour textures downscaled to maxImageSide, the
 /// textures' decoded bytes at most 4 × maxImageSide² × 4 (four full-size RGBA8 textures).
 GltfLimits gltfLimitsOf(const ServerLimits& limits);
+
+/// The outline members of a placement's outline answer (SPEC §8; numbers rounded to 1e-5):
+/// {pieces, bounds, segments, truncated, anchor_uv} (service_inspect.cpp).
+json outlineMembers(const SurfaceOutline& outline);
 
 /// Index of placement `pid` in doc["placements"], or −1.
 int placementIndex(const json& doc, const std::string& pid);

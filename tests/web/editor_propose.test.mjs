@@ -126,6 +126,16 @@ await runSuite("WebEditorProposeBrowserTest", async () => {
       const a = knee.placement.anchor;
       const want = [...a.position, ...a.normal, Math.max(...knee.placement.size)].map((x) => Math.round(x * 1e5) / 1e5);
       await until(async () => { const b = await param("surface_brush"); return b && b.split(",").map(Number).every((x, i) => Math.abs(x - want[i]) < 1e-5); }, "the ghost at the knee crease's anchor");
+      // The texture view draws every proposal not in the scene as a dashed violet outline (the
+      // propose answer's outline in the layout in use).
+      assert.ok(proposals.every((p) => p.outline && p.outline.segments.length > 0), "each proposal has an outline");
+      const violet = () => page.$eval("#uv", (c) => {
+        const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - 180) < 24 && Math.abs(d[i + 1] - 140) < 24 && d[i + 2] > 220) ++n;
+        return n;
+      });
+      await until(async () => (await violet()) > 50, "the texture view shows the proposals' outlines");
       await page.keyboard.press("ArrowDown");
       const next = proposals[proposals.findIndex((p) => p.placement.id === id) + 1];
       if (next) await page.waitForFunction((pid) => document.querySelector("#proposalList li.selected")?.dataset.id === pid, next.placement.id, { timeout: 5000 });
@@ -163,6 +173,12 @@ await runSuite("WebEditorProposeBrowserTest", async () => {
       await page.keyboard.press("Escape");
       await page.waitForFunction(() => document.getElementById("proposePanel").hidden, null, { timeout: 5000 });
       assert.equal(await param("surface_brush"), null, "no ghost once the panel is closed");
+      await until(async () => (await page.$eval("#uv", (c) => {
+        const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - 180) < 24 && Math.abs(d[i + 1] - 140) < 24 && d[i + 2] > 220) ++n;
+        return n;
+      })) === 0, "no texture ghosts once the panel is closed");
     }],
     ["keyboard: A opens Propose… with the focus in the list; ↓ and Space walk and untick; Esc closes; at 1280×720 it fits", async () => {
       await page.setViewportSize({ width: 1280, height: 720 });

@@ -5,7 +5,9 @@
 // a checkbox (accept / reject; ticked at first); proposals the scene already has ("existing") say
 // so and are never added again. The current row (a click, or ↑ ↓ in the list) is previewed alone
 // on the body (proposal_preview.js) and outlined in the 3D view as a ghost (the frame's surface
-// brush: a dashed circle at its anchor, as wide as it is). "Accept all" and "Accept selected" add
+// brush: a dashed circle at its anchor, as wide as it is); in the texture view every proposal not
+// in the scene is a dashed outline in the layout in use (the answer's `outline`; violet when
+// ticked, the current one thicker and labelled). "Accept all" and "Accept selected" add
 // them in ONE edit — one revision, one undo step: all of them through propose?apply=true, a subset
 // by one PUT of the document — and then offer the clip's sweep, where the patterns show.
 
@@ -13,6 +15,7 @@ import { store, on, set, emit, whenIdle, clipByName } from "./store.js";
 import { edit } from "./edits.js";
 import { notify } from "./notice.js";
 import { setGhostSource } from "./frame_view.js";
+import { setTextureGhosts } from "./texture_view.js";
 import { renderProposalPreview } from "./proposal_preview.js";
 import { openClipSweep, openSweep } from "./sweep_view.js";
 
@@ -38,6 +41,7 @@ export function initPropose(theApi, button) {
   opener = button;
   button.onclick = () => (proposeOpen() ? closePropose() : openPropose());
   setGhostSource(ghost);
+  setTextureGhosts(textureGhosts);
   on("scene", () => { if (proposeOpen()) closePropose(false); });
   // Someone (or undo) changed the scene: which proposals it has may have changed too.
   on("revision", () => { if (proposeOpen()) whenIdle("propose", () => load(false), 300); });
@@ -50,6 +54,13 @@ function ghost() {
   const p = prop && prop.placement;
   if (!p || p.projection !== "surface" || !p.anchor || !p.size) return null;
   return [...p.anchor.position, ...p.anchor.normal, Math.max(...p.size)];
+}
+
+/// Every proposal not in the scene yet as a texture-view ghost: its outline in the layout in use
+/// (the propose answer's `outline`), ticked or not, the current one marked.
+function textureGhosts() {
+  if (!proposeOpen()) return [];
+  return fresh().map((p) => ({ outline: p.outline, label: p.placement.label || idOf(p), ticked: ticked.has(idOf(p)), current: idOf(p) === current }));
 }
 
 /// Opens the panel and asks the server for proposals.
@@ -185,6 +196,7 @@ function toggle(id, yes) {
   const prop = byId(id);
   if (!prop || prop.existing) return;
   if (yes) ticked.add(id); else ticked.delete(id);
+  emit("ghost"); // the texture view's ghost turns grey or violet
   const box = panel.querySelector(`li[data-id="${CSS.escape(id)}"] input.accept`);
   if (box) box.checked = yes;
   const chosen = fresh().filter((p) => ticked.has(idOf(p))).length;

@@ -73,7 +73,7 @@ export function initTextureView(section, theApi) {
   canvas.addEventListener("pointercancel", () => cancelDrag());
   canvas.addEventListener("wheel", wheel, { passive: false });
   canvas.addEventListener("contextmenu", (e) => e.preventDefault());
-  on("doc selection lint presence overlay layout model revision solo drag", redraw);
+  on("doc selection lint presence overlay layout model revision solo drag ghost", redraw);
   on("layoutMode", () => requestAnimationFrame(fit)); // the stage changed size: fit the UV square again
   onImageLoaded(redraw);
 }
@@ -166,6 +166,7 @@ function draw() {
   }
   drawLabels(dims, w, h);
   for (const p of store.doc.placements) if (!geo.inTexture(p)) drawSurfaceOutline(p, soloed);
+  drawGhosts();
   // Other people's selections, in their colour.
   for (const [client, who] of store.presence) {
     for (const id of who.selection || []) {
@@ -179,6 +180,36 @@ function draw() {
   }
   const prim = store.selection.length ? placementById(store.selection[0]) : null;
   if (prim && geo.inTexture(prim)) drawHandles(shown(prim));
+}
+
+let ghostsOf = () => [];
+/// fn() → [{outline, label, ticked, current}]: footprints not in the scene yet (Propose…'s
+/// proposals, their outlines from the propose answer), drawn dashed over the layout.
+export function setTextureGhosts(fn) { ghostsOf = fn; }
+
+/// The ghosts: dashed outlines (violet when ticked, grey when not; the current one thicker, with its
+/// label at its anchor).
+function drawGhosts() {
+  for (const g of ghostsOf()) {
+    const o = g.outline;
+    if (!o || !o.segments) continue;
+    ctx.strokeStyle = g.ticked ? "#b48cff" : "#7d8794";
+    ctx.lineWidth = g.current ? 2.6 : 1.6;
+    ctx.setLineDash([5, 4]);
+    ctx.beginPath();
+    for (const seg of o.segments) {
+      ctx.moveTo(...toScreen([seg[0], seg[1]]));
+      ctx.lineTo(...toScreen([seg[2], seg[3]]));
+    }
+    ctx.stroke();
+    ctx.setLineDash([]);
+    if (g.current && o.anchor_uv) {
+      const [x, y] = toScreen(o.anchor_uv);
+      ctx.font = LABEL_FONT;
+      ctx.fillStyle = ctx.strokeStyle;
+      ctx.fillText(g.label, x + 6, y - 6);
+    }
+  }
 }
 
 /// A surface placement's decal outline (all pieces), a cross at its anchor and its label there.
