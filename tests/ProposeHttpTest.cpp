@@ -146,9 +146,10 @@ TEST_F(ProposeHttpTest, TransfersTheDefaultSetOntoOtherCharacters) {
         EXPECT_TRUE(http().get(s).js()["scene"]["placements"].empty());
         Reply applied = http().post(s + "/transfer", {{"from", from}});
         ASSERT_EQ(applied.status, 201) << applied.body;
-        EXPECT_EQ(applied.js()["revision"], 2);
-        EXPECT_EQ(applied.js()["scene"]["placements"].size(), p["transferred"].size());
-        for (const json& pl : applied.js()["scene"]["placements"]) EXPECT_EQ(pl["projection"], "surface");
+        const json a = applied.js(); // held: a range-for over a temporary's member would dangle
+        EXPECT_EQ(a["revision"], 2);
+        EXPECT_EQ(a["scene"]["placements"].size(), p["transferred"].size());
+        for (const json& pl : a["scene"]["placements"]) EXPECT_EQ(pl["projection"], "surface");
         EXPECT_EQ(http().get(s + "/revisions?limit=1").js()["revisions"][0]["op"], "transfer from " + from);
     }
     const std::string id = createScene(emptyScene("builtin:default"));
