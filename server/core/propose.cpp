@@ -103,11 +103,14 @@ RegionStrain strainOf(const Ctx& c, const std::vector<Tri>& tris,
     return out;
 }
 
-/// Posed positions of the vertices `tris` use under `world` (other vertices left at 0).
-std::vector<std::vector<glm::dvec3>> skinTris(const Ctx& c, const std::vector<Tri>& tris,
-                                              const std::vector<glm::mat4>& world) {
-    std::vector<std::vector<glm::dvec3>> posed(c.model.parts.size());
-    for (std::size_t pi = 0; pi < c.model.parts.size(); ++pi) posed[pi].assign(c.model.parts[pi].positions.size(), glm::dvec3(0.0));
+/// Posed positions under `world` of the vertices `tris` use, into `posed` (sized to the parts'
+/// vertices on the first call; other vertices are left as they are): one buffer for every sample.
+void skinTris(const Ctx& c, const std::vector<Tri>& tris, const std::vector<glm::mat4>& world,
+              std::vector<std::vector<glm::dvec3>>& posed) {
+    if (posed.size() != c.model.parts.size()) {
+        posed.resize(c.model.parts.size());
+        for (std::size_t pi = 0; pi < c.model.parts.size(); ++pi) posed[pi].assign(c.model.parts[pi].positions.size(), glm::dvec3(0.0));
+    }
     for (const Tri& t : tris) {
         const MeshPart& p = c.model.parts[t.part];
         for (int k = 0; k < 3; ++k) {
@@ -115,7 +118,6 @@ std::vector<std::vector<glm::dvec3>> skinTris(const Ctx& c, const std::vector<Tr
             if (v < p.positions.size()) posed[t.part][v] = skinVertex(p, v, world);
         }
     }
-    return posed;
 }
 
 /// Pearson r of the region's mean compression (stretch) with θ of `node` about `axis` over the
@@ -125,8 +127,10 @@ double correlationOf(const Ctx& c, const std::vector<Tri>& tris, int node, glm::
     if (n < 3 || tris.empty()) return 0.0;
     std::vector<double> xs, ys;
     const glm::quat restQ = c.model.nodes[static_cast<std::size_t>(node)].rotation;
+    std::vector<std::vector<glm::dvec3>> posed;
     for (std::size_t s = 0; s < n; ++s) {
-        const RegionStrain rs = strainOf(c, tris, skinTris(c, tris, c.sampleWorld[s]));
+        skinTris(c, tris, c.sampleWorld[s], posed);
+        const RegionStrain rs = strainOf(c, tris, posed);
         xs.push_back(jointAngle(restQ, c.motion.rotations[s][static_cast<std::size_t>(node)], glm::vec3(axis)));
         ys.push_back(stretch ? rs.stretch : rs.compression);
     }

@@ -50,6 +50,21 @@ bool corners(const MeshPart& p, const std::vector<glm::vec3>& pos, std::size_t t
     return true;
 }
 
+/// fn(part, first index, a, b, c) for every triangle of `m` whose corners index `positions[part]`
+/// (and the part's own positions).
+template <class Fn>
+void forEachTriangle(const Model& m, const std::vector<const std::vector<glm::vec3>*>& positions, Fn&& fn) {
+    for (std::size_t pi = 0; pi < m.parts.size() && pi < positions.size(); ++pi) {
+        const MeshPart& p = m.parts[pi];
+        const auto& pos = *positions[pi];
+        for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
+            std::uint32_t i[3];
+            if (!corners(p, pos, t, i)) continue;
+            fn(pi, t, glm::dvec3(pos[i[0]]), glm::dvec3(pos[i[1]]), glm::dvec3(pos[i[2]]));
+        }
+    }
+}
+
 } // namespace
 
 std::optional<SurfacePoint> nearestSurfacePoint(const Model& m,
@@ -57,21 +72,14 @@ std::optional<SurfacePoint> nearestSurfacePoint(const Model& m,
                                                 glm::dvec3 q) {
     double best = std::numeric_limits<double>::max();
     std::optional<SurfacePoint> out;
-    for (std::size_t pi = 0; pi < m.parts.size() && pi < positions.size(); ++pi) {
-        const MeshPart& p = m.parts[pi];
-        const auto& pos = *positions[pi];
-        for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-            std::uint32_t i[3];
-            if (!corners(p, pos, t, i)) continue;
-            const glm::dvec3 a(pos[i[0]]), b(pos[i[1]]), c(pos[i[2]]);
-            const glm::dvec3 w = closestBary(q, a, b, c);
-            const double d = glm::length(w.x * a + w.y * b + w.z * c - q);
-            if (d < best) {
-                best = d;
-                out = SurfacePoint{pi, t, w};
-            }
+    forEachTriangle(m, positions, [&](std::size_t pi, std::size_t t, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+        const glm::dvec3 w = closestBary(q, a, b, c);
+        const double d = glm::length(w.x * a + w.y * b + w.z * c - q);
+        if (d < best) {
+            best = d;
+            out = SurfacePoint{pi, t, w};
         }
-    }
+    });
     return out;
 }
 
@@ -80,30 +88,23 @@ std::optional<RayHit> castRay(const Model& m, const std::vector<const std::vecto
                               const std::function<bool(std::size_t, int)>& accept) {
     std::optional<RayHit> out;
     double best = maxDistance;
-    for (std::size_t pi = 0; pi < m.parts.size() && pi < positions.size(); ++pi) {
-        const MeshPart& p = m.parts[pi];
-        const auto& pos = *positions[pi];
-        for (std::size_t t = 0; t + 2 < p.indices.size(); t += 3) {
-            std::uint32_t i[3];
-            if (!corners(p, pos, t, i)) continue;
-            const glm::dvec3 a(pos[i[0]]), b(pos[i[1]]), c(pos[i[2]]);
-            const glm::dvec3 e1 = b - a, e2 = c - a, pv = glm::cross(dir, e2);
-            const double det = glm::dot(e1, pv);
-            if (std::abs(det) < 1e-20) continue;
-            const double inv = 1.0 / det;
-            const glm::dvec3 tv = origin - a;
-            const double u = glm::dot(tv, pv) * inv;
-            if (u < 0.0 || u > 1.0) continue;
-            const glm::dvec3 qv = glm::cross(tv, e1);
-            const double v = glm::dot(dir, qv) * inv;
-            if (v < 0.0 || u + v > 1.0) continue;
-            const double s = glm::dot(e2, qv) * inv;
-            if (!(s > 0.0) || s > best) continue;
-            if (accept && !accept(pi, static_cast<int>(t / 3))) continue;
-            best = s;
-            out = RayHit{SurfacePoint{pi, t, {1.0 - u - v, u, v}}, s};
-        }
-    }
+    forEachTriangle(m, positions, [&](std::size_t pi, std::size_t t, glm::dvec3 a, glm::dvec3 b, glm::dvec3 c) {
+        const glm::dvec3 e1 = b - a, e2 = c - a, pv = glm::cross(dir, e2);
+        const double det = glm::dot(e1, pv);
+        if (std::abs(det) < 1e-20) return;
+        const double inv = 1.0 / det;
+        const glm::dvec3 tv = origin - a;
+        const double u = glm::dot(tv, pv) * inv;
+        if (u < 0.0 || u > 1.0) return;
+        const glm::dvec3 qv = glm::cross(tv, e1);
+        const double v = glm::dot(dir, qv) * inv;
+        if (v < 0.0 || u + v > 1.0) return;
+        const double s = glm::dot(e2, qv) * inv;
+        if (!(s > 0.0) || s > best) return;
+        if (accept && !accept(pi, static_cast<int>(t / 3))) return;
+        best = s;
+        out = RayHit{SurfacePoint{pi, t, {1.0 - u - v, u, v}}, s};
+    });
     return out;
 }
 
