@@ -567,6 +567,7 @@ protected:
         loaded_ = std::make_unique<LoadedScene>(std::move(*l));
         model_ = std::make_shared<const Model>(loaded_->model);
         settings_.size = {256, 256};
+        settings_.aa = AntiAliasing::Msaa; // the references are MSAA 4x frames on every GL
     }
     static Pose pose(const std::string& clip, double time) {
         Pose p;

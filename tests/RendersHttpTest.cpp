@@ -75,6 +75,50 @@ TEST_F(RendersHttpTest, PostFrameTakesAPreviewTooLargeForTheRequestLine) {
 }
 
 // ================================================================================================
+// Anti-aliasing per frame (issue #28, item 3) and the render time the editor paces by (item 1)
+// ================================================================================================
+
+TEST_F(RendersHttpTest, FramesSayWhichAntiAliasingTheyUsedAndHowLongTheyTook) {
+    Http h = http();
+    json doc = smallScene();
+    doc["render"]["msaa"] = 4;
+    const std::string id = createScene(doc);
+    const std::string frame = "/scenes/" + id + "/frame?width=96&height=96";
+    const json info = h.get("/info").js();
+    const std::string autoMode = info["aa_auto"];
+    EXPECT_TRUE(autoMode == "post" || autoMode == "msaa4") << info.dump();
+    const bool software = info["gl"]["renderer"].get<std::string>().find("llvmpipe") != std::string::npos;
+    EXPECT_EQ(autoMode, software ? "post" : "msaa4");
+    Reply plain = h.get(frame);
+    ASSERT_EQ(plain.status, 200) << plain;
+    EXPECT_EQ(plain.header("X-Dermis-AA"), autoMode) << "the scene's render.aa is auto";
+    EXPECT_EQ(h.get(frame + "&aa=msaa").header("X-Dermis-AA"), "msaa4");
+    EXPECT_EQ(h.get(frame + "&msaa=2").header("X-Dermis-AA"), "msaa2") << "msaa alone selects MSAA";
+    EXPECT_EQ(h.get(frame + "&msaa=1").header("X-Dermis-AA"), "none");
+    Reply post = h.get(frame + "&aa=post");
+    EXPECT_EQ(post.header("X-Dermis-AA"), "post");
+    Reply none = h.get(frame + "&aa=none");
+    EXPECT_EQ(none.header("X-Dermis-AA"), "none");
+    EXPECT_NE(post.body, none.body) << "the edge pass changed the frame";
+    EXPECT_EQ(h.post("/scenes/" + id + "/frame", {{"width", 96}, {"height", 96}, {"aa", "post"}}).body, post.body);
+    expectError(h.get(frame + "&aa=fxaa"), 422, "aa");
+    // The scene's own render.aa is a document field like msaa.
+    doc["render"]["aa"] = "none";
+    Reply put = h.put("/scenes/" + id, doc);
+    ASSERT_EQ(put.status, 200) << put;
+    EXPECT_EQ(put.js()["scene"]["render"]["aa"], "none") << put.body;
+    EXPECT_EQ(h.get(frame).header("X-Dermis-AA"), "none");
+    doc["render"]["aa"] = "smaa";
+    expectError(h.put("/scenes/" + id, doc), 422, "/render/aa");
+    // Server-Timing: render;dur=<ms>, a plausible duration.
+    const std::string timing = plain.header("Server-Timing");
+    ASSERT_EQ(timing.rfind("render;dur=", 0), 0u) << timing;
+    const double ms = std::stod(timing.substr(11));
+    EXPECT_GT(ms, 0.0);
+    EXPECT_LT(ms, 60000.0);
+}
+
+// ================================================================================================
 // Stateless batch
 // ================================================================================================
 

@@ -25,13 +25,14 @@ namespace {
 
 class SurfaceHttpTest : public SharedServerTest {
 protected:
-    /// A scene of `model` with no placements, frames of 256² at msaa 1.
+    /// A scene of `model` with no placements, frames of 256² without anti-aliasing (decals are
+    /// measured by the pixels they change).
     static json emptyScene(const std::string& model) {
         return {{"format", "dermis.scene/1"},
                 {"model", model},
                 {"heightmap", {{"size", {512, 512}}}},
                 {"placements", json::array()},
-                {"render", {{"size", {256, 256}}, {"msaa", 1}, {"bump_strength", 4.0}}}};
+                {"render", {{"size", {256, 256}}, {"aa", "none"}, {"bump_strength", 4.0}}}};
     }
 
     /// A surface placement at a pick's anchor with the pick's suggested joint, active in any pose

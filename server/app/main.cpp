@@ -1,6 +1,6 @@
 // dermis-server — command line entry point. The offline commands:
 //   dermis-server bake   --scene S.json --out DIR [--time T] [--threads N] [--png] [--gpu] [--normals] [--gl B]
-//   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH] [--msaa N]
+//   dermis-server render --scene S.json --out frame.png [--time T | --frames A:B:STEP] [--size WxH] [--msaa N] [--aa M]
 //                        [--view V] [--heightmaps] [--gl B]
 //   dermis-server render … --frames A:B:STEP --shard I/N|auto/N [--resume]   (a farm shard)
 //   dermis-server farm-verify OUT --frames A:B:STEP [--json]
@@ -324,8 +324,13 @@ int main(int argc, char** argv) {
                           "Animation range A:B:STEP in seconds (frame k at A + k·STEP)")
         ->excludes(timeOpt);
     renderCmd->add_option("--size", render.size, "Frame size WxH (overrides render.size)");
-    renderCmd->add_option("--msaa", render.msaa, "Samples per pixel 1, 2 or 4 (overrides render.msaa)")
+    renderCmd->add_option("--msaa", render.msaa,
+                          "MSAA with 1, 2 or 4 samples per pixel (overrides render.msaa and selects MSAA)")
         ->check(CLI::IsMember({1, 2, 4}));
+    renderCmd->add_option("--aa", render.aa,
+                          "Anti-aliasing: auto (post on software rasterizers, else MSAA), msaa, post or none "
+                          "(overrides render.aa)")
+        ->check(CLI::IsMember({"auto", "msaa", "post", "none"}));
     renderCmd->add_option("--view", render.view,
                           "shaded (default), or unlit: bump / displacement height as grey, normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));

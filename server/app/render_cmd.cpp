@@ -66,6 +66,7 @@ int runRender(const RenderArgs& a) {
     FrameOverrides overrides;
     overrides.view = frameViewFromString(a.view).value_or(FrameView::Shaded); // checked by CLI11
     if (a.msaa) overrides.msaa = a.msaa;
+    if (!a.aa.empty()) overrides.aa = antiAliasingFromString(a.aa);
     if (!a.size.empty()) {
         int w = 0, h = 0;
         char tail = 0;

@@ -21,7 +21,8 @@ namespace dermis::app {
 struct RenderArgs {
     std::string scene, out, gl = "auto", frames, size, content, view = "shaded", shard;
     double time = 0.0;
-    int msaa = 0; ///< 0: the scene's render.msaa
+    int msaa = 0; ///< 0: the scene's render.msaa (given: MSAA with that many samples)
+    std::string aa; ///< "": the scene's render.aa (or MSAA when msaa is given); auto|msaa|post|none
     bool hasTime = false, heightmaps = false, resume = false;
 };
 

@@ -14,7 +14,11 @@ Result<FramePlan> planFrame(const Scene& scene, const Model& model, const Patter
     r = scene.render;
     if (o.width) r.size[0] = *o.width;
     if (o.height) r.size[1] = *o.height;
-    if (o.msaa) r.msaa = *o.msaa;
+    if (o.msaa) {
+        r.msaa = *o.msaa;
+        r.aa = AntiAliasing::Msaa;
+    }
+    if (o.aa) r.aa = *o.aa;
     if (o.yaw) r.camera.yaw = *o.yaw;
     if (o.pitch) r.camera.pitch = *o.pitch;
     if (o.distance) r.camera.distance = *o.distance;

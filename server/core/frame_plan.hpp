@@ -40,7 +40,10 @@ struct HeightMapInput {
 /// A frame's overrides of the scene (query parameters, --time, --size). Absent = the scene's.
 struct FrameOverrides {
     std::optional<double> time; ///< overrides pose.time
+    /// `msaa` given without `aa` selects MSAA with that many samples (as before `render.aa`:
+    /// `msaa=1` is a frame without anti-aliasing); `aa` given sets the mode.
     std::optional<int> width, height, msaa;
+    std::optional<AntiAliasing> aa;
     std::optional<double> yaw, pitch, distance;
     std::optional<std::array<double, 3>> target; ///< the camera's target (Camera::target)
     FrameView view = FrameView::Shaded; ///< what the frame shows (never in the scene)

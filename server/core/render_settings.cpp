@@ -1,5 +1,6 @@
 #include "render_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -28,6 +29,20 @@ std::optional<FrameView> frameViewFromString(std::string_view s) {
     for (FrameView v : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal})
         if (toString(v) == s) return v;
     return std::nullopt;
+}
+
+std::string ResolvedAntiAliasing::label() const {
+    if (mode == AntiAliasing::Post) return "post";
+    if (mode == AntiAliasing::None || samples <= 1) return "none";
+    return "msaa" + std::to_string(samples);
+}
+
+ResolvedAntiAliasing resolveAntiAliasing(const RenderSettings& render, bool softwareRasterizer,
+                                         int maxSamples) {
+    AntiAliasing mode = render.aa;
+    if (mode == AntiAliasing::Auto) mode = softwareRasterizer ? AntiAliasing::Post : AntiAliasing::Msaa;
+    if (mode != AntiAliasing::Msaa) return {mode, 1};
+    return {mode, std::max(1, std::min(render.msaa, maxSamples))};
 }
 
 Status validateRenderSettings(const RenderSettings& r, const RenderLimits& limits, const char* where) {

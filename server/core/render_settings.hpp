@@ -11,6 +11,7 @@
 #include "scene.hpp"
 
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace dermis {
@@ -33,6 +34,23 @@ std::optional<FrameView> frameViewFromString(std::string_view s);
 struct RenderLimits {
     int maxSide = kMaxRenderSize; ///< a server's configured limit (≤ kMaxRenderSize)
 };
+
+/// What a frame's anti-aliasing resolves to: the samples of its colour target and whether the
+/// post-process edge pass runs after it (never both: Post and None draw one sample).
+struct ResolvedAntiAliasing {
+    AntiAliasing mode = AntiAliasing::Msaa; ///< never Auto
+    int samples = 1;
+    /// "msaa4", "msaa2", "post" or "none" (MSAA with one sample is "none"): the frame answer's
+    /// X-Dermis-AA header and the benchmarks' label.
+    std::string label() const;
+};
+
+/// The one place `render.aa: auto` is decided (SPEC §2b "render"): Auto is Post on a software
+/// rasterizer and MSAA with `render.msaa` samples elsewhere; Msaa uses min(render.msaa,
+/// maxSamples) samples (the GL's limit; ≥ 1); Post and None draw one sample. Pure; does not check
+/// ranges (validateRenderSettings does).
+ResolvedAntiAliasing resolveAntiAliasing(const RenderSettings& render, bool softwareRasterizer,
+                                         int maxSamples);
 
 /// Checks ranges, naming the first offending field by JSON pointer under "/render":
 /// size sides in [1, kMaxRenderSize] (InvalidArgument) and ≤ limits.maxSide (TooLarge);

@@ -27,6 +27,24 @@ std::optional<DisplacementMode> displacementModeFromString(std::string_view s) {
     return std::nullopt;
 }
 
+std::string_view toString(AntiAliasing a) {
+    switch (a) {
+    case AntiAliasing::Msaa: return "msaa";
+    case AntiAliasing::Post: return "post";
+    case AntiAliasing::None: return "none";
+    case AntiAliasing::Auto: break;
+    }
+    return "auto";
+}
+
+std::optional<AntiAliasing> antiAliasingFromString(std::string_view s) {
+    if (s == "auto") return AntiAliasing::Auto;
+    if (s == "msaa") return AntiAliasing::Msaa;
+    if (s == "post") return AntiAliasing::Post;
+    if (s == "none") return AntiAliasing::None;
+    return std::nullopt;
+}
+
 std::string_view toString(Projection p) { return p == Projection::Surface ? "surface" : "uv"; }
 
 double Placement::depthOrDefault() const {
@@ -120,6 +138,7 @@ json toJson(const Scene& scene) {
     render["displacement_scale"] = r.displacementScale ? json(*r.displacementScale) : json("auto");
     render["bump_strength"] = r.bumpStrength;
     render["msaa"] = r.msaa;
+    render["aa"] = std::string(toString(r.aa));
     render["displacement"] = std::string(toString(r.displacement));
     doc["render"] = std::move(render);
     return doc;

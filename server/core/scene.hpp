@@ -136,12 +136,22 @@ enum class DisplacementMode { Vertex, Tessellated };
 std::string_view toString(DisplacementMode m);
 std::optional<DisplacementMode> displacementModeFromString(std::string_view s);
 
+/// How a frame is anti-aliased (`render.aa`). Auto: MSAA with `msaa` samples on a GPU, Post on a
+/// software rasterizer (Mesa llvmpipe / softpipe), where MSAA 4 costs 2–2.6× the skin pass;
+/// Msaa: always `msaa` samples (1 = none); Post: one full-screen edge pass (FXAA, shaders/
+/// fxaa.frag) over a 1-sample frame; None: 1 sample, no pass. resolveAntiAliasing
+/// (render_settings.hpp) is the one place Auto becomes a mode.
+enum class AntiAliasing { Auto, Msaa, Post, None };
+std::string_view toString(AntiAliasing a);
+std::optional<AntiAliasing> antiAliasingFromString(std::string_view s);
+
 struct RenderSettings {
     std::array<int, 2> size{1024, 1024};
     Camera camera;
     std::optional<double> displacementScale; ///< absent = "auto"
     double bumpStrength = 1.0;
-    int msaa = 4; ///< 1, 2 or 4
+    int msaa = 4; ///< 1, 2 or 4: the samples when `aa` resolves to MSAA
+    AntiAliasing aa = AntiAliasing::Auto;
     /// "vertex": displace the mesh's own vertices (the paper); "tessellated": subdivide each
     /// triangle on the GPU first, so that bulges smaller than a triangle still move the surface.
     DisplacementMode displacement = DisplacementMode::Vertex;

@@ -540,6 +540,12 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
         if (!n) return n.error();
         render.msaa = *n;
     }
+    if (const json* aa = Reader::find(v, "aa")) {
+        auto e = rd.enumeration(*aa, ptr + "/aa", antiAliasingFromString,
+                                "\"auto\", \"msaa\", \"post\" or \"none\"");
+        if (!e) return e.error();
+        render.aa = *e;
+    }
     if (const json* dm = Reader::find(v, "displacement")) {
         auto e = rd.enumeration(*dm, ptr + "/displacement", displacementModeFromString,
                                 "\"vertex\" or \"tessellated\"");

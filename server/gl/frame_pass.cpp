@@ -6,6 +6,7 @@
 #include "gl/uniform_blocks.hpp"
 
 #include "core/camera.hpp"
+#include "core/edge_aa.hpp"
 #include "core/render_settings.hpp"
 
 #include <algorithm>
@@ -131,7 +132,11 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
 
     // Stage 2: skin, displace, shade.
     t0 = std::chrono::steady_clock::now();
-    const int samples = std::min(rs.msaa, std::max(1, info.maxSamples));
+    // MSAA draws `samples` per pixel and resolves; post-process AA draws one and runs the edge
+    // pass on the read-back frame below (core/edge_aa.hpp).
+    const ResolvedAntiAliasing aa = resolveAntiAliasing(rs, info.software, info.maxSamples);
+    const int samples = aa.samples;
+    out.antiAliasing = aa.label();
     if (auto s = ensureFrameTargets(W, H, samples); !s) return s.error();
     uploadPalette(model, **gm, req.world);
     const double dispScale = rs.displacementScale ? *rs.displacementScale : (*gm)->autoDisplacement;
@@ -156,6 +161,11 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     if (auto s = readFrame(readFbo, out.image); !s) return s.error();
     out.timings.readbackMs = msSince(t0);
     if (auto s = checkGl("frame readback"); !s) return s.error();
+    if (aa.mode == AntiAliasing::Post) {
+        t0 = std::chrono::steady_clock::now();
+        antiAliasEdges(out.image);
+        out.timings.postAaMs = msSince(t0);
+    }
     return out;
 }
 

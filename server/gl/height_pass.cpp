@@ -120,17 +120,12 @@ HeightPassBlock surfaceBlock(const BakePlacement& p, const TexelRect& rect, int 
 }
 
 /// Whether this height pass is baked by the CPU (RendererOptions::softwareCpuBakeCoverage): a
-/// software rasterizer and footprints covering more than `coverage` map areas.
-bool softwareRasterizer(const std::string& glRenderer) {
-    return glRenderer.find("llvmpipe") != std::string::npos ||
-           glRenderer.find("softpipe") != std::string::npos ||
-           glRenderer.find("swrast") != std::string::npos;
-}
-
+/// software rasterizer (RendererInfo::software) and footprints covering more than `coverage` map
+/// areas.
 bool bakeOnCpu(const HeightPassInput& in, const std::vector<TexelRect>& rects, double coverage,
-               const std::string& glRenderer) {
+               bool software) {
     if (!(coverage > 0.0)) return false;
-    if (!softwareRasterizer(glRenderer)) return false;
+    if (!software) return false;
     double covered = 0.0;
     for (std::size_t k = 0; k < in.placements.size(); ++k) {
         const BakePlacement& p = in.placements[k];
@@ -306,7 +301,7 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
         return Ok{};
     }
     lastHeights.reset();
-    if (bakeOnCpu(in, resolved->surfaceRects, softwareCpuBakeCoverage, info.renderer)) {
+    if (bakeOnCpu(in, resolved->surfaceRects, softwareCpuBakeCoverage, info.software)) {
         BakeSettings settings;
         settings.width = W;
         settings.height = H;
@@ -326,7 +321,7 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
     // maps (glTexSubImage2D) and only clears them: a frame without placements after a CPU-baked
     // one differed from the same frame rendered again (glFlush did not help). Waiting for the
     // pass makes frames depend on their inputs only; hardware GLs are not affected.
-    if (softwareRasterizer(info.renderer)) glFinish();
+    if (info.software) glFinish();
     if (auto st = checkGl("height pass"); !st) return st;
     lastHeights = std::move(key);
     ++heightPasses;

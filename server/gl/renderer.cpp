@@ -70,6 +70,17 @@ Status Renderer::Impl::init(GlBackend backend) {
     return checkGl("initialising the renderer");
 }
 
+namespace {
+
+/// Mesa's software rasterizers, by GL_RENDERER ("llvmpipe (LLVM 15.0.6, 256 bits)").
+bool softwareRasterizer(const std::string& glRenderer) {
+    return glRenderer.find("llvmpipe") != std::string::npos ||
+           glRenderer.find("softpipe") != std::string::npos ||
+           glRenderer.find("swrast") != std::string::npos;
+}
+
+} // namespace
+
 void Renderer::Impl::readDriverInfo() {
     info.backend = std::string(toString(context->backend()));
     info.device = context->device();
@@ -83,6 +94,7 @@ void Renderer::Impl::readDriverInfo() {
     info.glslVersion = str(GL_SHADING_LANGUAGE_VERSION);
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &info.maxTextureSize);
     glGetIntegerv(GL_MAX_SAMPLES, &info.maxSamples);
+    info.software = softwareRasterizer(info.renderer);
     glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &uboAlignment);
     glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &maxRenderbufferSize);
     uboAlignment = std::max(uboAlignment, 16);

@@ -60,6 +60,9 @@ struct RendererInfo {
     std::string vendor, renderer, version, glslVersion; ///< glGetString
     int maxTextureSize = 0;
     int maxSamples = 0;
+    /// A software rasterizer (Mesa llvmpipe / softpipe / swrast): `render.aa: auto` is post-process
+    /// AA there (core resolveAntiAliasing), and big height passes are baked on the CPU.
+    bool software = false;
     std::vector<std::string> tried; ///< one line per backend tried before this one, with why it failed
 };
 
@@ -99,6 +102,7 @@ using HeightPassInput = HeightMapInput;
 struct FrameTimings {
     double heightMs = 0.0;   ///< height pass (or upload of CPU maps)
     double skinMs = 0.0;     ///< skin pass incl. MSAA resolve
+    double postAaMs = 0.0;   ///< post-process AA on the read-back frame (render.aa "post")
     double readbackMs = 0.0; ///< pixel-pack readback into the frame
 };
 
@@ -152,6 +156,7 @@ struct FrameResult {
     glm::vec3 boundsMin{0.0f}, boundsMax{0.0f}; ///< posed bounds used for framing
     glm::vec3 cameraTarget{0.0f}; ///< the point the camera looked at (FrameCamera::target)
     float cameraDistance = 0.0f;  ///< eye to target ("auto" resolved)
+    std::string antiAliasing;     ///< what render.aa resolved to: ResolvedAntiAliasing::label()
 };
 
 /// What a service needs of a renderer, so that it can be injected: Renderer is the GL one; tests

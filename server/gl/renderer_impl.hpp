@@ -17,6 +17,7 @@
 #pragma once
 
 #include "core/camera.hpp"
+#include "core/render_settings.hpp"
 #include "gl/gl_context.hpp"
 #include "gl/renderer.hpp"
 

@@ -91,6 +91,7 @@ void sendDocError(Res& res, const Error& e) {
 void sendImage(Res& res, EncodedImage&& img) {
     res.status = 200;
     if (!img.backend.empty()) res.set_header("X-Dermis-Backend", img.backend);
+    if (!img.antiAliasing.empty()) res.set_header("X-Dermis-AA", img.antiAliasing);
     if (img.changedPixels >= 0) res.set_header("X-Dermis-Changed-Pixels", std::to_string(img.changedPixels));
     res.body.assign(img.bytes.begin(), img.bytes.end());
     res.set_header("Content-Type", img.contentType);

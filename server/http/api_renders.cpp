@@ -7,6 +7,7 @@
 
 #include <set>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -116,6 +117,14 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         }
         p.surfaceBrush = std::array<double, 7>{b[0], b[1], b[2], b[3], b[4], b[5], b[6]};
     }
+    if (req.has_param("aa")) {
+        const auto aa = antiAliasingFromString(req.get_param_value("aa"));
+        if (!aa) {
+            sendError(res, 422, "invalid_argument", "dermis::Api: aa: must be auto, msaa, post or none", "aa");
+            return false;
+        }
+        p.aa = *aa;
+    }
     if (req.has_param("view")) {
         const auto view = frameViewFromString(req.get_param_value("view"));
         if (!view) {
@@ -160,11 +169,17 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
     return true;
 }
 
-/// A frame answer: the image and the camera the renderer used (X-Dermis-Camera-Distance,
-/// X-Dermis-Camera-Target: "x,y,z"), which the editor needs to pan and zoom from an "auto" camera.
-void sendFrame(Res& res, EncodedImage&& img) {
+/// A frame answer: the image, the camera the renderer used (X-Dermis-Camera-Distance,
+/// X-Dermis-Camera-Target: "x,y,z"), which the editor needs to pan and zoom from an "auto" camera,
+/// and `Server-Timing: render;dur=<ms>`, the server's time from `t0` (the route's start) to the
+/// encoded frame, with which the editor paces the frames it keeps in flight over a slow link.
+void sendFrame(Res& res, EncodedImage&& img, std::chrono::steady_clock::time_point t0) {
     const auto camera = img.camera;
     sendImage(res, std::move(img));
+    char dur[64];
+    std::snprintf(dur, sizeof dur, "render;dur=%.1f",
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    res.set_header("Server-Timing", dur);
     if (!camera) return;
     char buf[160];
     std::snprintf(buf, sizeof buf, "%.9g", (*camera)[0]);
@@ -211,7 +226,7 @@ namespace {
 /// comma-separated), so that one parser (frameParams) reads both. False (and 422 sent) for
 /// anything else than an object of known members.
 bool framePostParams(const Req& req, Res& res, Req& out) {
-    static const std::set<std::string> known = {"format", "width", "height", "msaa", "yaw", "pitch",
+    static const std::set<std::string> known = {"format", "width", "height", "msaa", "aa", "yaw", "pitch",
                                                 "distance", "time", "target", "highlight", "hover",
                                                 "brush", "surface_brush", "view", "patterns", "only",
                                                 "preview", "revision"};
@@ -248,31 +263,34 @@ bool framePostParams(const Req& req, Res& res, Req& out) {
 
 void installRenderRoutes(RouteTable& t) {
     t.add("GET", "/scenes/{id}/frame", [](Api::Impl& a, const Req& req, Res& res) {
+        const auto t0 = std::chrono::steady_clock::now();
         FrameParams p;
         if (!frameParams(req, res, p)) return;
         auto r = a.svc.frame(req.matches[1], p);
         if (!r) return sendError(res, r.error());
-        sendFrame(res, std::move(*r));
+        sendFrame(res, std::move(*r), t0);
     });
     // The same frame with its parameters in a JSON body: a preview (up to 16 KB) need not fit the
     // 8 KB request line. Nothing is stored.
     t.add("POST", "/scenes/{id}/frame", [](Api::Impl& a, const Req& req, Res& res) {
+        const auto t0 = std::chrono::steady_clock::now();
         Req q;
         if (!framePostParams(req, res, q)) return;
         FrameParams p;
         if (!frameParams(q, res, p)) return;
         auto r = a.svc.frame(req.matches[1], p);
         if (!r) return sendError(res, r.error());
-        sendFrame(res, std::move(*r));
+        sendFrame(res, std::move(*r), t0);
     });
     t.add("GET", "/scenes/{id}/frame-diff", [](Api::Impl& a, const Req& req, Res& res) {
         FrameParams p;
         if (!frameParams(req, res, p)) return;
         if (!req.has_param("against"))
             return sendError(res, 422, "invalid_argument", "dermis::Api: against: off or a revision number is required", "against");
+        const auto t0 = std::chrono::steady_clock::now();
         auto r = a.svc.frameDiff(req.matches[1], p, req.get_param_value("against"));
         if (!r) return sendError(res, r.error());
-        sendFrame(res, std::move(*r));
+        sendFrame(res, std::move(*r), t0);
     });
     t.add("GET", "/scenes/{id}/sweep", [](Api::Impl& a, const Req& req, Res& res) {
         SweepParams p;

@@ -372,6 +372,8 @@ json Service::info() const {
                 {"backend", r.backend},
                 {"device", r.device},
                 {"gl", {{"vendor", r.vendor}, {"renderer", r.renderer}, {"version", r.version}}},
+                // What the default render settings' aa ("auto") resolves to on this renderer.
+                {"aa_auto", resolveAntiAliasing(RenderSettings{}, r.software, r.maxSamples).label()},
                 {"limits", limits_.toJson()},
                 {"render_queue", state_->inFlight.load()}};
     if (auto c = state_->renderer->cacheStats())

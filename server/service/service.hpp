@@ -76,6 +76,7 @@ struct EncodedImage {
     std::vector<std::uint8_t> bytes;
     std::string contentType;
     std::string backend; ///< which GL backend rendered it ("" for CPU-only answers)
+    std::string antiAliasing = {}; ///< frames: what render.aa resolved to ("post", "msaa4", "none"; header X-Dermis-AA)
     std::int64_t changedPixels = -1; ///< frame-diff only: pixels that differ (−1: not a diff)
     /// Frames: the camera the renderer used, "auto" distance and target resolved: distance,
     /// target x, y, z (headers X-Dermis-Camera-Distance / -Target). Absent for other images.
@@ -100,6 +101,7 @@ std::optional<std::uint64_t> parseRevisionNumber(const std::string& text);
 struct FrameParams {
     std::string format = "png"; ///< png | jpeg | webp (lossless); see isFrameFormat
     std::optional<int> width, height, msaa;
+    std::optional<AntiAliasing> aa; ///< `aa`; see FrameOverrides for how it meets `msaa`
     std::optional<double> yaw, pitch, distance, time;
     std::optional<std::array<double, 3>> target; ///< the camera's target (core Camera::target)
     // Outlines on the skin (the editor's selection, hover and place brush; nothing when empty:

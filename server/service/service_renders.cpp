@@ -20,6 +20,7 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     o.width = p.width;
     o.height = p.height;
     o.msaa = p.msaa;
+    o.aa = p.aa;
     o.yaw = p.yaw;
     o.pitch = p.pitch;
     o.distance = p.distance;
@@ -98,7 +99,8 @@ Result<std::vector<FrameOutline>> outlinesOf(const Scene& scene, const FramePara
 } // namespace
 
 Result<Image8> Service::State::renderImage(const Snapshot& snap, const FrameParams& p,
-                                           std::optional<std::array<double, 4>>* camera) {
+                                           std::optional<std::array<double, 4>>* camera,
+                                           std::string* antiAliasing) {
     auto plan = this->plan(snap, p);
     if (!plan) return plan.error();
     auto outlines = outlinesOf(snap.scene, p);
@@ -110,6 +112,7 @@ Result<Image8> Service::State::renderImage(const Snapshot& snap, const FramePara
     if (camera)
         *camera = std::array<double, 4>{result->cameraDistance, result->cameraTarget.x,
                                         result->cameraTarget.y, result->cameraTarget.z};
+    if (antiAliasing) *antiAliasing = result->antiAliasing;
     return std::move(result->image);
 }
 
@@ -198,7 +201,7 @@ Result<Service::State::Snapshot> Service::State::withCompare(Snapshot snap, cons
 
 Result<EncodedImage> Service::State::render(const Snapshot& snap, const FrameParams& p) {
     EncodedImage out;
-    auto image = renderImage(snap, p, &out.camera);
+    auto image = renderImage(snap, p, &out.camera, &out.antiAliasing);
     if (!image) return image.error();
     out.backend = renderer->info().backend;
     auto bytes = p.format == "jpeg"   ? encodeJpeg(*image, 90)

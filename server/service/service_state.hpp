@@ -352,9 +352,11 @@ struct Service::State {
     /// p.only: InvalidArgument, field "only").
     Result<Snapshot> withCompare(Snapshot snap, const std::string& id, const FrameParams& p) const;
     /// Plans and renders one frame of `snap` with `p`'s overrides and outlines (not encoded);
-    /// `camera` (when given) receives the camera used: distance, target x, y, z.
+    /// `camera` (when given) receives the camera used: distance, target x, y, z; `antiAliasing`
+    /// what render.aa resolved to (FrameResult::antiAliasing).
     Result<Image8> renderImage(const Snapshot& snap, const FrameParams& p,
-                               std::optional<std::array<double, 4>>* camera = nullptr);
+                               std::optional<std::array<double, 4>>* camera = nullptr,
+                               std::string* antiAliasing = nullptr);
     /// The frame plan of `snap` with `p`'s overrides (errors name the parameters).
     Result<FramePlan> plan(const Snapshot& snap, const FrameParams& p) const;
     /// Plans and renders one frame of `snap` with `p`'s overrides; encodes it.
