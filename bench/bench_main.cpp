@@ -9,9 +9,11 @@
 //    library's size); footprints cover 0.08–0.3 of the UV square each, rotated.
 // 2. frame: the paper's per-frame loop on the default character (~4.3k triangles, ~50 joints)
 //    with the first 15 placements of models/default.scene.json and 1024² maps, the pose moving
-//    along the squat clip: height pass, skin pass, readback, PNG encode and total, at 512² and
-//    1024², MSAA off and 4x, with GPU height maps and with CPU height maps (the paper's "CPU"
-//    configuration). Stages are separated by glFinish.
+//    along the squat clip: height pass, skin pass, post-process AA, readback, PNG encode and
+//    total, at 512² and 1024², anti-aliasing off, post (render.aa "post") and MSAA 4x, with GPU
+//    height maps and with CPU height maps (the paper's "CPU" configuration). Stages are
+//    separated by glFinish. "aa_quality": SSIM of one 1024² frame per mode against MSAA 4x and
+//    against a supersampled frame (2048² MSAA 4x, 2×2 blocks averaged).
 // 3. encoders (JSON "encoders"): PNG, JPEG, lossless WebP and EXR encode time and size of a
 //    512² and a 1024² frame of that scene (bench_encoders.cpp).
 // 4. scaling (JSON "scaling"): frame time against placements, map size, triangles and joints,
@@ -19,6 +21,7 @@
 #include "core/heightmap.hpp"
 #include "gl/renderer.hpp"
 #include "core/frame_plan.hpp"
+#include "core/image_similarity.hpp"
 #include "io/frame_io.hpp"
 #include "io/scene_files.hpp"
 #include "bench_common.hpp"
@@ -84,10 +87,13 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
     HeightMaps cpuHeights; // reused: no per-frame allocation
     for (bool cpuMaps : {false, true})
         for (int size : {512, 1024})
-            for (int msaa : {1, 4}) {
+            for (const AntiAliasing aa : {AntiAliasing::None, AntiAliasing::Post, AntiAliasing::Msaa}) {
+                // Off, the post-process edge pass (render.aa "post"), MSAA 4x.
+                const int msaa = aa == AntiAliasing::Msaa ? 4 : 1;
                 scene.render.size = {size, size};
                 scene.render.msaa = msaa;
-                std::vector<double> height, skinMs, readback, encode, staged, total;
+                scene.render.aa = aa;
+                std::vector<double> height, skinMs, postAa, readback, encode, staged, total;
                 // Two loops: with glFinish between stages (per-stage figures), then without
                 // (the frame time a client sees: pose → encoded frame).
                 for (bool profile : {true, false})
@@ -130,6 +136,7 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                         height.push_back(cpuMaps ? cpuBakeMs + result->timings.heightMs
                                                  : result->timings.heightMs);
                         skinMs.push_back(result->timings.skinMs);
+                        postAa.push_back(result->timings.postAaMs);
                         readback.push_back(result->timings.readbackMs);
                         encode.push_back(msSince(te));
                         staged.push_back(msSince(t0));
@@ -138,18 +145,56 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                                  {"heightmaps", cpuMaps ? "cpu" : "gpu"},
                                  {"frame_size", size},
                                  {"map_size", 1024},
+                                 {"aa", toString(aa)},
                                  {"msaa", msaa},
                                  {"placements", scene.placements.size()},
                                  {"triangles", model->triangleCount()},
                                  {"joints", model->joints.size()},
                                  {"height_ms", round2(medianMs(height))},
                                  {"skin_ms", round2(medianMs(skinMs))},
+                                 {"post_aa_ms", round2(medianMs(postAa))},
                                  {"readback_ms", round2(medianMs(readback))},
                                  {"png_encode_ms", round2(medianMs(encode))},
                                  {"total_ms", round2(medianMs(total))},
                                  {"total_with_stage_syncs_ms", round2(medianMs(staged))},
                                  {"repetitions", total.size()}});
             }
+    return 0;
+}
+
+/// SSIM of the squat at t = 0.5 s, 1024², with each anti-aliasing mode against MSAA 4x and
+/// against a supersampled frame (2048² with MSAA 4x, each 2×2 block averaged: 16 samples).
+int benchAaQuality(Renderer& renderer, const DefaultScene& ds, nlohmann::json& out) {
+    const auto frame = [&](AntiAliasing aa, int size) -> Result<Image8> {
+        Scene scene = ds.scene;
+        scene.render.size = {size, size};
+        scene.render.aa = aa;
+        scene.render.msaa = 4;
+        FrameOverrides overrides;
+        overrides.time = ds.clipDuration * 0.5;
+        auto plan = planFrame(scene, *ds.model, ds.images, nullptr, overrides);
+        if (!plan) return plan.error();
+        auto result = renderer.renderFrame(frameRequest(*plan, ds.model));
+        if (!result) return result.error();
+        return std::move(result->image);
+    };
+    auto big = frame(AntiAliasing::Msaa, 2048);
+    auto msaa = frame(AntiAliasing::Msaa, 1024), post = frame(AntiAliasing::Post, 1024),
+         none = frame(AntiAliasing::None, 1024);
+    for (const auto* r : {&big, &msaa, &post, &none})
+        if (!*r) {
+            std::cerr << r->error().message << "\n";
+            return 1;
+        }
+    auto truth = boxDownsample(*big, 2);
+    if (!truth) {
+        std::cerr << truth.error().message << "\n";
+        return 1;
+    }
+    const auto s = [](const Image8& a, const Image8& b) { return std::round(*ssim(a, b) * 10000) / 10000; };
+    out = {{"frame_size", 1024},
+           {"vs_msaa4", {{"none", s(*none, *msaa)}, {"post", s(*post, *msaa)}}},
+           {"vs_supersampled", {{"none", s(*none, *truth)}, {"post", s(*post, *truth)}, {"msaa4", s(*msaa, *truth)}}}};
     return 0;
 }
 
@@ -233,7 +278,7 @@ int main(int argc, char** argv) {
                              {"repetitions", ms.size()}});
         }
     nlohmann::json gpuInfo = nullptr;
-    nlohmann::json encoders = nullptr, scalingOut = nullptr;
+    nlohmann::json encoders = nullptr, scalingOut = nullptr, aaQuality = nullptr;
     if (gpu || scaling) {
         auto renderer = Renderer::create(backend);
         if (!renderer) {
@@ -249,6 +294,7 @@ int main(int argc, char** argv) {
         }
         if (gpu) {
             if (int rc = benchFrames(**renderer, *ds, repeat, cases); rc != 0) return rc;
+            if (int rc = benchAaQuality(**renderer, *ds, aaQuality); rc != 0) return rc;
             encoders = nlohmann::json::array();
             if (int rc = benchEncoders(**renderer, *ds, std::max(5, repeat), encoders); rc != 0)
                 return rc;
@@ -262,6 +308,7 @@ int main(int argc, char** argv) {
                           {"hardware_threads", hw},
                           {"gl", gpuInfo},
                           {"results", cases},
+                          {"aa_quality", aaQuality},
                           {"encoders", encoders},
                           {"scaling", scalingOut}};
     std::cout << out.dump(2) << "\n";

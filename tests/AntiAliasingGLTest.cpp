@@ -72,25 +72,6 @@ std::unique_ptr<LoadedScene> AntiAliasingGLTest::loaded_;
 std::shared_ptr<const Model> AntiAliasingGLTest::model_;
 std::string AntiAliasingGLTest::createError_;
 
-/// `img` shrunk by `k` in each direction, each pixel the mean of its k×k block (sRGB bytes
-/// averaged: near enough for a similarity reference).
-Image8 boxDown(const Image8& img, int k) {
-    Image8 out;
-    out.width = img.width / k;
-    out.height = img.height / k;
-    out.rgba.resize(static_cast<std::size_t>(out.width) * out.height * 4);
-    for (int y = 0; y < out.height; ++y)
-        for (int x = 0; x < out.width; ++x)
-            for (int c = 0; c < 4; ++c) {
-                int sum = 0;
-                for (int dy = 0; dy < k; ++dy)
-                    for (int dx = 0; dx < k; ++dx)
-                        sum += img.rgba[((static_cast<std::size_t>(y) * k + dy) * img.width + x * k + dx) * 4 + c];
-                out.rgba[(static_cast<std::size_t>(y) * out.width + x) * 4 + c] = static_cast<std::uint8_t>((sum + k * k / 2) / (k * k));
-            }
-    return out;
-}
-
 } // namespace
 
 TEST_F(AntiAliasingGLTest, AutoIsPostOnASoftwareRasterizerAndMsaaOnAGpu) {
@@ -129,7 +110,7 @@ TEST_F(AntiAliasingGLTest, PostIsCloserToASupersampledFrameThanNoAntiAliasing) {
     // a pixel). The framing depends on the aspect only, so the pictures line up.
     auto big = squat(AntiAliasing::Msaa, 4, 1024);
     ASSERT_TRUE(big) << big.error().message;
-    const Image8 truth = boxDown(big->image, 4);
+    const Image8 truth = *boxDownsample(big->image, 4);
     auto msaa = squat(AntiAliasing::Msaa), post = squat(AntiAliasing::Post), none = squat(AntiAliasing::None);
     ASSERT_TRUE(msaa && post && none);
     const double sNone = *ssim(none->image, truth), sPost = *ssim(post->image, truth),

@@ -135,6 +135,25 @@ TEST(AntiAliasingTest, SsimIsOneForTheSameImageLowerForOthersAndChecksSizes) {
     EXPECT_FALSE(ssim(raster(4, 4, 1, shapes), raster(4, 4, 1, shapes)));
 }
 
+TEST(AntiAliasingTest, BoxDownsampleAveragesBlocks) {
+    Image8 img;
+    img.width = 5;
+    img.height = 4;
+    img.rgba.assign(5 * 4 * 4, 0);
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 5; ++x) img.rgba[(static_cast<std::size_t>(y) * 5 + x) * 4] = static_cast<std::uint8_t>(10 * x + y);
+    auto half = boxDownsample(img, 2);
+    ASSERT_TRUE(half);
+    EXPECT_EQ(half->width, 2); // the fifth column is not a whole block
+    EXPECT_EQ(half->height, 2);
+    EXPECT_EQ(half->rgba[0], 6);  // (0 + 1 + 10 + 11) / 4 = 5.5 → 6
+    EXPECT_EQ(half->rgba[4], 26); // (20 + 21 + 30 + 31) / 4 = 25.5 → 26
+    EXPECT_EQ(half->rgba[8], 8);  // (2 + 3 + 12 + 13) / 4
+    EXPECT_EQ(boxDownsample(img, 1)->rgba, img.rgba);
+    EXPECT_FALSE(boxDownsample(img, 0));
+    EXPECT_FALSE(boxDownsample(img, 5));
+}
+
 TEST(AntiAliasingTest, AutoIsPostOnSoftwareRasterizersAndMsaaElsewhere) {
     RenderSettings rs;
     EXPECT_EQ(rs.aa, AntiAliasing::Auto);

@@ -50,4 +50,29 @@ Result<double> ssim(const Image8& a, const Image8& b) {
     return sum / static_cast<double>(windows);
 }
 
+Result<Image8> boxDownsample(const Image8& image, int factor) {
+    const char* where = "dermis::boxDownsample";
+    if (factor < 1) return makeError(ErrorCode::InvalidArgument, where, "factor", "must be at least 1");
+    if (image.rgba.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 4 ||
+        image.width < factor || image.height < factor)
+        return makeError(ErrorCode::InvalidArgument, where, "image", "smaller than one block or a buffer that does not match its size");
+    Image8 out;
+    out.width = image.width / factor;
+    out.height = image.height / factor;
+    out.rgba.resize(static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height) * 4);
+    const int n = factor * factor;
+    for (int y = 0; y < out.height; ++y)
+        for (int x = 0; x < out.width; ++x)
+            for (std::size_t c = 0; c < 4; ++c) {
+                int sum = 0;
+                for (int dy = 0; dy < factor; ++dy)
+                    for (int dx = 0; dx < factor; ++dx)
+                        sum += image.rgba[(static_cast<std::size_t>(y * factor + dy) * static_cast<std::size_t>(image.width) +
+                                           static_cast<std::size_t>(x * factor + dx)) * 4 + c];
+                out.rgba[(static_cast<std::size_t>(y) * static_cast<std::size_t>(out.width) + static_cast<std::size_t>(x)) * 4 + c] =
+                    static_cast<std::uint8_t>((sum + n / 2) / n);
+            }
+    return out;
+}
+
 } // namespace dermis
