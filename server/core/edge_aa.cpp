@@ -11,7 +11,8 @@ namespace {
 
 constexpr float kEdgeThreshold = 0.125f;     // relative contrast that makes an edge (FXAA "high")
 constexpr float kEdgeThresholdMin = 0.0312f; // absolute contrast below which nothing is an edge
-constexpr float kSubpixel = 0.75f;           // strength of the sub-pixel term (FXAA's default)
+constexpr float kSubpixel = 0.5f;            // strength of the sub-pixel term (FXAA's default 0.75 blurs texture
+                                             // detail MSAA keeps: SSIM vs MSAA 4x 0.9961 → 0.9966)
 constexpr int kSteps = 10;
 constexpr float kStepScale[kSteps] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.5f, 2.0f, 2.0f, 4.0f, 8.0f};
 

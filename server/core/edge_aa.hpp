@@ -21,8 +21,9 @@ namespace dermis {
 /// local maximum) is left as it is; on an edge, the edge's direction comes from the 3×3 luma
 /// gradients, the search walks along it both ways (up to 10 steps of 1–8 pixels) to its ends, and
 /// the pixel becomes a linear blend of itself and its neighbour across the edge, weighted by how
-/// near the nearer end is, or by the sub-pixel term (how much it stands out of its 3×3 average)
-/// where that is larger. Luma is computed on the encoded values, as FXAA does.
+/// near the nearer end is, or by the sub-pixel term (how much it stands out of its 3×3 average,
+/// at half FXAA's default strength, so texture detail stays) where that is larger. Luma is
+/// computed on the encoded values, as FXAA does.
 ///
 /// `threads`: rows are split over that many threads (0: up to 2, and 1 below 256×256 pixels).
 /// An image with a side under 3 pixels, or whose buffer does not hold width·height·4 bytes, is
