@@ -334,6 +334,8 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--view", render.view,
                           "shaded (default), or unlit: bump / displacement height as grey, normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
+    renderCmd->add_flag("--timings", render.timings,
+                        "Print where the time went (start-up, the first frame's stages, encode) as JSON on stderr");
     renderCmd->add_flag("--heightmaps", render.heightmaps,
                         "Also write <frame>.bump.exr and <frame>.displacement.exr");
     renderCmd->add_option("--content", render.content, "Built-in content directory (builtin: names)");

@@ -106,10 +106,32 @@ int runRender(const RenderArgs& a) {
 
     // The GL context starts (EGL, shader compilation) on the renderer's thread while this thread
     // loads and parses the scene, its model and patterns: the two take similar time cold.
+    nlohmann::json timings = nlohmann::json::object();
+    timings["args_ms"] = msSince(t0);
     auto rendererStart = std::async(std::launch::async, [&] { return Renderer::create(backendOf(a.gl)); });
+    auto tLoad = std::chrono::steady_clock::now();
     auto loaded = loadSceneFile(a.scene, a.content.empty() ? dermisContentDir() : a.content);
-    auto renderer = rendererStart.get();
+    timings["scene_load_ms"] = msSince(tLoad);
     if (!loaded) return fail(loaded.error());
+    // SPEC §8: the height-map layout by the service's rule (core textureLayoutFor) and its
+    // rest-surface map, baked once for every frame when a surface placement needs it — still
+    // while the renderer starts.
+    auto tLayout = std::chrono::steady_clock::now();
+    auto model = std::make_shared<const Model>(std::move(loaded->model));
+    auto layout = textureLayoutFor(*model, loaded->scene.uvLayout);
+    if (!layout) return fail(layout.error());
+    overrides.layout = std::make_shared<const TextureLayout>(std::move(*layout));
+    for (const Placement& p : loaded->scene.placements)
+        if (p.enabled && p.projection == Projection::Surface && !overrides.layout->empty()) {
+            overrides.rest = std::make_shared<const RestSurfaceMap>(
+                bakeRestSurface(*model, *overrides.layout, loaded->scene.heightmapSize[0],
+                                loaded->scene.heightmapSize[1]));
+            break;
+        }
+    timings["layout_ms"] = msSince(tLayout);
+    tLoad = std::chrono::steady_clock::now();
+    auto renderer = rendererStart.get();
+    timings["renderer_wait_ms"] = msSince(tLoad);
     if (!renderer) return fail(renderer.error());
     const double stillTime = a.hasTime ? a.time : loaded->scene.pose.time;
     // The one range check of render settings (size included) runs in planFrame; "--size" is named
@@ -122,32 +144,30 @@ int runRender(const RenderArgs& a) {
         return e;
     };
 
-    auto model = std::make_shared<const Model>(std::move(loaded->model));
+    timings["context_ms"] = (*renderer)->info().contextMs;
+    timings["programs_ms"] = (*renderer)->info().programsMs;
     RenderSettings used;
     // Frames are encoded and written on a worker while the next one renders (at most two waiting:
     // bounded memory). Each file's bytes are those of the sequential path (deterministic encoders).
     FrameWriteQueue writer(1, 2);
-    // SPEC §8: the height-map layout by the service's rule (core textureLayoutFor) and its
-    // rest-surface map, baked once for every frame when a surface placement needs it.
-    auto layout = textureLayoutFor(*model, loaded->scene.uvLayout);
-    if (!layout) return fail(layout.error());
-    overrides.layout = std::make_shared<const TextureLayout>(std::move(*layout));
-    for (const Placement& p : loaded->scene.placements)
-        if (p.enabled && p.projection == Projection::Surface && !overrides.layout->empty()) {
-            overrides.rest = std::make_shared<const RestSurfaceMap>(
-                bakeRestSurface(*model, *overrides.layout, loaded->scene.heightmapSize[0],
-                                loaded->scene.heightmapSize[1]));
-            break;
-        }
     for (int k : todo) {
+        const bool first = k == todo.front();
+        const auto tFrame = std::chrono::steady_clock::now();
         overrides.time = animation ? range.time(k) : stillTime;
         auto plan = planFrame(loaded->scene, *model, loaded->images, loaded->base, overrides);
         if (!plan) return fail(checkSize(plan.error()));
         FrameRequest request = frameRequest(*plan, model);
         request.readHeightMaps = a.heightmaps;
+        request.profile = a.timings && first; // a GL sync between stages: per-stage figures
         used = plan->render;
         auto result = (*renderer)->renderFrame(request);
         if (!result) return fail(result.error());
+        if (a.timings && first) {
+            const FrameTimings& ft = result->timings;
+            timings["first_frame"] = {{"aa", result->antiAliasing}, {"height_ms", ft.heightMs},
+                                      {"skin_ms", ft.skinMs},       {"post_aa_ms", ft.postAaMs},
+                                      {"readback_ms", ft.readbackMs}, {"total_ms", msSince(tFrame)}};
+        }
         const std::string path = pathOf(k);
         auto frame = std::make_shared<FrameResult>(std::move(*result));
         const bool heightmaps = a.heightmaps;
@@ -170,8 +190,10 @@ int runRender(const RenderArgs& a) {
             }
             return Ok{};
         };
+        const auto tWrite = std::chrono::steady_clock::now();
         if (auto s = todo.size() == 1 ? job() : writer.push(std::move(job)); !s)
             return fail(s.error());
+        if (todo.size() == 1) timings["encode_write_ms"] = msSince(tWrite);
     }
     if (auto s = writer.finish(); !s) return fail(s.error());
     if (sharded) {
@@ -184,6 +206,15 @@ int runRender(const RenderArgs& a) {
               << (*renderer)->info().backend << " (" << (*renderer)->info().renderer << ") to "
               << (animation ? pathOf(todo.front()) + " …" : a.out) << " ("
               << static_cast<int>(msSince(t0)) << " ms)\n";
+    if (a.timings) {
+        timings["frames"] = todo.size();
+        timings["total_ms"] = msSince(t0);
+        for (auto& [key, value] : timings.items())
+            if (value.is_number_float()) value = std::round(value.get<double>() * 10) / 10;
+        for (auto& [key, value] : timings["first_frame"].items())
+            if (value.is_number_float()) value = std::round(value.get<double>() * 10) / 10;
+        std::cerr << nlohmann::json{{"timings", timings}}.dump() << "\n";
+    }
     return 0;
 }
 

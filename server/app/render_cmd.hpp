@@ -24,6 +24,10 @@ struct RenderArgs {
     int msaa = 0; ///< 0: the scene's render.msaa (given: MSAA with that many samples)
     std::string aa; ///< "": the scene's render.aa (or MSAA when msaa is given); auto|msaa|post|none
     bool hasTime = false, heightmaps = false, resume = false;
+    /// Print where the time went as one JSON line on stderr: start-up (context, programs, scene
+    /// load, the wait for the renderer), the first frame's stages (with a GL sync between them)
+    /// and its encode + write; the wall time outside runRender is the process's start and exit.
+    bool timings = false;
 };
 
 int runRender(const RenderArgs& a);

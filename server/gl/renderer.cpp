@@ -61,12 +61,16 @@ Status Renderer::Impl::checkGl(const char* what) {
 }
 
 Status Renderer::Impl::init(GlBackend backend) {
+    auto t0 = std::chrono::steady_clock::now();
     auto ctx = GlContext::create(backend, info.tried);
     if (!ctx) return ctx.error();
     context = std::move(*ctx);
     readDriverInfo();
+    info.contextMs = msSince(t0);
+    t0 = std::chrono::steady_clock::now();
     if (auto s = buildPrograms(); !s) return s;
     createSharedObjects();
+    info.programsMs = msSince(t0);
     return checkGl("initialising the renderer");
 }
 

@@ -63,6 +63,9 @@ struct RendererInfo {
     /// A software rasterizer (Mesa llvmpipe / softpipe / swrast): `render.aa: auto` is post-process
     /// AA there (core resolveAntiAliasing), and big height passes are baked on the CPU.
     bool software = false;
+    /// Start-up: milliseconds to create the context (EGL/OSMesa, driver strings) and to build the
+    /// programs and shared objects (`render --timings`, dermis-coldbench).
+    double contextMs = 0.0, programsMs = 0.0;
     std::vector<std::string> tried; ///< one line per backend tried before this one, with why it failed
 };
 
