@@ -43,6 +43,33 @@ TEST(RenderCliGLTest, InfoPrintsTheBackendAsJson) {
     EXPECT_FALSE(j["gl_vendor"].get<std::string>().empty());
     EXPECT_NE(j["gl_version"].get<std::string>().find("4."), std::string::npos);
     EXPECT_TRUE(j["tried"].is_array());
+    const bool software = j["gl_renderer"].get<std::string>().find("llvmpipe") != std::string::npos;
+    EXPECT_EQ(j["aa_auto"], software ? "post" : "msaa4");
+}
+
+TEST(RenderCliGLTest, AaChoosesTheAntiAliasingAndTimingsSaysWhereTheTimeWent) {
+    TempDir dir;
+    std::map<std::string, std::vector<std::uint8_t>> frames;
+    for (const char* aa : {"post", "none", "msaa"}) {
+        const std::string out = dir / (std::string(aa) + ".png");
+        CliRun r = runServer(dir, "render --scene " + kDefaultScene + " --out " + out + " --size 128x128 --aa " + aa +
+                                      " --timings" + gl());
+        ASSERT_EQ(r.code, 0) << aa << ": " << r.err;
+        frames[aa] = readBytes(out);
+        const auto line = r.err.find("{\"timings\"");
+        ASSERT_NE(line, std::string::npos) << r.err;
+        const json t = json::parse(r.err.substr(line))["timings"];
+        EXPECT_EQ(t["first_frame"]["aa"], std::string(aa) == "msaa" ? "msaa4" : aa) << t.dump();
+        EXPECT_GT(t["context_ms"].get<double>(), 0.0) << t.dump();
+        EXPECT_GT(t["first_frame"]["skin_ms"].get<double>(), 0.0) << t.dump();
+        EXPECT_GE(t["total_ms"].get<double>(), t["first_frame"]["total_ms"].get<double>()) << t.dump();
+        EXPECT_EQ(t["frames"], 1);
+    }
+    EXPECT_NE(frames["post"], frames["none"]);
+    EXPECT_NE(frames["msaa"], frames["none"]);
+    CliRun r = runServer(dir, "render --scene " + kDefaultScene + " --out " + (dir / "x.png") + " --aa fxaa" + gl());
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_NE(r.err.find("--aa"), std::string::npos) << r.err;
 }
 
 TEST(RenderCliGLTest, EglDeviceEitherStartsOrSaysWhy) {

@@ -118,6 +118,7 @@ int runInfo(const std::string& gl) {
                         {"glsl_version", i.glslVersion},
                         {"max_texture_size", i.maxTextureSize},
                         {"max_samples", i.maxSamples},
+                        {"aa_auto", resolveAntiAliasing(RenderSettings{}, i.software, i.maxSamples).label()},
                         {"tried", i.tried}};
     std::cout << j.dump(2) << "\n";
     return 0;
