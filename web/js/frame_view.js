@@ -14,8 +14,14 @@
 //
 // While a drag runs in the texture view, frames preview the dragged placement (the frame route's
 // `preview`: nothing stored) at each pointer move, with MSAA off; the edits go to the server at
-// their own pace. Frames are coalesced: one request in flight per image, the newest wanted URL wins when it ends,
-// and a frame never replaces a newer one; a frame slower than 500 ms shows a spinner.
+// their own pace. Frames are coalesced: the newest wanted URL wins, the state changes of one
+// moment ask for one frame, and a frame never replaces a newer one (stale answers are dropped);
+// a frame slower than 500 ms shows a spinner. When no gesture runs, one request is in flight per
+// image. While a gesture runs (a drag in either view, a slider, a key burst) the 3D view keeps
+// several in flight, paced to the server's own time per frame (its `Server-Timing`), so that over
+// a slow link frames keep coming at the server's rate instead of one per round trip (FrameLoader
+// below; docs/remote-authoring.md); on loopback that stays one. The texture view never waits for
+// the network: it draws on the client.
 
 import { store, on, set, emit, shownTime, whenIdle, placementById } from "./store.js";
 import { API, query } from "./api.js";
@@ -34,59 +40,175 @@ let placeAs = "surface"; // "surface" (on the body, SPEC §8) | "uv" (in the tex
 let brushDiameter = null; // model units; null until the first frame gives the model's scale
 const FRAME_SIZES = [384, 512, 768, 1024];
 export let frameSize = 512;
-export const frameStats = { shown: 0, requested: 0, times: [] };
+/// Frame statistics for tests and benchmarks (window.dermisEditor.frameStats): frames shown and
+/// requested, answers dropped as stale, the most requests of the 3D view in flight at once
+/// (`peakInFlight`, a test may reset it), the pipeline's estimates (server ms per frame, the rest
+/// of a round trip, k) and `inFlightLimit`: null (adaptive), or a cap on the requests in flight
+/// (1: one at a time, the editor before pipelining — the benchmark's "before").
+export const frameStats = { shown: 0, requested: 0, dropped: 0, times: [], peakInFlight: 0, inFlightLimit: null, pipeline: null };
 
-/// Loads URLs into one <img>: at most one fetch in flight, the newest wanted URL next; `onShown`
-/// runs after a frame is on screen.
+// Pipelining (issue #28, docs/remote-authoring.md): over a slow link one request in flight gives
+// one frame per round trip (100 ms RTT: ~6–9 frames/s). While `pipelined()` (a gesture: a drag in
+// the texture view, a decal drag, a slider, a key burst; or a drag on the 3D stage) the loader
+// keeps up to k requests in flight and issues a new one only when the wanted URL is new and at
+// least PACE·S ms passed since the last issue. S is the server's time per frame: the median of the
+// last answers' `Server-Timing: render;dur=`, which counts the wait in the server's render queue,
+// so requests issued faster than it renders raise S and slow the pace (no queue builds up). rtt is
+// the rest of a request's time (EWMA of fetch → body − dur), and k = 1 + floor(rtt / S), 1..4: one
+// more request per whole frame the server can render while an answer travels. On loopback the
+// rest (8–25 ms here, S 20–30) is mostly CPU work on the cores the server renders with, not
+// waiting, and overlapping it only made frames older (k = 2 there: 105–123 ms instead of 78–84
+// on a busy machine): k stays 1 there, as before. Stale requests are not aborted (that closes
+// an HTTP/1.1 connection: a new handshake at RTT); their answers are dropped. Chromium opens 6
+// connections per host: the event stream, ≤ 4 frames and an edit.
+const MAX_IN_FLIGHT = 4;
+const PACE = 0.9;    // the pace's share of S: a little faster than the server, so it never idles
+const EWMA = 0.25;   // weight of a new sample in rtt
+const S_WINDOW = 9;  // answers in S's median
+
+/// The server's time of a frame answer (`Server-Timing: render;dur=<ms>`), or null.
+function serverDur(headers) {
+  const m = /(?:^|,)\s*render\s*;[^,]*\bdur=([\d.]+)/.exec(headers.get("Server-Timing") || "");
+  return m ? +m[1] : null;
+}
+
+const median = (xs) => { const v = [...xs].sort((a, b) => a - b); return v.length ? v[v.length >> 1] : null; };
+
+/// Runs fn in a task of its own soon (no timer clamping): the state changes of one moment (a
+/// gesture's end: its revision, its end, its preview released) ask for one frame, the last.
+const soon = (() => {
+  const ch = new MessageChannel();
+  const queue = [];
+  ch.port1.onmessage = () => { for (const fn of queue.splice(0)) fn(); };
+  return (fn) => { if (queue.push(fn) === 1) ch.port2.postMessage(0); };
+})();
+
+/// Loads URLs into one <img>: the newest wanted URL wins and a frame never replaces a newer one
+/// on screen. Idle: at most one request in flight (the newest wanted URL next). While
+/// `pipelined()`: up to k in flight, paced (above); `onShown` runs after a frame is on screen.
 class FrameLoader {
-  constructor(el, onShown) {
+  constructor(el, onShown, pipelined = () => false) {
     this.el = el;
     this.onShown = onShown;
-    this.inFlight = false;
-    this.wanted = null;   // {url, seq, t0}
+    this.pipelined = pipelined;
+    this.wanted = null;         // {url, seq, t0}: not asked for yet
+    this.inFlight = new Set();  // jobs asked for, not on screen (or dropped) yet
+    this.newest = null;         // the newest job asked for
     this.shownSeq = 0;
     this.seq = 0;
-    this.url = null;
+    this.url = null;            // the URL on screen
     this.objectUrl = null;
     this.slowTimer = null;
+    this.paceTimer = null;
+    this.pumpSoon = false;
+    this.lastIssue = -Infinity;
+    this.showing = Promise.resolve(); // frames go on screen one at a time, in answer order
+    this.durs = { pipelined: [], idle: [] }; // the last Server-Timing durs, per mode
+    this.rttMs = null;
   }
   load(url) {
-    if (url === this.url && !this.inFlight) return;
+    // The newest request asked for this URL: its answer is the next one to go on screen.
+    if (this.newest && this.newest.url === url && !this.newest.failed) { this.wanted = null; return; }
     this.wanted = { url, seq: ++this.seq, t0: performance.now() };
-    this.pump();
+    if (!this.pumpSoon) { this.pumpSoon = true; soon(() => { this.pumpSoon = false; this.pump(); }); }
   }
-  async pump() {
-    if (this.inFlight || !this.wanted) return;
+  /// S: the server's time per frame while pipelining, in ms (null: not measured yet).
+  serverTime() {
+    return median(this.durs.pipelined.length ? this.durs.pipelined : this.durs.idle);
+  }
+  /// How many requests may be in flight now, and the pace (ms between issues) while pipelining.
+  budget() {
+    const cap = Math.max(1, Math.min(MAX_IN_FLIGHT, frameStats.inFlightLimit ?? MAX_IN_FLIGHT));
+    if (!this.pipelined()) return { pipelined: false, k: 1, cap, gap: 0 };
+    const S = this.serverTime();
+    return { pipelined: true, k: this.depth(cap), cap, gap: S ? PACE * S : 0 };
+  }
+  /// k: requests in flight that keep the server busy over the round trip (1 until measured).
+  depth(cap) {
+    const S = this.serverTime();
+    const k = S && this.rttMs !== null ? 1 + Math.floor(this.rttMs / Math.max(S, 1)) : 1;
+    return Math.max(1, Math.min(cap, k));
+  }
+  pump() {
+    if (!this.wanted) return;
+    const b = this.budget();
+    if (b.pipelined) {
+      if (this.inFlight.size >= b.k) return; // an answer calls pump again
+      const wait = b.k > 1 ? this.lastIssue + b.gap - performance.now() : 0;
+      if (wait > 0) {
+        if (!this.paceTimer) this.paceTimer = setTimeout(() => { this.paceTimer = null; this.pump(); }, wait);
+        return;
+      }
+    } else {
+      // Idle: one at a time; the requests of a gesture that just ended do not hold up its final
+      // frame (they are stale: their answers are dropped), within the cap.
+      if (this.inFlight.size >= b.cap || [...this.inFlight].some((j) => !j.pipelined)) return;
+    }
     const job = this.wanted;
     this.wanted = null;
-    this.inFlight = true;
-    clearTimeout(this.slowTimer);
-    this.slowTimer = setTimeout(() => { spinner.hidden = false; }, 500);
+    this.run(job, b.pipelined);
+  }
+  async run(job, pipelined) {
+    job.pipelined = pipelined;
+    job.issuedAt = this.lastIssue = performance.now();
+    this.newest = job;
+    this.inFlight.add(job);
+    frameStats.requested++;
+    frameStats.peakInFlight = Math.max(frameStats.peakInFlight, this.inFlight.size);
+    if (!this.slowTimer) this.slowTimer = setTimeout(() => { spinner.hidden = false; }, 500);
+    let answer = null;
     try {
       const r = await fetchFrame(job.url);
-      const changed = r.headers.get("X-Dermis-Changed-Pixels");
-      if (this.onCamera) this.onCamera(r.headers);
+      if (this.onCamera && job.seq > this.shownSeq) this.onCamera(r.headers);
       const blob = await r.blob();
-      if (job.seq > this.shownSeq) {
-        const objectUrl = URL.createObjectURL(blob);
-        await new Promise((resolve) => { this.el.onload = this.el.onerror = resolve; this.el.src = objectUrl; });
-        if (this.objectUrl) URL.revokeObjectURL(this.objectUrl);
-        this.objectUrl = objectUrl;
-        this.shownSeq = job.seq;
-        this.url = job.url;
-        this.el.dataset.url = job.url;
-        this.el.dataset.changedPixels = changed || "";
-        this.onShown && this.onShown(job, performance.now());
-      }
+      job.bodyAt = performance.now();
+      job.dur = serverDur(r.headers);
+      this.learn(job);
+      answer = { blob, changed: r.headers.get("X-Dermis-Changed-Pixels") };
     } catch (e) {
-      if (e.status !== 0 || store.online) notify(`Frame: ${e.message}`, "error");
-      this.url = null;
-    } finally {
-      this.inFlight = false;
-      clearTimeout(this.slowTimer);
-      spinner.hidden = true;
-      this.pump();
+      job.failed = true;
+      if (job.seq > this.shownSeq && (e.status !== 0 || store.online)) notify(`Frame: ${e.message}`, "error");
     }
+    if (answer && job.seq > this.shownSeq) await this.show(job, answer);
+    else if (answer) frameStats.dropped++;
+    // A request counts until its frame is on screen (or dropped): the next render then does not
+    // compete with this decode for the CPU (measured: frames 10–15 ms older without this on
+    // loopback, where the server and the browser share the cores).
+    this.inFlight.delete(job);
+    if (!this.inFlight.size) this.quiet();
+    this.pump();
+  }
+  /// Folds a finished request into S and rtt.
+  learn(job) {
+    if (job.dur === null || !Number.isFinite(job.dur)) return;
+    const durs = this.durs[job.pipelined ? "pipelined" : "idle"];
+    durs.push(job.dur);
+    if (durs.length > S_WINDOW) durs.shift();
+    const rest = Math.max(0, job.bodyAt - job.issuedAt - job.dur);
+    this.rttMs = this.rttMs === null ? rest : this.rttMs + EWMA * (rest - this.rttMs);
+    if (this.onShown) frameStats.pipeline = { serverMs: +this.serverTime().toFixed(1), rttMs: +this.rttMs.toFixed(1), k: this.depth(this.budget().cap) };
+  }
+  quiet() {
+    clearTimeout(this.slowTimer);
+    this.slowTimer = null;
+    spinner.hidden = true;
+  }
+  show(job, { blob, changed }) {
+    this.showing = this.showing.then(async () => {
+      if (job.seq <= this.shownSeq) { frameStats.dropped++; return; } // a newer frame went on screen first
+      const objectUrl = URL.createObjectURL(blob);
+      await new Promise((resolve) => { this.el.onload = this.el.onerror = resolve; this.el.src = objectUrl; });
+      if (this.objectUrl) URL.revokeObjectURL(this.objectUrl);
+      this.objectUrl = objectUrl;
+      this.shownSeq = job.seq;
+      this.url = job.url;
+      this.el.dataset.url = job.url;
+      this.el.dataset.changedPixels = changed || "";
+      this.quiet(); // the spinner again when the next frame takes 500 ms
+      if (this.inFlight.size > 1) this.slowTimer = setTimeout(() => { spinner.hidden = false; }, 500);
+      this.onShown && this.onShown(job, performance.now());
+    }).catch((e) => console.error(e));
+    return this.showing;
   }
 }
 
@@ -134,15 +256,18 @@ export function initFrameView(section, theApi) {
   splitHandle = section.querySelector(".split-handle");
   sizeSelect = section.querySelector("#frameSize");
   sizeSelect.value = String(frameSize);
+  // Frames pipeline while a gesture runs (store.gestures: a drag, a slider, a key burst) or the
+  // pointer drags on the 3D stage (orbit, pan, a decal).
+  let stageDrag = false;
   mainLoader = new FrameLoader(img, (job, now) => {
     frameStats.shown++;
-    if (trace.on) trace.frames.push({ t0: job.t0, shownAt: now });
+    if (trace.on) trace.frames.push({ t0: job.t0, shownAt: now, issuedAt: job.issuedAt, bodyAt: job.bodyAt, seq: job.seq, dur: job.dur, pipelined: job.pipelined });
     frameStats.times.push(now - job.t0);
     if (frameStats.times.length > 1000) frameStats.times.shift();
     img.alt = "rendered frame";
     if (store.compare.mode === "diff") document.getElementById("diffText").textContent = `${img.dataset.changedPixels || "?"} px changed`;
     img.dataset.seq = String(job.seq);
-  });
+  }, () => store.gestures > 0 || stageDrag);
   mainLoader.onCamera = noteFrameCamera;
   cmpLoader = new FrameLoader(cmpImg);
   const $ = (id) => section.querySelector("#" + id);
@@ -162,6 +287,9 @@ export function initFrameView(section, theApi) {
     brushFor, // the brush outlined where a pick hit
     onClick: click, onChange: refresh, onError: (e) => notify(`Frame: ${e.message}`, "error"),
   });
+  stage.addEventListener("pointerdown", (e) => { if (e.button === 0 || e.button === 1) stageDrag = true; });
+  const stageDragEnd = () => { if (stageDrag) { stageDrag = false; mainLoader.pump(); } };
+  for (const type of ["pointerup", "pointercancel", "lostpointercapture"]) stage.addEventListener(type, stageDragEnd);
   on("selection doc scene", () => {
     const has = store.selection.some((id) => placementById(id));
     $("frameSelection").disabled = !has;
