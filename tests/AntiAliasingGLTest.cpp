@@ -8,7 +8,7 @@
 #include "ImageCompare.hpp"
 #include "SceneFrame.hpp"
 
-#include "GlTestBackend.hpp"
+#include "RendererSuite.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,15 +21,10 @@ namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
 
-class AntiAliasingGLTest : public ::testing::Test {
+class AntiAliasingGLTest : public RendererSuite {
 protected:
     static void SetUpTestSuite() {
-        auto r = Renderer::create(requestedBackend());
-        if (!r) {
-            createError_ = r.error().message;
-            return;
-        }
-        renderer_ = std::move(*r);
+        RendererSuite::SetUpTestSuite();
         auto l = loadSceneFile(kSource + "/models/default.scene.json");
         if (!l) {
             createError_ = l.error().message;
@@ -39,12 +34,13 @@ protected:
         model_ = std::make_shared<const Model>(loaded_->model);
     }
     static void TearDownTestSuite() {
-        renderer_.reset();
+        RendererSuite::TearDownTestSuite();
         loaded_.reset();
         model_.reset();
     }
     void SetUp() override {
-        ASSERT_TRUE(renderer_ && loaded_) << "backend " << toString(requestedBackend()) << ": " << createError_;
+        RendererSuite::SetUp();
+        ASSERT_TRUE(loaded_) << createError_;
     }
 
     /// The default scene squatting (the reference pose of RendererGLTest), side² (256), with `aa`.
@@ -62,15 +58,9 @@ protected:
         return renderer_->renderFrame(frame->request);
     }
 
-    static std::unique_ptr<Renderer> renderer_;
-    static std::unique_ptr<LoadedScene> loaded_;
-    static std::shared_ptr<const Model> model_;
-    static std::string createError_;
+    inline static std::unique_ptr<LoadedScene> loaded_;
+    inline static std::shared_ptr<const Model> model_;
 };
-std::unique_ptr<Renderer> AntiAliasingGLTest::renderer_;
-std::unique_ptr<LoadedScene> AntiAliasingGLTest::loaded_;
-std::shared_ptr<const Model> AntiAliasingGLTest::model_;
-std::string AntiAliasingGLTest::createError_;
 
 } // namespace
 

@@ -18,7 +18,7 @@
 #include "io/scene_files.hpp"
 #include "ImageCompare.hpp"
 
-#include "GlTestBackend.hpp"
+#include "RendererSuite.hpp"
 
 #include <gtest/gtest.h>
 
@@ -40,28 +40,7 @@ const std::string kBarbarian = kShared + "/models/KayKitBarbarian/Barbarian.glb"
 
 using test::requestedBackend;
 
-class RendererGLTest : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() {
-        auto r = Renderer::create(requestedBackend());
-        if (!r) {
-            createError_ = r.error().message;
-            return;
-        }
-        renderer_ = std::move(*r);
-    }
-    static void TearDownTestSuite() { renderer_.reset(); }
-    void SetUp() override {
-        ASSERT_TRUE(renderer_) << "no GL context for backend " << toString(requestedBackend())
-                               << ": " << createError_;
-    }
-    Renderer& gl() { return *renderer_; }
-
-    static std::unique_ptr<Renderer> renderer_;
-    static std::string createError_;
-};
-std::unique_ptr<Renderer> RendererGLTest::renderer_;
-std::string RendererGLTest::createError_;
+class RendererGLTest : public RendererSuite {};
 
 std::shared_ptr<const Model> loadModel(const std::string& path) {
     auto m = loadGltfFile(path);

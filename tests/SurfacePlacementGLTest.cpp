@@ -15,7 +15,7 @@
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
 
-#include "GlTestBackend.hpp"
+#include "RendererSuite.hpp"
 #include "SceneFrame.hpp"
 
 #include <gtest/gtest.h>
@@ -31,33 +31,19 @@ const std::string kShared = DERMIS_SHARED_DIR;
 const std::string kSource = DERMIS_SOURCE_DIR;
 const std::string kCesium = kShared + "/models/CesiumMan/CesiumMan.glb";
 
-class SurfacePlacementGLTest : public ::testing::Test {
+class SurfacePlacementGLTest : public RendererSuite {
 protected:
-    static void SetUpTestSuite() {
-        auto r = Renderer::create(requestedBackend());
-        if (!r) {
-            createError_ = r.error().message;
-            return;
-        }
-        renderer_ = std::move(*r);
-    }
-    static void TearDownTestSuite() { renderer_.reset(); }
     void SetUp() override {
-        ASSERT_TRUE(renderer_) << "no GL context: " << createError_;
+        RendererSuite::SetUp();
+        if (HasFatalFailure()) return;
         auto l = loadSceneFile(kSource + "/models/default.scene.json");
         ASSERT_TRUE(l) << l.error().message;
         loaded_ = std::make_unique<LoadedScene>(std::move(*l));
         model_ = std::make_shared<const Model>(loaded_->model);
     }
-    Renderer& gl() { return *renderer_; }
-
-    static std::unique_ptr<Renderer> renderer_;
-    static std::string createError_;
     std::unique_ptr<LoadedScene> loaded_;
     std::shared_ptr<const Model> model_;
 };
-std::unique_ptr<Renderer> SurfacePlacementGLTest::renderer_;
-std::string SurfacePlacementGLTest::createError_;
 
 /// The anchor of part `pi`'s vertex `v` (bind space), with a tangent ⟂ its normal.
 SurfaceAnchor anchorAt(const Model& m, std::size_t pi, std::size_t v) {
