@@ -2,7 +2,8 @@
 // editor (X-Dermis-Client), sends If-Match when the caller gives a revision, turns error answers
 // into ApiError (code, message, field, status, and the current revision of a 412), and asks the
 // sign-in dialog for a session when the server answers 401 (then retries once). It keeps no token:
-// the session lives in the server's HttpOnly cookie. Does not cache and does not retry otherwise.
+// the session lives in the server's HttpOnly cookie (openSession opens it). Does not cache and does
+// not retry otherwise.
 
 import { inWords } from "./messages.js";
 
@@ -75,6 +76,20 @@ export class Api {
 
   /// A Blob answer (images).
   async blob(path, opts) { return (await this.raw("GET", path, opts)).blob(); }
+}
+
+/// Opens a session with `token` (POST /session: the server sets its HttpOnly session cookie),
+/// for the sign-in dialog. Not through an Api: no client name, and a 401 here means a wrong token,
+/// not "sign in". Throws ApiError: 401 for a wrong token, status 0 (code "network", `raw` the
+/// browser's words) where the server cannot be reached.
+export async function openSession(token) {
+  let r;
+  try {
+    r = await fetch(API + "/session", { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify({ token }) });
+  } catch (e) {
+    throw new ApiError(0, "network", e.message);
+  }
+  if (!r.ok) throw await ApiError_from(r);
 }
 
 async function ApiError_from(r) {

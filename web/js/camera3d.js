@@ -21,6 +21,7 @@
 // can be), previewed in the frames, one edit and one undo step when the drag ends; Esc cancels.
 
 import { store, set, placementById } from "./store.js";
+import { focusPath } from "./scene_resource.js";
 import * as geo from "./geometry.js";
 import { Stream, patchPlacement } from "./edits.js";
 import { hold, release, withPending } from "./pending.js";
@@ -116,7 +117,7 @@ export async function focusOf(pid, params) {
   if (focusCache.key === key) return focusCache.answer;
   const q = new URLSearchParams({ placement: pid, time: String(params.time ?? 0) });
   if (params.revision) q.set("revision", String(params.revision));
-  const answer = await api.get(`/scenes/${store.sceneId}/focus?${q}`);
+  const answer = await api.get(focusPath(store.sceneId, q));
   focusCache = { key, answer };
   return answer;
 }

@@ -11,7 +11,8 @@
 // one revision per gesture; a `live` Stream (joint sliders, whose frames need the stored pose)
 // also sends values while the gesture runs, at most one in flight, at least `interval` ms apart.
 
-import { store, set, emit } from "./store.js";
+import { store, set, emit, Topic } from "./store.js";
+import { scenePath } from "./scene_resource.js";
 import { notify } from "./notice.js";
 import { trace } from "./trace.js";
 import { inWords } from "./messages.js";
@@ -28,13 +29,13 @@ export function initEdits(theApi, reload) {
 
 export const canUndo = () => undoStack.length > 0;
 export const canRedo = () => redoStack.length > 0;
-export function clearUndo() { undoStack.length = 0; redoStack.length = 0; emit("undo"); }
+export function clearUndo() { undoStack.length = 0; redoStack.length = 0; emit(Topic.UNDO); }
 
 /// Records an undo step: going back to `revision` undoes `what` (words, e.g. 'move "elbow L"').
 export function pushUndo(revision, what) {
   undoStack.push({ revision, what });
   redoStack.length = 0;
-  emit("undo");
+  emit(Topic.UNDO);
 }
 
 let beforeEdit = () => {};
@@ -43,11 +44,11 @@ let beforeEdit = () => {};
 export function setBeforeEdit(fn) { beforeEdit = fn; }
 
 /// Applies an edit answer ({id, revision, scene}) to the state.
-export function accept(answer, topic = "doc") {
+export function accept(answer, topic = Topic.DOC) {
   if (!answer || answer.id !== store.sceneId || answer.revision < store.revision) return;
   const fields = { doc: answer.scene, revision: answer.revision };
   if (store.pinnedRevision !== null) fields.pinnedRevision = null;
-  set(fields, topic + " revision");
+  set(fields, [topic, Topic.REVISION]);
 }
 
 let queue = Promise.resolve(); // this editor's edits, one at a time, in order
@@ -59,9 +60,8 @@ let queue = Promise.resolve(); // this editor's edits, one at a time, in order
 /// `undoable` records it for undo.
 export function edit(method, path, body, opts = {}) {
   beforeEdit();
-  ++store.busy;
-  emit("busy");
-  const run = queue.then(() => send(method, path, body, opts)).finally(() => { --store.busy; emit("busy"); });
+  set({ busy: store.busy + 1 });
+  const run = queue.then(() => send(method, path, body, opts)).finally(() => set({ busy: store.busy - 1 }));
   queue = run.catch(() => {});
   return run;
 }
@@ -73,14 +73,14 @@ async function send(method, path, body, { undoable = true, quiet = false, what =
   const words = undoable ? what || describeEdit(method, path, payload) : null; // before the answer changes the document
   try {
     const sentAt = performance.now();
-    const answer = await api.send(method, `/scenes/${store.sceneId}${path}`, payload, before);
+    const answer = await api.send(method, scenePath(store.sceneId, path), payload, before);
     if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
     accept(answer);
     if (store.saveError !== null) set({ saveError: null });
     if (undoable) pushUndo(before, words);
     return answer;
   } catch (e) {
-    if (onRefused && onRefused(e)) { emit("refused"); return null; } // the caller says what now
+    if (onRefused && onRefused(e)) { emit(Topic.REFUSED); return null; } // the caller says what now
     await refused(e, quiet);
     return null;
   }
@@ -96,7 +96,7 @@ export async function refused(e, quiet = false) {
   } else if (!quiet) {
     notify(inWords(e, store.doc), "error");
   }
-  emit("refused");
+  emit(Topic.REFUSED);
 }
 
 /// An edit in words, for undo and redo notices: 'move "elbow L"', 'change h of "elbow L"',
@@ -174,7 +174,7 @@ async function travel(from, to, nothing, verb, back) {
     to.push({ revision: here, what: step.what });
     notify(`${verb}: ${step.what || `revision ${step.revision}`}.`, "info", back, "undo");
   } else from.push(step);
-  emit("undo");
+  emit(Topic.UNDO);
 }
 
 export const undo = () => travel(undoStack, redoStack, "Nothing to undo.", "Undone", { label: "Redo", run: () => redo() });
@@ -200,10 +200,10 @@ export class Stream {
     this.before = store.revision;
     this.timer = null;
     this.done = false;
-    ++store.gestures;
+    set({ gestures: store.gestures + 1 }, []); // not told: nothing shows otherwise until the gesture changes something
   }
   end() {
-    if (!this.ended) { this.ended = true; --store.gestures; emit("gestures"); }
+    if (!this.ended) { this.ended = true; set({ gestures: store.gestures - 1 }); }
   }
   send(value) {
     if (this.done) return;

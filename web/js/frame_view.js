@@ -23,8 +23,9 @@
 // below; docs/remote-authoring.md); on loopback that stays one. The texture view never waits for
 // the network: it draws on the client.
 
-import { store, on, set, emit, shownTime, whenIdle, placementById } from "./store.js";
-import { API, query } from "./api.js";
+import { store, on, set, emit, shownTime, whenIdle, placementById, Topic } from "./store.js";
+import { API } from "./api.js";
+import { framePath, frameDiffPath, pickPath, turntableUrl, fetchRevisions } from "./scene_resource.js";
 import * as geo from "./geometry.js";
 import { notify } from "./notice.js";
 import { addPlacement } from "./edits.js";
@@ -274,7 +275,7 @@ export function initFrameView(section, theApi) {
   $("viewMode").onchange = (e) => set({ view: e.target.value });
   $("compareMode").onchange = (e) => set({ compare: { ...store.compare, mode: e.target.value } });
   $("compareAgainst").onchange = (e) => set({ compare: { ...store.compare, against: e.target.value } });
-  $("split").oninput = (e) => { store.compare.split = +e.target.value; layoutCompare(); };
+  $("split").oninput = (e) => { set({ compare: { ...store.compare, split: +e.target.value } }); layoutCompare(); };
   sizeSelect.onchange = () => { frameSize = +sizeSelect.value; refresh(); };
   $("placeTool").onclick = () => setPlaceTool(!placeTool);
   $("placeAs").onchange = (e) => { placeAs = e.target.value; pointer.brush = null; showPlaceHint(); refresh(); };
@@ -290,20 +291,21 @@ export function initFrameView(section, theApi) {
   stage.addEventListener("pointerdown", (e) => { if (e.button === 0 || e.button === 1) stageDrag = true; });
   const stageDragEnd = () => { if (stageDrag) { stageDrag = false; mainLoader.pump(); } };
   for (const type of ["pointerup", "pointercancel", "lostpointercapture"]) stage.addEventListener(type, stageDragEnd);
-  on("selection doc scene", () => {
+  on([Topic.SELECTION, Topic.DOC, Topic.SCENE], () => {
     const has = store.selection.some((id) => placementById(id));
     $("frameSelection").disabled = !has;
     $("turntable").disabled = !has;
   });
-  on("doc revision camera view compare solo time pinnedRevision gestures drag selection ghost", () => {
+  on([Topic.DOC, Topic.REVISION, Topic.CAMERA, Topic.VIEW, Topic.COMPARE, Topic.SOLO, Topic.TIME, Topic.PINNED_REVISION, Topic.GESTURES,
+      Topic.DRAG, Topic.SELECTION, Topic.GHOST], () => {
     $("viewMode").value = store.view;
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
     $("compareAgainstLabel").hidden = store.compare.mode === "off"; // "against" means nothing until comparing
     refresh();
   });
-  on("revision", () => whenIdle("compare-list", fillAgainst, 400));
-  on("currentPattern patterns", showPlaceHint);
+  on(Topic.REVISION, () => whenIdle("compare-list", fillAgainst, 400));
+  on([Topic.CURRENT_PATTERN, Topic.PATTERNS], showPlaceHint);
 }
 
 /// The view bar's ⋯ menu (Size, Reset): where the bar is narrow (a container query in
@@ -424,7 +426,7 @@ function fetchFrame(url) {
 }
 
 export function frameUrl() {
-  return `/scenes/${store.sceneId}/frame${query(frameParams(store.compare.mode === "off"))}`;
+  return framePath(store.sceneId, frameParams(store.compare.mode === "off"));
 }
 
 export function refresh() {
@@ -433,11 +435,11 @@ export function refresh() {
   const p = frameParams(cmp.mode === "off");
   const against = cmp.against === "off" ? { patterns: "off" } : { revision: +cmp.against };
   if (cmp.mode === "diff") {
-    mainLoader.load(`/scenes/${store.sceneId}/frame-diff${query({ ...p, against: cmp.against })}`);
+    mainLoader.load(frameDiffPath(store.sceneId, { ...p, against: cmp.against }));
   } else {
-    mainLoader.load(`/scenes/${store.sceneId}/frame${query(p)}`);
+    mainLoader.load(framePath(store.sceneId, p));
   }
-  if (cmp.mode === "split" || cmp.mode === "flicker") cmpLoader.load(`/scenes/${store.sceneId}/frame${query({ ...p, ...against })}`);
+  if (cmp.mode === "split" || cmp.mode === "flicker") cmpLoader.load(framePath(store.sceneId, { ...p, ...against }));
   layoutCompare();
 }
 
@@ -465,7 +467,7 @@ async function fillAgainst() {
   const sel = document.getElementById("compareAgainst");
   const keep = sel.value;
   try {
-    const list = await api.get(`/scenes/${store.sceneId}/revisions?limit=30`);
+    const list = await fetchRevisions(api, store.sceneId);
     sel.innerHTML = `<option value="off">patterns off</option>` +
       list.revisions.filter((r) => r.revision !== store.revision)
         .map((r) => `<option value="${r.revision}">r${r.revision} ${escapeHtml(r.op)}</option>`).join("");
@@ -494,8 +496,8 @@ function displaySide() {
 /// The pick answer at a frame pixel of this view.
 export function pickAt(x, y) {
   const p = frameParams();
-  return api.get(`/scenes/${store.sceneId}/pick${query({ x, y, width: p.width, height: p.height, yaw: p.yaw,
-                                                             pitch: p.pitch, distance: p.distance, target: p.target, time: p.time })}`);
+  return api.get(pickPath(store.sceneId, { x, y, width: p.width, height: p.height, yaw: p.yaw,
+                                           pitch: p.pitch, distance: p.distance, target: p.target, time: p.time }));
 }
 
 async function click(e) {
@@ -505,7 +507,7 @@ async function click(e) {
   try { hit = await pickAt(px[0], px[1]); } catch (err) { notify(`Pick: ${err.message}`, "error"); return; }
   if (!hit.hit) { if (!placeTool && !e.altKey) set({ selection: [] }); return; }
   if (placeTool || e.altKey) {
-    emit("place-at", { uv: hit.uv, suggested: hit.suggested, anchor: hit.anchor });
+    emit(Topic.PLACE_AT, { uv: hit.uv, suggested: hit.suggested, anchor: hit.anchor });
     if (placeAs === "surface" && hit.anchor) await placeOnBody(hit.anchor, hit.suggested);
     else await placeAt(hit.uv, hit.suggested);
     return;
@@ -522,9 +524,9 @@ export function openTurntable() {
   const pid = store.selection.find((id) => placementById(id));
   if (!pid) return notify("Select a placement first: the turntable shows its range of motion.", "warn");
   const c = store.camera;
-  const url = `${API}/scenes/${store.sceneId}/turntable${query({ placement: pid, frames: 36, size: 320,
+  const url = turntableUrl(store.sceneId, { placement: pid, frames: 36, size: 320,
     yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined, target: c.target ? c.target.join(",") : undefined,
-    time: shownTime(), revision: store.pinnedRevision ?? undefined, view: store.view === "shaded" ? undefined : store.view })}`;
+    time: shownTime(), revision: store.pinnedRevision ?? undefined, view: store.view === "shaded" ? undefined : store.view });
   let dlg = document.getElementById("turntableDialog");
   if (!dlg) {
     dlg = document.createElement("dialog");

@@ -2,6 +2,7 @@
 // a select; Tab switches texture/3D inside the views (the paper's switch; Shift+Tab leaves them).
 
 import { store, set, placementById, heightmapSize } from "./store.js";
+import { pickUVPath, outlinePath } from "./scene_resource.js";
 import * as geo from "./geometry.js";
 import { removePlacements, mirrorPlacement, addPlacement, patchPlacement, undo, redo } from "./edits.js";
 import { nudge } from "./pending.js";
@@ -179,7 +180,7 @@ async function placeNth(n) {
   const uv = store.cursorUV && store.cursorUV.every((x) => x >= 0 && x <= 1) ? store.cursorUV : viewCentreUV();
   const body = placementFromPattern(pattern, uv);
   try {
-    const q = await api.get(`/scenes/${store.sceneId}/pick?u=${uv[0]}&v=${uv[1]}`);
+    const q = await api.get(pickUVPath(store.sceneId, uv));
     if (q.hit && q.suggested) applySuggested(body, q.suggested, pattern);
   } catch { /* no surface there (off the charts): the pattern's defaults stay */ }
   const answer = await addPlacement(body);
@@ -215,11 +216,11 @@ async function nudgeOnBody(ids, d) {
   for (const id of ids) {
     const p = placementById(id);
     try {
-      const o = await api.get(`/scenes/${store.sceneId}/placements/${encodeURIComponent(id)}/outline`);
+      const o = await api.get(outlinePath(store.sceneId, id));
       if (!o.anchor_uv) continue;
       const uv = [o.anchor_uv[0] + d[0], o.anchor_uv[1] + d[1]];
       if (!uv.every((x) => x >= 0 && x <= 1)) continue;
-      const q = await api.get(`/scenes/${store.sceneId}/pick?u=${uv[0]}&v=${uv[1]}`);
+      const q = await api.get(pickUVPath(store.sceneId, uv));
       if (!q.hit || !q.anchor) continue;
       await patchPlacement(id, { anchor: geo.anchorNear(p, q.anchor) }, { what: `move "${p.label || p.id}"` });
     } catch (err) { notify(`Move: ${err.message}`, "error"); }

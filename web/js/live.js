@@ -4,9 +4,9 @@
 // 30 s); `resync` re-reads. When the stream drops, the offline banner shows; EventSource
 // reconnects by itself and the editor re-reads the scene when it is back.
 
-import { store, on, set, emit } from "./store.js";
+import { store, on, set, emit, Topic } from "./store.js";
 import { setOffline } from "./notice.js";
-import { API } from "./api.js";
+import { eventsUrl, presencePath } from "./scene_resource.js";
 
 let api, source = null, reload = async () => {}, presenceTimer = null, color = null, everOpen = false;
 
@@ -14,12 +14,20 @@ export function initLive(theApi, reloadScene) {
   api = theApi;
   reload = reloadScene;
   color = `hsl(${Math.floor(Math.random() * 360)}, 75%, 62%)`;
-  on("selection", announce);
-  on("presence", renderPeople);
+  on(Topic.SELECTION, announce);
+  on(Topic.PRESENCE, renderPeople);
   setInterval(expirePresence, 2000);
 }
 
 export const myColor = () => color;
+
+/// Sets the presence to a copy of it changed by `change(map)` (the store's Map is never changed
+/// in place) and tells "presence".
+function changePresence(change) {
+  const presence = new Map(store.presence);
+  change(presence);
+  set({ presence });
+}
 
 /// The people on this scene, as chips in their colour (title: what they have selected).
 function renderPeople() {
@@ -42,7 +50,7 @@ export function connect() {
   if (source) source.close();
   everOpen = false;
   const id = store.sceneId;
-  const es = (source = new EventSource(`${API}/scenes/${id}/events`));
+  const es = (source = new EventSource(eventsUrl(id)));
   es.addEventListener("hello", (e) => {
     const wasOffline = !store.online;
     set({ online: true });
@@ -52,16 +60,15 @@ export function connect() {
     else if (wasOffline) reload();
     everOpen = true;
     announce();
-    api.get(`/scenes/${id}/presence`).then((answer) => {
+    api.get(presencePath(id)).then((answer) => changePresence((presence) => {
       for (const who of answer.presence || [])
         if (who.client !== api.client)
-          store.presence.set(who.client, { selection: who.selection, color: who.color, until: Date.now() + 1000 * who.expires_in });
-      emit("presence");
-    }).catch(() => {});
+          presence.set(who.client, { selection: who.selection, color: who.color, until: Date.now() + 1000 * who.expires_in });
+    })).catch(() => {});
   });
   es.addEventListener("change", (e) => {
     const ev = JSON.parse(e.data);
-    emit("event");
+    emit(Topic.EVENT);
     if (ev.scene !== store.sceneId) return;
     if (ev.revision <= store.revision) return; // older than what this editor has
     if (ev.client && ev.client === api.client && store.busy > 0) return; // ours: its answer brings the document
@@ -71,10 +78,9 @@ export function connect() {
   es.addEventListener("presence", (e) => {
     const ev = JSON.parse(e.data);
     if (!ev.client || ev.client === api.client) return;
-    if (ev.left) { store.presence.delete(ev.client); emit("presence"); return; }
+    if (ev.left) { changePresence((presence) => presence.delete(ev.client)); return; }
     const until = Date.now() + 1000 * (ev.expires_in || 30);
-    store.presence.set(ev.client, { selection: ev.selection || [], color: ev.color, until });
-    emit("presence");
+    changePresence((presence) => presence.set(ev.client, { selection: ev.selection || [], color: ev.color, until }));
   });
   es.onerror = () => {
     if (es !== source) return;
@@ -93,13 +99,12 @@ async function announce() {
   if (!store.sceneId || !store.online) return;
   const body = { client: api.client, selection: store.selection.slice(0, 100), color };
   try {
-    await api.send("POST", `/scenes/${store.sceneId}/presence`, body);
+    await api.send("POST", presencePath(store.sceneId), body);
   } catch { /* presence is best effort: the next announcement tries again */ }
 }
 
 function expirePresence() {
   const now = Date.now();
-  let changed = false;
-  for (const [k, v] of store.presence) if (v.until < now) { store.presence.delete(k); changed = true; }
-  if (changed) emit("presence");
+  if ([...store.presence.values()].some((v) => v.until < now))
+    changePresence((presence) => { for (const [k, v] of presence) if (v.until < now) presence.delete(k); });
 }

@@ -5,7 +5,8 @@
 // onto this character), and "Copy link".
 
 import { Api, makeClientName, ApiError } from "./api.js";
-import { store, set, on, emit, whenIdle, placementById } from "./store.js";
+import { store, set, on, emit, whenIdle, placementById, Topic } from "./store.js";
+import { SCENES_PATH, scenePath, lintPath, heightmapsPath } from "./scene_resource.js";
 import { signIn } from "./signin.js";
 import { notify } from "./notice.js";
 import { initImages, forget } from "./images.js";
@@ -33,27 +34,26 @@ const api = new Api({ client: makeClientName(), signIn });
 async function reloadScene() {
   if (!store.sceneId) return;
   try {
-    const answer = await api.get(`/scenes/${store.sceneId}`);
+    const answer = await api.get(scenePath(store.sceneId));
     if (answer.revision !== store.revision || JSON.stringify(answer.scene) !== JSON.stringify(store.doc)) {
-      set({ doc: answer.scene, revision: answer.revision }, "doc revision");
+      set({ doc: answer.scene, revision: answer.revision }, [Topic.DOC, Topic.REVISION]);
     }
   } catch (e) { notify(`Reading the scene: ${e.message}`, "error"); }
 }
 
 async function loadLint() {
-  try { set({ lint: await api.get(`/scenes/${store.sceneId}/lint`) }); } catch { set({ lint: [] }); }
+  try { set({ lint: await api.get(lintPath(store.sceneId)) }); } catch { set({ lint: [] }); }
 }
 
 /// Opens scene `id`; `link` (a permalink's fields) sets revision, time, camera and selection.
 async function openScene(id, link = {}) {
-  const answer = await api.get(`/scenes/${id}`);
+  const answer = await api.get(scenePath(id));
   const model = await api.get(`/models/${encodeURIComponent(answer.scene.model)}`);
   // The height-map layout the scene uses (SPEC §8: its own UVs, or the generated layout where
   // they are missing or shared); null where there is none to draw (uv_layout "model" without UVs).
   const layoutMode = encodeURIComponent(answer.scene.uv_layout || "auto");
   const layout = await api.get(`/models/${encodeURIComponent(model.id)}/uv-layout?layout=${layoutMode}`).catch(() => null);
   clearUndo();
-  store.presence.clear();
   const camera = { yaw: link.yaw ?? 0, pitch: link.pitch ?? 10, distance: link.distance ?? null, target: link.target ?? null };
   if (link.yaw === undefined && answer.scene.render && answer.scene.render.camera) {
     const c = answer.scene.render.camera;
@@ -67,7 +67,9 @@ async function openScene(id, link = {}) {
     sceneId: id, doc: answer.scene, revision: answer.revision, model, layout, camera,
     time: link.time ?? null, view: link.view || "shaded", pinnedRevision: pinned,
     selection: (link.selection || []).filter((s) => answer.scene.placements.some((p) => p.id === s)), solo: [],
-  }, "scene doc revision model layout camera time view pinnedRevision selection solo presence");
+    presence: new Map(),
+  }, [Topic.SCENE, Topic.DOC, Topic.REVISION, Topic.MODEL, Topic.LAYOUT, Topic.CAMERA, Topic.TIME, Topic.VIEW, Topic.PINNED_REVISION,
+      Topic.SELECTION, Topic.SOLO, Topic.PRESENCE]);
   $("scene").value = id;
   connect();
   fit();
@@ -75,7 +77,7 @@ async function openScene(id, link = {}) {
 
 /// The scene menu: each scene by its model's name and placement count (the id in the tooltip).
 async function refreshSceneList(select) {
-  const [scenes, models] = await Promise.all([api.get("/scenes").then((a) => a.scenes), api.get("/models").then((a) => a.models).catch(() => [])]);
+  const [scenes, models] = await Promise.all([api.get(SCENES_PATH).then((a) => a.scenes), api.get("/models").then((a) => a.models).catch(() => [])]);
   const names = new Map(models.map((m) => [m.id, m.name || m.id]));
   const esc = (t) => String(t).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]);
   $("scene").innerHTML = scenes.map((s) => {
@@ -91,9 +93,9 @@ function wireToolbar() {
   $("scene").onchange = () => openScene($("scene").value).catch((e) => notify(e.message, "error"));
   $("undo").onclick = () => undo();
   $("redo").onclick = () => redo();
-  on("undo revision", () => { $("undo").disabled = !canUndo(); $("redo").disabled = !canRedo(); });
-  on("revision", () => { $("revision").textContent = `r${store.revision}`; });
-  on("busy saveError online revision", showSaveState);
+  on([Topic.UNDO, Topic.REVISION], () => { $("undo").disabled = !canUndo(); $("redo").disabled = !canRedo(); });
+  on(Topic.REVISION, () => { $("revision").textContent = `r${store.revision}`; });
+  on([Topic.BUSY, Topic.SAVE_ERROR, Topic.ONLINE, Topic.REVISION], showSaveState);
   // Closing or reloading the window while an edit is still on its way would lose it: ask first.
   window.addEventListener("beforeunload", (e) => { if (store.busy > 0 || bursting()) { e.preventDefault(); e.returnValue = ""; } });
   // The layout buttons only: <main class="workspace"> carries data-layout too, and a click in the
@@ -101,7 +103,7 @@ function wireToolbar() {
   const layoutButtons = document.querySelectorAll("button[data-layout]");
   for (const b of layoutButtons)
     b.onclick = () => { if (store.layoutMode !== b.dataset.layout) set({ layoutMode: b.dataset.layout }); };
-  on("layoutMode", () => {
+  on(Topic.LAYOUT_MODE, () => {
     document.querySelector(".workspace").dataset.layout = store.layoutMode;
     for (const b of layoutButtons) b.classList.toggle("on", b.dataset.layout === store.layoutMode);
   });
@@ -112,7 +114,7 @@ function wireToolbar() {
   $("loadFile").onchange = () => { const f = $("loadFile").files[0]; if (f) loadSceneFile(f); $("loadFile").value = ""; };
   $("transferFrom").onclick = () => openTransferDialog(api);
   $("copyLink").onclick = async () => { await copyLink(); notify("Link copied: it opens this exact view.", "info"); };
-  on("pinnedRevision revision", () => {
+  on([Topic.PINNED_REVISION, Topic.REVISION], () => {
     const b = $("pinned");
     b.hidden = store.pinnedRevision === null;
     if (b.hidden) return;
@@ -122,12 +124,12 @@ function wireToolbar() {
     $("revertPinned").onclick = () => revert(store.pinnedRevision);
   });
   // The scene menu counts placements: it follows once things are quiet.
-  on("revision", () => whenIdle("scene-list", () => refreshSceneList(store.sceneId).catch(() => {}), 400));
-  on("revision", () => whenIdle("lint", () => {
-    forget(`/scenes/${store.sceneId}/heightmaps/`);
-    store.overlayRevision = store.revision; // the overlay follows once things are quiet
+  on(Topic.REVISION, () => whenIdle("scene-list", () => refreshSceneList(store.sceneId).catch(() => {}), 400));
+  on(Topic.REVISION, () => whenIdle("lint", () => {
+    forget(heightmapsPath(store.sceneId));
+    set({ overlayRevision: store.revision }); // the overlay follows once things are quiet
     loadLint();
-    emit("overlay");
+    emit(Topic.OVERLAY);
   }));
   // Files dropped anywhere: a .glb makes a new scene, an image becomes a pattern, anything else is refused.
   document.addEventListener("dragover", (e) => { if ([...e.dataTransfer.types].includes("Files")) e.preventDefault(); });
@@ -159,7 +161,7 @@ async function newSceneFromModel(f) {
     notify(`Uploading ${f.name}…`, "info", null, "newscene");
     const model = await api.json("POST", `/models?name=${encodeURIComponent(f.name.replace(/\.glb$/i, ""))}`,
                                  { body: f, headers: { "Content-Type": "model/gltf-binary" } });
-    const scene = await api.send("POST", "/scenes", { format: "dermis.scene/1", model: model.id, placements: [] });
+    const scene = await api.send("POST", SCENES_PATH, { format: "dermis.scene/1", model: model.id, placements: [] });
     await refreshSceneList(scene.id);
     await openScene(scene.id);
     const joints = model.joint_count ?? model.joints;
@@ -207,7 +209,7 @@ async function start() {
     const link = readLink();
     let scenes = await refreshSceneList();
     if (!scenes.length) {
-      const created = await api.send("POST", "/scenes", { default_patterns: true });
+      const created = await api.send("POST", SCENES_PATH, { default_patterns: true });
       scenes = await refreshSceneList(created.id);
     }
     const id = link.scene && scenes.some((s) => s.id === link.scene) ? link.scene : scenes[0].id;

@@ -9,7 +9,7 @@
 // leaving the page commits first. Drags: texture_view.js sets the drag's fields with hold() and
 // commits through edits.js's Stream.
 
-import { store, on, emit, placementById } from "./store.js";
+import { store, on, emit, set, placementById, Topic } from "./store.js";
 import { patchPlacement, pushUndo, setBeforeEdit } from "./edits.js";
 
 const BURST_MS = 450;
@@ -31,7 +31,7 @@ export function pendingPreview() {
 /// Shows `fields` over placement `id` until release(id) (a drag's value; a commit on its way).
 export function hold(id, fields) {
   shownFields.set(id, { ...(shownFields.get(id) || {}), ...fields });
-  emit("drag");
+  emit(Topic.DRAG);
 }
 
 /// Stops showing placement `id`'s pending fields (its edit is on the server, or was dropped):
@@ -45,7 +45,7 @@ export function release(id, sent = null) {
     if (Object.keys(rest).length) shownFields.set(id, rest);
     else shownFields.delete(id);
   } else shownFields.delete(id);
-  emit("drag");
+  emit(Topic.DRAG);
 }
 
 /// True while a key burst waits to be committed.
@@ -56,8 +56,7 @@ export const bursting = () => burst !== null;
 export function nudge(ids, change, verb = "adjust") {
   if (!burst) {
     burst = { before: store.revision, ids: new Set(), verbs: new Set(), timer: null };
-    ++store.gestures;
-    emit("gestures");
+    set({ gestures: store.gestures + 1 });
   }
   for (const id of ids) {
     const p = placementById(id);
@@ -80,8 +79,7 @@ export async function commitBurst() {
     const fields = shownFields.get(id);
     return fields ? patchPlacement(id, fields, { undoable: false }).finally(() => release(id, fields)) : null;
   }).filter(Boolean);
-  --store.gestures;
-  emit("gestures");
+  set({ gestures: store.gestures - 1 });
   const answers = await Promise.all(edits);
   if (answers.some(Boolean)) pushUndo(b.before, describeBurst(b));
 }
@@ -96,5 +94,5 @@ function describeBurst({ ids, verbs }) {
 
 // Another edit, a new selection or leaving the page sends a waiting burst first.
 setBeforeEdit(() => (burst ? commitBurst() : Promise.resolve()));
-on("selection", () => { if (burst) commitBurst(); });
+on(Topic.SELECTION, () => { if (burst) commitBurst(); });
 window.addEventListener("pagehide", () => { if (burst) commitBurst(); });

@@ -3,7 +3,7 @@
 // Opening such a link shows that revision's frame from that camera at that time — the same
 // frame request, so the same bytes on the same server — until the person edits or leaves it.
 
-import { store, on, set } from "./store.js";
+import { store, on, set, Topic } from "./store.js";
 import { frameSize } from "./frame_view.js";
 
 /// What the page's URL asks for (numbers parsed; absent fields undefined).
@@ -42,7 +42,7 @@ export function currentLink() {
 
 export function initPermalink() {
   let timer = null;
-  on("doc revision time camera view selection pinnedRevision", () => {
+  on([Topic.DOC, Topic.REVISION, Topic.TIME, Topic.CAMERA, Topic.VIEW, Topic.SELECTION, Topic.PINNED_REVISION], () => {
     clearTimeout(timer);
     timer = setTimeout(() => { if (store.sceneId) history.replaceState(null, "", currentLink()); }, 150);
   });

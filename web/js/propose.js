@@ -11,7 +11,8 @@
 // them in ONE edit — one revision, one undo step: all of them through propose?apply=true, a subset
 // by one PUT of the document — and then offer the clip's sweep, where the patterns show.
 
-import { store, on, set, emit, whenIdle, clipByName } from "./store.js";
+import { store, on, set, emit, whenIdle, clipByName, Topic } from "./store.js";
+import { proposePath } from "./scene_resource.js";
 import { edit } from "./edits.js";
 import { notify } from "./notice.js";
 import { setGhostSource } from "./frame_view.js";
@@ -42,9 +43,9 @@ export function initPropose(theApi, button) {
   button.onclick = () => (proposeOpen() ? closePropose() : openPropose());
   setGhostSource(ghost);
   setTextureGhosts(textureGhosts);
-  on("scene", () => { if (proposeOpen()) closePropose(false); });
+  on(Topic.SCENE, () => { if (proposeOpen()) closePropose(false); });
   // Someone (or undo) changed the scene: which proposals it has may have changed too.
-  on("revision", () => { if (proposeOpen()) whenIdle("propose", () => load(false), 300); });
+  on(Topic.REVISION, () => { if (proposeOpen()) whenIdle("propose", () => load(false), 300); });
   panel.addEventListener("keydown", onKey);
 }
 
@@ -80,7 +81,7 @@ export function closePropose(focusBack = true) {
   panel.hidden = true;
   opener.setAttribute("aria-expanded", "false");
   current = null;
-  emit("ghost");
+  emit(Topic.GHOST);
   if (focusBack) opener.focus();
 }
 
@@ -89,7 +90,7 @@ const modelName = () => (store.model && (store.model.name || store.model.id)) ||
 /// (Re)reads the proposals; `first` ticks every new one and previews the first row.
 async function load(first) {
   const scene = store.sceneId;
-  const request = api.send("POST", `/scenes/${scene}/propose`, {});
+  const request = api.send("POST", proposePath(scene), {});
   loading = request;
   let answer;
   try { answer = await request; } catch (e) {
@@ -113,7 +114,7 @@ function take(list, first) {
   const was = current;
   if (first || !byId(current)) current = proposals.length ? idOf(fresh()[0] || proposals[0]) : null;
   render();
-  emit("ghost");
+  emit(Topic.GHOST);
   if (first || current !== was) preview();
 }
 
@@ -196,7 +197,7 @@ function toggle(id, yes) {
   const prop = byId(id);
   if (!prop || prop.existing) return;
   if (yes) ticked.add(id); else ticked.delete(id);
-  emit("ghost"); // the texture view's ghost turns grey or violet
+  emit(Topic.GHOST); // the texture view's ghost turns grey or violet
   const box = panel.querySelector(`li[data-id="${CSS.escape(id)}"] input.accept`);
   if (box) box.checked = yes;
   const chosen = fresh().filter((p) => ticked.has(idOf(p))).length;
@@ -216,7 +217,7 @@ function choose(id) {
     if (yes) li.scrollIntoView({ block: "nearest" });
   }
   panel.querySelector("#proposalList").setAttribute("aria-activedescendant", `prop-${id}`);
-  emit("ghost");
+  emit(Topic.GHOST);
   preview();
 }
 

@@ -2,7 +2,7 @@
 // this form; the token goes once to POST /session, which sets an HttpOnly session cookie that
 // every later request (frames and events too) carries. The page keeps the token nowhere.
 
-import { API } from "./api.js";
+import { openSession } from "./api.js";
 
 let signingIn = null;
 const $ = (id) => document.getElementById(id);
@@ -17,22 +17,19 @@ export function signIn() {
     input.focus();
     form.onsubmit = async (e) => {
       e.preventDefault();
-      const body = JSON.stringify({ token: input.value });
+      const token = input.value;
       input.value = "";
       error.textContent = "";
       try {
-        const r = await fetch(API + "/session", { method: "POST", headers: { "Content-Type": "application/json" }, body });
-        if (r.ok) {
-          box.hidden = true;
-          form.onsubmit = null;
-          signingIn = null;
-          resolve();
-          return;
-        }
-        const answer = await r.json().catch(() => ({}));
-        error.textContent = r.status === 401 ? "That token is not the right one. Try again?"
-                                             : (answer.error ? answer.error.message : r.statusText);
-      } catch (err) { error.textContent = err.message; }
+        await openSession(token);
+        box.hidden = true;
+        form.onsubmit = null;
+        signingIn = null;
+        resolve();
+        return;
+      } catch (err) {
+        error.textContent = err.status === 401 ? "That token is not the right one. Try again?" : (err.raw ?? err.message);
+      }
       input.focus();
     };
   });

@@ -4,6 +4,7 @@
 // Also their hit test (a piece's bounds) for selecting and dragging in the texture view.
 
 import { store } from "./store.js";
+import { outlinePath } from "./scene_resource.js";
 
 let api = null;
 let onLoaded = () => {};
@@ -22,7 +23,7 @@ export function outlineOf(p) {
   if (hit && hit.key === key) return hit.answer;
   const entry = { key, answer: hit ? hit.answer : null, loading: true }; // the old outline until the new one lands
   cache.set(p.id, entry);
-  api.get(`/scenes/${store.sceneId}/placements/${encodeURIComponent(p.id)}/outline`)
+  api.get(outlinePath(store.sceneId, p.id))
     .then((a) => { if (cache.get(p.id) === entry) { entry.answer = a; onLoaded(); } })
     .catch(() => { if (cache.get(p.id) === entry) { entry.answer = null; } })
     .finally(() => { entry.loading = false; });

@@ -5,7 +5,7 @@
 // the placements most active then) — every pattern of a scene at work at once.
 
 import { store, shownTime } from "./store.js";
-import { API, query } from "./api.js";
+import { sweepUrl as sweepRouteUrl } from "./scene_resource.js";
 import { notify } from "./notice.js";
 import { focusOf } from "./camera3d.js";
 
@@ -16,8 +16,8 @@ export function sweepUrl(p, zoom = null) {
   const c = store.camera;
   const camera = zoom ? { distance: zoom.distance, target: zoom.target.join(",") }
                       : { distance: c.distance ?? undefined, target: c.target ? c.target.join(",") : undefined };
-  return `${API}/scenes/${store.sceneId}/sweep${query({ placement: p.id, steps: zoom ? 6 : 8, size: zoom ? 256 : 192,
-    yaw: c.yaw, pitch: c.pitch, ...camera, time: shownTime(), revision: store.pinnedRevision ?? undefined })}`;
+  return sweepRouteUrl(store.sceneId, { placement: p.id, steps: zoom ? 6 : 8, size: zoom ? 256 : 192,
+    yaw: c.yaw, pitch: c.pitch, ...camera, time: shownTime(), revision: store.pinnedRevision ?? undefined });
 }
 
 /// Opens the sweep dialog of placement p.
@@ -40,8 +40,8 @@ export async function openSweep(p) {
 /// Opens the sweep dialog of clip `clip` (6 cells of the clip's time, the 3D view's camera).
 export function openClipSweep(clip) {
   const c = store.camera;
-  const url = `${API}/scenes/${store.sceneId}/sweep${query({ clip, steps: 6, size: 352, yaw: c.yaw, pitch: c.pitch,
-    distance: c.distance ?? undefined, target: c.target ? c.target.join(",") : undefined, revision: store.pinnedRevision ?? undefined })}`;
+  const url = sweepRouteUrl(store.sceneId, { clip, steps: 6, size: 352, yaw: c.yaw, pitch: c.pitch,
+    distance: c.distance ?? undefined, target: c.target ? c.target.join(",") : undefined, revision: store.pinnedRevision ?? undefined });
   const dlg = document.getElementById("sweepDialog");
   dlg.innerHTML = `<h2>Sweep of the clip ${escapeHtml(clip)}: every placement over its time</h2>
     <div><img id="sweepSheet" alt="sweep contact sheet of the clip ${escapeHtml(clip)}" src="${url}"></div><form method="dialog"><button>Close</button></form>`;

@@ -14,7 +14,8 @@
 //
 // Draws from the store; edits go through edits.js (a Stream per drag: one edit when it ends).
 
-import { store, on, emit, set, placementById, heightmapSize } from "./store.js";
+import { store, on, emit, set, placementById, heightmapSize, Topic } from "./store.js";
+import { heightmapPath, pickUVPath } from "./scene_resource.js";
 import * as geo from "./geometry.js";
 import { image, heightOverlay, onImageLoaded, patternImagePath } from "./images.js";
 import { Stream, patchPlacement } from "./edits.js";
@@ -73,8 +74,9 @@ export function initTextureView(section, theApi) {
   canvas.addEventListener("pointercancel", () => cancelDrag());
   canvas.addEventListener("wheel", wheel, { passive: false });
   canvas.addEventListener("contextmenu", (e) => e.preventDefault());
-  on("doc selection lint presence overlay layout model revision solo drag ghost", redraw);
-  on("layoutMode", () => requestAnimationFrame(fit)); // the stage changed size: fit the UV square again
+  on([Topic.DOC, Topic.SELECTION, Topic.LINT, Topic.PRESENCE, Topic.OVERLAY, Topic.LAYOUT, Topic.MODEL, Topic.REVISION, Topic.SOLO,
+      Topic.DRAG, Topic.GHOST], redraw);
+  on(Topic.LAYOUT_MODE, () => requestAnimationFrame(fit)); // the stage changed size: fit the UV square again
   onImageLoaded(redraw);
 }
 
@@ -133,7 +135,7 @@ function draw() {
     ctx.globalAlpha = 1;
   }
   if (store.overlay !== "none") {
-    const ov = heightOverlay(`/scenes/${store.sceneId}/heightmaps/${store.overlay}?revision=${store.overlayRevision || store.revision}`);
+    const ov = heightOverlay(heightmapPath(store.sceneId, store.overlay, store.overlayRevision || store.revision));
     if (ov) ctx.drawImage(ov, ox, oy, s, s);
   }
   if (store.layout) {
@@ -460,7 +462,7 @@ function pointerDown(e) {
 function pointerMove(e) {
   const [x, y] = local(e);
   const uv = toUV(x, y);
-  store.cursorUV = uv;
+  set({ cursorUV: uv });
   if (!drag) {
     const what = store.doc ? under(x, y) : null;
     const id = what ? what.id : null;
@@ -527,7 +529,7 @@ async function slideOnBody(d) {
   if (!p || !o || !o.anchor_uv || Math.hypot(...d.delta) < 1e-6) { redraw(); return; }
   const uv = [o.anchor_uv[0] + d.delta[0], o.anchor_uv[1] + d.delta[1]];
   try {
-    const hit = uv.every((x) => x >= 0 && x <= 1) ? await api.get(`/scenes/${store.sceneId}/pick?u=${uv[0]}&v=${uv[1]}`) : { hit: false };
+    const hit = uv.every((x) => x >= 0 && x <= 1) ? await api.get(pickUVPath(store.sceneId, uv)) : { hit: false };
     if (!hit.hit || !hit.anchor) notify(`"${p.label || p.id}" stays: no body under that point of the layout.`, "warn");
     else await patchPlacement(d.id, { anchor: geo.anchorNear(p, hit.anchor) }, { what: `move "${p.label || p.id}"` });
   } finally { redraw(); }

@@ -6,6 +6,7 @@
 // it: one edit, one revision, one undo step.
 
 import { store } from "./store.js";
+import { SCENES_PATH, transferPath } from "./scene_resource.js";
 import { edit } from "./edits.js";
 import { notify } from "./notice.js";
 
@@ -15,7 +16,7 @@ export async function openTransferDialog(api) {
   const dlg = document.getElementById("transferDialog");
   let scenes, models;
   try {
-    [scenes, models] = await Promise.all([api.get("/scenes").then((a) => a.scenes.filter((s) => s.id !== store.sceneId && s.placements > 0)),
+    [scenes, models] = await Promise.all([api.get(SCENES_PATH).then((a) => a.scenes.filter((s) => s.id !== store.sceneId && s.placements > 0)),
                                           api.get("/models").then((a) => a.models).catch(() => [])]);
   } catch (e) { return notify(e.message, "error"); }
   const names = new Map(models.map((m) => [m.id, m.name || m.id]));
@@ -32,7 +33,7 @@ export async function openTransferDialog(api) {
     go.disabled = true;
     result.textContent = "Matching the joints…";
     try {
-      const answer = await api.send("POST", `/scenes/${store.sceneId}/transfer?apply=false`, { from });
+      const answer = await api.send("POST", transferPath(store.sceneId, { apply: false }), { from });
       if (source.value !== from) return; // another scene was chosen meanwhile
       shown = { from, answer };
       result.innerHTML = describe(answer);

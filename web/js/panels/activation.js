@@ -2,7 +2,8 @@
 // lane per placement (brightness = t), the route's flags marked (never active, saturated, jump),
 // the shown time as a cursor; click or drag to jump to a time.
 
-import { store, on, set, clipByName, shownTime, whenIdle } from "../store.js";
+import { store, on, set, clipByName, shownTime, whenIdle, Topic } from "../store.js";
+import { activationPath } from "../scene_resource.js";
 import { notify } from "../notice.js";
 
 let api, canvas, data = null, key = "";
@@ -11,8 +12,8 @@ export function initActivation(section, theApi) {
   api = theApi;
   section.innerHTML = `<canvas id="activation" width="900" height="220" tabindex="0" aria-label="activation strip: t of each placement over the clip; click to jump to a time"></canvas>`;
   canvas = section.querySelector("#activation");
-  on("revision doc", () => whenIdle("activation", load));
-  on("time selection", draw);
+  on([Topic.REVISION, Topic.DOC], () => whenIdle("activation", load));
+  on([Topic.TIME, Topic.SELECTION], draw);
   const jump = (e) => {
     if (!data) return;
     const r = canvas.getBoundingClientRect();
@@ -42,7 +43,7 @@ async function load() {
   key = k;
   if (!clip) { data = null; draw(); return; }
   try {
-    const answer = await api.get(`/scenes/${store.sceneId}/activation?clip=${encodeURIComponent(clip)}&fps=30`);
+    const answer = await api.get(activationPath(store.sceneId, clip, 30));
     if (k !== key) return;
     data = answer;
   } catch (e) { data = null; notify(`Activation: ${e.message}`, "error"); }

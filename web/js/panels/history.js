@@ -3,7 +3,8 @@
 // The list is one Tab stop (roving focus, on the current revision's row): ↑/↓, Home and End move
 // the focus between revisions without reverting; Enter (or Space) reverts to the focused one.
 
-import { store, on, whenIdle } from "../store.js";
+import { store, on, whenIdle, Topic } from "../store.js";
+import { fetchRevisions } from "../scene_resource.js";
 import { revert } from "../edits.js";
 import { escapeHtml } from "./library.js";
 import { notify } from "../notice.js";
@@ -16,16 +17,16 @@ export function initHistory(section, theApi) {
   section.innerHTML = `<h2>History</h2><ul class="list history" id="historyList" aria-label="revisions (arrows move, Enter reverts)" data-roving></ul>`;
   list = section.querySelector("#historyList");
   list.addEventListener("keydown", onListKey);
-  on("revision", () => whenIdle("history", load));
+  on(Topic.REVISION, () => whenIdle("history", load));
   // Another scene: its history at once (not the last scene's until things are quiet).
-  on("scene", () => { list.innerHTML = ""; load(); });
+  on(Topic.SCENE, () => { list.innerHTML = ""; load(); });
 }
 
 async function load() {
   if (!store.sceneId) return;
   const mine = ++loading;
   let answer;
-  try { answer = await api.get(`/scenes/${store.sceneId}/revisions?limit=40`); } catch (e) { notify(`History: ${e.message}`, "error"); return; }
+  try { answer = await fetchRevisions(api, store.sceneId); } catch (e) { notify(`History: ${e.message}`, "error"); return; }
   if (mine !== loading) return;
   const focused = list.contains(document.activeElement) ? document.activeElement.closest("li")?.dataset.revision : null;
   list.innerHTML = "";

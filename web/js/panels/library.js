@@ -4,7 +4,7 @@
 // with a notice and nothing is sent. The list is one tab stop (roving focus): ←/→/↑/↓, Home and
 // End move to a pattern and choose it.
 
-import { store, on, set, emit } from "../store.js";
+import { store, on, set, emit, Topic } from "../store.js";
 import { notify } from "../notice.js";
 import { patternImagePath } from "../images.js";
 
@@ -15,7 +15,7 @@ export function choosePattern(id) {
   const hadFocus = list && list.contains(document.activeElement);
   currentId = id;
   render();
-  emit("currentPattern");
+  emit(Topic.CURRENT_PATTERN);
   if (hadFocus) list.querySelector('button[tabindex="0"]')?.focus();
 }
 
@@ -44,7 +44,7 @@ export function initLibrary(section, theApi) {
     });
   }
   list.addEventListener("keydown", onListKey);
-  on("patterns", render);
+  on(Topic.PATTERNS, render);
 }
 
 /// Arrow keys, Home and End inside the list: the focus and the current pattern move together.

@@ -4,11 +4,11 @@
 // "go to pose" buttons (pose the driver at θmin / θmax) and the sweep contact sheet. Each field
 // is sent when it changes (Enter or leaving it).
 
-import { store, on, primary, placementById, shownTime, whenIdle } from "../store.js";
+import { store, on, set, primary, placementById, shownTime, whenIdle, Topic } from "../store.js";
 import { patchPlacement, patchPose, mirrorPlacement } from "../edits.js";
 import { height, normalizedT } from "../deform.js";
 import { escapeHtml } from "./library.js";
-import { query } from "../api.js";
+import { driversPath } from "../scene_resource.js";
 import { openSweep } from "../sweep_view.js";
 import { notify } from "../notice.js";
 import { overrideAt, axisLabel } from "../joint_angles.js";
@@ -19,12 +19,12 @@ export function initParams(section, theApi) {
   api = theApi;
   section.innerHTML = `<h2>Parameters <span class="grow"></span><span id="paramsId" class="badge"></span></h2><div id="paramsBody"></div>`;
   box = section.querySelector("#paramsBody");
-  on("selection model patterns", render);
-  on("doc", () => refreshValues(false));
+  on([Topic.SELECTION, Topic.MODEL, Topic.PATTERNS], render);
+  on(Topic.DOC, () => refreshValues(false));
   // A refused edit: every field shows the document's value again, the one being typed in too.
-  on("refused", () => refreshValues(true));
-  on("selection doc time revision", () => whenIdle("drivers", loadDrivers, 60));
-  on("drivers", drawLive);
+  on(Topic.REFUSED, () => refreshValues(true));
+  on([Topic.SELECTION, Topic.DOC, Topic.TIME, Topic.REVISION], () => whenIdle("drivers", loadDrivers, 60));
+  on(Topic.DRIVERS, drawLive);
 }
 
 /// Each placement's current θ and t at the shown time (GET /scenes/{id}/drivers).
@@ -34,10 +34,10 @@ async function loadDrivers() {
   if (key === driversKey) return;
   driversKey = key;
   try {
-    const answer = await api.get(`/scenes/${store.sceneId}/drivers${query({ time: shownTime(), revision: store.revision })}`);
+    const answer = await api.get(driversPath(store.sceneId, { time: shownTime(), revision: store.revision }));
     if (key !== driversKey) return;
     drivers = new Map(answer.placements.map((d) => [d.placement, d]));
-    store.liveCamera = answer.camera;
+    set({ liveCamera: answer.camera });
     drawLive();
   } catch (e) { drivers = new Map(); }
 }

@@ -4,7 +4,7 @@
 // the selected row): ↑/↓, Home and End move to a row and select it, Alt+↑/↓ moves the row in the
 // document; H and S toggle the focused selection as everywhere.
 
-import { store, on, set, whenIdle } from "../store.js";
+import { store, on, set, whenIdle, Topic } from "../store.js";
 import { patternImagePath } from "../images.js";
 import { patchPlacement, putScene } from "../edits.js";
 import { escapeHtml } from "./library.js";
@@ -23,8 +23,8 @@ export function initPlacements(section) {
   empty = section.querySelector("#placementsEmpty");
   count = section.querySelector("#placementCount");
   list.addEventListener("keydown", onListKey);
-  on("selection lint solo", render);
-  on("doc", () => whenIdle("placements", render, 0)); // not on every step of a drag
+  on([Topic.SELECTION, Topic.LINT, Topic.SOLO], render);
+  on(Topic.DOC, () => whenIdle("placements", render, 0)); // not on every step of a drag
 }
 
 export function toggleEnabled(ids) {

@@ -2,7 +2,7 @@
 // shown time: it changes frames, not the document), and a slider per joint axis that drives a
 // placement (pose.joints overrides: dragging sends coalesced pose edits; "release" removes one).
 
-import { store, on, set, clipByName, shownTime } from "../store.js";
+import { store, on, set, clipByName, shownTime, Topic } from "../store.js";
 import { patchPose, Stream } from "../edits.js";
 import { escapeHtml } from "./library.js";
 import { overrideAngle, overrideAt, axisLabel } from "../joint_angles.js";
@@ -28,9 +28,9 @@ export function initPose(section) {
   playBtn.onclick = () => togglePlay();
   slider.oninput = () => set({ time: +slider.value });
   section.querySelector("#setTime").onclick = () => patchPose({ time: shownTime() });
-  on("doc model", renderClips);
-  on("doc", renderJoints);
-  on("time doc", showTime);
+  on([Topic.DOC, Topic.MODEL], renderClips);
+  on(Topic.DOC, renderJoints);
+  on([Topic.TIME, Topic.DOC], showTime);
 }
 
 function renderClips() {
