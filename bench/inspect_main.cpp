@@ -2,7 +2,7 @@
 // read per-model derived data (UV index, symmetry plane, clip ranges, UV diagnosis): lint, pick by
 // UV, mirror, a model's details (GET /models/{id}).
 // Usage: dermis-inspectbench [--repeat N] [--model PATH]…
-//   (default 15 repetitions; models: the built-in default character, ../shared's CesiumMan and
+//   (default 15 repetitions; models: the built-in default character, tests/models' CesiumMan and
 //   KayKit Barbarian when present, or the --model files given)
 //
 // The Service is opened on a temporary data folder with a renderer that renders nothing (these
@@ -259,11 +259,11 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> cases; // label, path ("" = built-in)
     if (models.empty()) {
         cases.emplace_back("builtin:default", "");
-        const std::string shared = DERMIS_SHARED_DIR;
+        const std::string models = DERMIS_TEST_MODELS;
         for (auto [label, rel] :
-             {std::pair{"CesiumMan", "/models/CesiumMan/CesiumMan.glb"},
-              std::pair{"KayKitBarbarian", "/models/KayKitBarbarian/Barbarian.glb"}})
-            if (std::filesystem::exists(shared + rel)) cases.emplace_back(label, shared + rel);
+             {std::pair{"CesiumMan", "/CesiumMan/CesiumMan.glb"},
+              std::pair{"KayKitBarbarian", "/KayKitBarbarian/Barbarian.glb"}})
+            if (std::filesystem::exists(models + rel)) cases.emplace_back(label, models + rel);
     } else {
         for (const std::string& m : models)
             cases.emplace_back(std::filesystem::path(m).stem().string(), m);

@@ -3,7 +3,7 @@
 // is like. Usage: dermis-layoutbench [--repeat N] [--cone DEGREES] [--png DIR]
 //                                    [--model PATH [--subdivide L]]…
 //   (default 5 repetitions after one unmeasured run; models: the built-in default character and
-//   ../shared's CesiumMan, RiggedFigure and KayKit Barbarian, each also subdivided once (×4
+//   tests/models' CesiumMan, RiggedFigure and KayKit Barbarian, each also subdivided once (×4
 //   triangles, core subdivideModel), and the default character subdivided twice (×16, ≈ 69k
 //   triangles) — or the --model files given, subdivided L times with --subdivide (×4^L triangles);
 //   --cone sets LayoutGenOptions::coneDegrees; --png writes DIR/layout-<model>.png,
@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
             results.push_back(benchModel(levels ? p + " ×" + std::to_string(1 << (2 * levels)) : p,
                                          subdivided(load(p), levels), repeat));
     } else {
-        const std::string shared = std::string(DERMIS_SHARED_DIR) + "/models/";
+        const std::string shared = std::string(DERMIS_TEST_MODELS) + "/";
         const std::vector<std::pair<std::string, std::string>> models = {
             {"default", resolveModelPath("builtin:default", "", dermisContentDir())},
             {"CesiumMan", shared + "CesiumMan/CesiumMan.glb"},

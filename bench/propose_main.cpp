@@ -4,7 +4,7 @@
 // Usage: dermis-proposebench [--repeat N]
 //   (default 3 repetitions, median and smallest reported; models: the built-in default character,
 //   the default character subdivided twice with joints added up to 60 (≈ 75k triangles: over the
-//   issue's 50k), and ../shared's CesiumMan, RiggedFigure and KayKit Barbarian)
+//   issue's 50k), and tests/models' CesiumMan, RiggedFigure and KayKit Barbarian)
 //
 // Single-threaded, like the server's analysis (built once per model, on the first propose or
 // pick). Wall time and the thread's CPU time (nearer an idle machine's on a busy one).
@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    const std::string shared = DERMIS_SHARED_DIR;
+    const std::string testModels = DERMIS_TEST_MODELS;
     auto source = loadSceneFile(dermisContentDir() + "/models/default.scene.json");
     if (!source) {
         std::cerr << source.error().message << "\n";
@@ -76,9 +76,9 @@ int main(int argc, char** argv) {
         if (big) big = withSyntheticJoints(*big, 60);
         if (big) models.push_back({"default x16, 60 joints", std::move(*big)});
     }
-    for (const char* rel : {"/models/CesiumMan/CesiumMan.glb", "/models/RiggedFigure/RiggedFigure.glb",
-                            "/models/KayKitBarbarian/Barbarian.glb"}) {
-        auto m = loadGltfFile(shared + rel);
+    for (const char* rel : {"/CesiumMan/CesiumMan.glb", "/RiggedFigure/RiggedFigure.glb",
+                            "/KayKitBarbarian/Barbarian.glb"}) {
+        auto m = loadGltfFile(testModels + rel);
         if (m) models.push_back({rel, std::move(*m)});
         else std::cerr << rel << ": " << m.error().message << "\n";
     }

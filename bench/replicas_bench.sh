@@ -18,7 +18,7 @@ frames="${3:-60}"
 server="$build/dermis-server" client="$build/client/dermis"
 [ -x "$server" ] && [ -x "$client" ] || { echo "replicas_bench: build dermis-server and dermis first ($build)" >&2; exit 2; }
 src="$(cd "$(dirname "$0")/.." && pwd)"
-models="${DERMIS_MODELS:-$src/../shared/models}"
+models="${DERMIS_TEST_MODELS:-$src/tests/models}"
 nginx_bin=$(command -v nginx || echo /usr/sbin/nginx)
 work="$(mktemp -d)"
 pids=()

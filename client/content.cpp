@@ -3,7 +3,7 @@
 #include "content.hpp"
 
 #include "context.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <filesystem>
 

@@ -4,7 +4,7 @@
 #include "batch.hpp"
 #include "frames.hpp"
 #include "http_client.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -1,6 +1,6 @@
 // Dermis — declarations shared by every program. Prepended after "#version" and the variant
 // #defines by the renderer (server/gl/programs.cpp). Each uniform block here has a C++ mirror in
-// server/gl/uniform_blocks.hpp with the same std140 layout; UniformBlockGLTest checks it.
+// server/gl/private/uniform_blocks.hpp with the same std140 layout; UniformBlockGLTest checks it.
 
 // Per-placement constants of the height pass (paper §4 stage 1; SPEC §2; surface placements
 // SPEC §8).

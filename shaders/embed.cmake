@@ -2,7 +2,7 @@
 #   cmake -DOUT=<file.cpp> -DFILES="a.vert;b.frag;..." -P embed.cmake
 # Each file becomes one entry of dermis::gl::shaderSources() under its file name.
 set(body "// Generated from shaders/ by shaders/embed.cmake; do not edit.\n")
-string(APPEND body "#include \"gl/shader_sources.hpp\"\n\nnamespace dermis::gl {\n\n")
+string(APPEND body "#include \"shader_sources.hpp\"\n\nnamespace dermis::gl {\n\n")
 string(APPEND body "const std::vector<ShaderSource>& shaderSources() {\n")
 string(APPEND body "    static const std::vector<ShaderSource> sources = {\n")
 foreach(f IN LISTS FILES)

@@ -1,4 +1,4 @@
-// BakeCliTest — `dermis-server bake` end to end on a character from ../shared/models: the EXR
+// BakeCliTest — `dermis-server bake` end to end on a character from tests/models: the EXR
 // maps equal the in-process CPU reference, are non-zero exactly inside the footprints, and bad
 // scenes exit non-zero with the offending field on stderr. Needs the built dermis-server.
 #include "core/bake.hpp"
@@ -18,9 +18,9 @@ using nlohmann::json;
 
 namespace {
 
-const std::string kCesium = std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb";
+const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
 const std::string kRigged =
-    std::string(DERMIS_SHARED_DIR) + "/models/RiggedFigure/RiggedFigure.glb";
+    std::string(DERMIS_TEST_MODELS) + "/RiggedFigure/RiggedFigure.glb";
 const char* kJoint = "Skeleton_torso_joint_2";
 
 

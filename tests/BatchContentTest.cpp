@@ -8,7 +8,7 @@
 // ContentCache itself.
 #include "ServiceFixture.hpp"
 
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 #include "service/content_cache.hpp"
 
 #include <map>
@@ -24,7 +24,7 @@ class BatchContentTest : public ServiceFixture {
 protected:
     void SetUp() override {
         ServiceFixture::SetUp();
-        model_ = readBytes(std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb");
+        model_ = readBytes(std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb");
         ASSERT_FALSE(model_.empty());
         pattern_ = patternPng(32, 32);
     }

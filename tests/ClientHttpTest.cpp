@@ -38,7 +38,7 @@ namespace {
 
 const std::string kClient = DERMIS_CLIENT_EXE;
 const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kRiggedFigure = std::string(DERMIS_SHARED_DIR) + "/models/RiggedFigure/RiggedFigure.glb";
+const std::string kRiggedFigure = std::string(DERMIS_TEST_MODELS) + "/RiggedFigure/RiggedFigure.glb";
 
 std::string backend() {
     const char* env = std::getenv("DERMIS_TEST_GL");

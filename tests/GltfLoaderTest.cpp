@@ -1,5 +1,5 @@
 // GltfLoaderTest — glTF 2.0 in (server/io/gltf_loader.hpp): the shared models written by others
-// (shared/models; the tests fail, never skip, when they are missing), small hand-built files that
+// (tests/models; the tests fail, never skip, when they are missing), small hand-built files that
 // pin each loading rule, and external files (only from the model's folder) and files in memory
 // (only resolving to each other). Corrupt input is GltfLoaderDamageTest's; the builders and checks
 // both use are in GltfTestBuilder.hpp. Reads the shared models and writes temporary files.

@@ -30,7 +30,7 @@ namespace dermis::test::gltf {
 
 using json = nlohmann::json;
 
-inline const std::string kModels = std::string(DERMIS_SHARED_DIR) + "/models/";
+inline const std::string kModels = std::string(DERMIS_TEST_MODELS) + "/";
 inline const std::string kCesiumMan = kModels + "CesiumMan/CesiumMan.glb";
 inline const std::string kRiggedFigure = kModels + "RiggedFigure/RiggedFigure.glb";
 inline const std::string kBarbarian = kModels + "KayKitBarbarian/Barbarian.glb";

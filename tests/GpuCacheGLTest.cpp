@@ -25,7 +25,7 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kCesium = std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb";
+const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
 
 /// Resident memory of this process in MB, from /proc/self/statm (pages).
 /// How much the resident memory may grow over 20 cycles: 100 MB (issue #12), plus, under

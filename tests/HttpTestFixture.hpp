@@ -39,11 +39,11 @@ namespace dermis::test::http {
 
 using nlohmann::json;
 
-inline const std::string kShared = DERMIS_SHARED_DIR;
+inline const std::string kTestModels = DERMIS_TEST_MODELS;
 inline const std::string kApi = "/api/v1";
-inline const std::string kCesiumMan = kShared + "/models/CesiumMan/CesiumMan.glb";
-inline const std::string kBarbarian = kShared + "/models/KayKitBarbarian/Barbarian.glb";
-inline const std::string kRiggedFigure = kShared + "/models/RiggedFigure/RiggedFigure.glb";
+inline const std::string kCesiumMan = kTestModels + "/CesiumMan/CesiumMan.glb";
+inline const std::string kBarbarian = kTestModels + "/KayKitBarbarian/Barbarian.glb";
+inline const std::string kRiggedFigure = kTestModels + "/RiggedFigure/RiggedFigure.glb";
 inline constexpr std::size_t kMaxUpload = 8u << 20;
 inline constexpr std::size_t kMaxPlacements = 24; // the default pattern set has 18
 

@@ -190,7 +190,7 @@ TEST(ImageDecodeTest, PatternLibraryAndModelImagesDecodeAsOpenImageIoDoes) {
             ++patterns;
         }
     EXPECT_GE(patterns, 10) << "the built-in pattern library";
-    const std::string models = std::string(DERMIS_SHARED_DIR) + "/models";
+    const std::string models = std::string(DERMIS_TEST_MODELS);
     for (const auto& e : std::filesystem::recursive_directory_iterator(models))
         if (e.path().extension() == ".glb") {
             int k = 0;

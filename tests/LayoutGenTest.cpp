@@ -3,7 +3,7 @@
 // checkTextureLayout (which is compared with it): on hand-built meshes (a cube welded and split by
 // face, an open cylinder and a UV sphere welded and split at their UV seams, a grid with a
 // repeated-vertex and a zero-area triangle) and on the real models (the built-in default
-// character, ../shared's CesiumMan, RiggedFigure without UVs and the KayKit Barbarian with its
+// character, tests/models' CesiumMan, RiggedFigure without UVs and the KayKit Barbarian with its
 // props): the layout's structure (triangle order, `source` the part's corners), every UV in
 // [0,1]², no flipped triangle, 0 texels of a 1024² map covered by two triangles, ≥ 4 free texels
 // (the default gutter) between texels touched by different charts and along the border, area
@@ -31,7 +31,7 @@ using namespace dermis;
 
 namespace {
 
-const std::string kShared = std::string(DERMIS_SHARED_DIR) + "/models/";
+const std::string kTestModels = std::string(DERMIS_TEST_MODELS) + "/";
 constexpr int kRes = 1024;
 constexpr double kPi = 3.14159265358979323846;
 
@@ -445,17 +445,17 @@ TEST(LayoutGenTest, DefaultCharacter) {
 }
 
 TEST(LayoutGenTest, CesiumMan) {
-    expectGoodLayout(loadModel(kShared + "CesiumMan/CesiumMan.glb"), "CesiumMan");
+    expectGoodLayout(loadModel(kTestModels + "CesiumMan/CesiumMan.glb"), "CesiumMan");
 }
 
 TEST(LayoutGenTest, RiggedFigureWithoutUvs) {
-    const Model m = loadModel(kShared + "RiggedFigure/RiggedFigure.glb");
+    const Model m = loadModel(kTestModels + "RiggedFigure/RiggedFigure.glb");
     EXPECT_FALSE(m.hasUVs());
     expectGoodLayout(m, "RiggedFigure");
 }
 
 TEST(LayoutGenTest, BarbarianWithPropsSharesOneSquare) {
-    const Model m = loadModel(kShared + "KayKitBarbarian/Barbarian.glb");
+    const Model m = loadModel(kTestModels + "KayKitBarbarian/Barbarian.glb");
     ASSERT_GT(m.parts.size(), 5u);
     const GeneratedLayout g = expectGoodLayout(m, "KayKit Barbarian");
     for (std::size_t k = 0; k < m.parts.size(); ++k)
@@ -533,7 +533,7 @@ TEST(LayoutGenTest, ASoupFitsUntilTheGuttersDoNot) {
 
 TEST(LayoutGenTest, OtherGutterAndResolution) {
     // 2 texels at 512²: the layout still verifies at its own resolution.
-    const Model m = loadModel(kShared + "CesiumMan/CesiumMan.glb");
+    const Model m = loadModel(kTestModels + "CesiumMan/CesiumMan.glb");
     LayoutGenOptions o;
     o.resolution = 512;
     o.gutterTexels = 2;

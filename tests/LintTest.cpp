@@ -255,7 +255,7 @@ TEST_F(LintTest, FindsAsymmetricMirrorPairs) {
 
 // --- the model's own UVs (SPEC §8 UV diagnosis): uv_overlap, no_uvs, no_influence on overlap ---
 
-const std::string kModels = std::string(DERMIS_SHARED_DIR) + "/models/";
+const std::string kModels = std::string(DERMIS_TEST_MODELS) + "/";
 
 std::shared_ptr<const Model> loadShared(const std::string& path) {
     auto m = loadGltfFile(path);

@@ -20,8 +20,8 @@ using namespace dermis;
 namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kCesium = std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb";
-const std::string kBarbarian = std::string(DERMIS_SHARED_DIR) + "/models/KayKitBarbarian/Barbarian.glb";
+const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
+const std::string kBarbarian = std::string(DERMIS_TEST_MODELS) + "/KayKitBarbarian/Barbarian.glb";
 
 /// A point of `lookup`'s atlas: the first chart hit on a 0.05 grid.
 std::array<double, 2> somewhereOnTheAtlas(const UvLookup& lookup) {

@@ -31,9 +31,9 @@ using json = nlohmann::json;
 namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kCesium = std::string(DERMIS_SHARED_DIR) + "/models/CesiumMan/CesiumMan.glb";
+const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
 const std::string kBarbarian =
-    std::string(DERMIS_SHARED_DIR) + "/models/KayKitBarbarian/Barbarian.glb";
+    std::string(DERMIS_TEST_MODELS) + "/KayKitBarbarian/Barbarian.glb";
 
 std::shared_ptr<const Model> loadShared(const std::string& path) {
     auto m = loadGltfFile(path);

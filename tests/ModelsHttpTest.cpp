@@ -17,7 +17,7 @@
 #include "GltfTestBuilder.hpp"
 #include "HttpTestFixture.hpp"
 #include "io/gltf_loader.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <chrono>
 #include <cstdio>

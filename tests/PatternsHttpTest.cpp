@@ -5,7 +5,7 @@
 //     scene's alias map, 409 while in use, 204 once unused (an alias no placement names is
 //     dropped); previews of tall patterns keep the aspect ratio.
 #include "HttpTestFixture.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 using namespace dermis;
 using namespace dermis::test;

@@ -33,7 +33,7 @@ protected:
 };
 
 TEST_F(ProposeHttpTest, ProposesAppliesInOneRevisionLintCleanWithTwinsTheMirrorAgreesWith) {
-    for (const std::string& path : {kCesiumMan, kBarbarian, kShared + "/models/RiggedFigure/RiggedFigure.glb"}) {
+    for (const std::string& path : {kCesiumMan, kBarbarian, kTestModels + "/RiggedFigure/RiggedFigure.glb"}) {
         SCOPED_TRACE(path);
         const std::string id = createScene(emptyScene(uploadModel(path, false)));
         const std::string s = "/scenes/" + id;

@@ -26,7 +26,7 @@ using namespace dermis;
 namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kModels = std::string(DERMIS_SHARED_DIR) + "/models/";
+const std::string kModels = std::string(DERMIS_TEST_MODELS) + "/";
 
 std::shared_ptr<const Model> load(const std::string& path) {
     auto m = loadGltfFile(path);

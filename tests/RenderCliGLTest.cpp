@@ -22,7 +22,7 @@ using nlohmann::json;
 namespace {
 
 const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kShared = DERMIS_SHARED_DIR;
+const std::string kTestModels = DERMIS_TEST_MODELS;
 const std::string kDefaultScene = kSource + "/models/default.scene.json";
 
 std::string backend() {
@@ -189,7 +189,7 @@ TEST(RenderCliGLTest, RendersTheSharedModels) {
     for (const char* model : {"CesiumMan/CesiumMan.glb", "KayKitBarbarian/Barbarian.glb",
                               "RiggedFigure/RiggedFigure.glb"}) {
         writeText(dir / "s.json", json{{"format", "dermis.scene/1"},
-                                       {"model", kShared + "/models/" + model},
+                                       {"model", kTestModels + "/" + model},
                                        {"pose", {{"time", 0.5}}}}
                                       .dump());
         CliRun r = runServer(dir, "render --scene " + (dir / "s.json") + " --out " +

@@ -13,7 +13,7 @@
 #include "core/bake.hpp"
 #include "gl/renderer.hpp"
 #include "SceneFrame.hpp"
-#include "gl/uniform_blocks.hpp"
+#include "uniform_blocks.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
 #include "ImageCompare.hpp"
@@ -33,10 +33,10 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kShared = DERMIS_SHARED_DIR;
+const std::string kTestModels = DERMIS_TEST_MODELS;
 const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kCesium = kShared + "/models/CesiumMan/CesiumMan.glb";
-const std::string kBarbarian = kShared + "/models/KayKitBarbarian/Barbarian.glb";
+const std::string kCesium = kTestModels + "/CesiumMan/CesiumMan.glb";
+const std::string kBarbarian = kTestModels + "/KayKitBarbarian/Barbarian.glb";
 
 using test::requestedBackend;
 

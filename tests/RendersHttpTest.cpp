@@ -9,7 +9,7 @@
 //   * back-pressure: with a render queue of 1 (a second server), concurrent frames answer 200 or
 //     503 + Retry-After, and renders go through again once the burst is over.
 #include "HttpTestFixture.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 #include "io/webp_encode.hpp"
 
 using namespace dermis;

@@ -443,8 +443,14 @@ TEST_F(ServiceContentTest, WithoutADefaultPatternSetScenesStillWork) {
 }
 
 TEST_F(ServiceContentTest, MissingContentFailsToOpen) {
-    auto svc = open((dir_ / "nowhere"));
+    // A content folder that is not there: the service does not start on nothing, and says what it
+    // looked for and where (the built-in character under the given folder).
+    const std::string nowhere = dir_ / "nowhere";
+    auto svc = open(nowhere);
     ASSERT_FALSE(svc);
+    EXPECT_EQ(svc.error().code, ErrorCode::NotFound) << svc.error().message;
+    EXPECT_NE(svc.error().message.find(nowhere + "/models/default.glb"), std::string::npos)
+        << svc.error().message;
 }
 
 } // namespace

@@ -7,7 +7,7 @@
 // hit test agrees; the cap truncates with a flag; errors name the field; a UV placement is its
 // rotated rectangle; the anchor's UV is that of the nearest surface point facing the anchor within
 // the decal's reach (else of the nearest triangle), a UV placement's is its center; on the KayKit
-// Barbarian (../shared) through its generated layout, a decal at a pick anchor on the forearm
+// Barbarian (tests/models) through its generated layout, a decal at a pick anchor on the forearm
 // gives pieces inside [0,1]² holding the picked point, which is its anchor UV.
 #include "core/bake.hpp"
 #include "core/heightmap.hpp"
@@ -391,7 +391,7 @@ TEST(SurfaceOutlineTest, TheAnchorUvPrefersASurfaceFacingTheAnchorWithinReach) {
 // --- a real character --------------------------------------------------------------------------
 
 TEST(SurfaceOutlineTest, TheBarbariansForearmDecalInItsGeneratedLayout) {
-    auto loaded = loadGltfFile(std::string(DERMIS_SHARED_DIR) + "/models/KayKitBarbarian/Barbarian.glb");
+    auto loaded = loadGltfFile(std::string(DERMIS_TEST_MODELS) + "/KayKitBarbarian/Barbarian.glb");
     ASSERT_TRUE(loaded) << loaded.error().message;
     const Model& own = *loaded;
     auto layout = generateTextureLayout(own);

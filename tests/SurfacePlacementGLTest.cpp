@@ -27,9 +27,9 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kShared = DERMIS_SHARED_DIR;
+const std::string kTestModels = DERMIS_TEST_MODELS;
 const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kCesium = kShared + "/models/CesiumMan/CesiumMan.glb";
+const std::string kCesium = kTestModels + "/CesiumMan/CesiumMan.glb";
 
 class SurfacePlacementGLTest : public RendererSuite {
 protected:

@@ -1,5 +1,5 @@
 // SHA-256 over OpenSSL's EVP interface (libcrypto from libssl-dev).
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <openssl/evp.h>
 

@@ -1,4 +1,4 @@
-// Dermis io — SHA-256 digests through OpenSSL's libcrypto (EVP_Digest), for content-addressed
+// Dermis common (server and client) — SHA-256 digests through OpenSSL's libcrypto (EVP_Digest), for content-addressed
 // uploads (the same model or pattern bytes get the same id) and manifests.
 // Pure functions of their input; no state, thread-safe. What it does not do: keyed hashes (HMAC),
 // streaming over files (hash what is in memory).

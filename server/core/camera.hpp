@@ -28,7 +28,7 @@
 #pragma once
 
 #include "rig.hpp"
-#include "scene.hpp"
+#include "render_settings.hpp"
 
 #include <glm/glm.hpp>
 

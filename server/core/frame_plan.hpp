@@ -25,18 +25,6 @@
 
 namespace dermis {
 
-/// What both height-map stages take: the CPU reference (bakeHeightMaps below) and the GPU pass.
-struct HeightMapInput {
-    std::vector<BakePlacement> placements; ///< document order; `pattern` points into live images
-    const HeightImage* base = nullptr;     ///< optional static bump map
-    std::uint64_t baseId = 0;              ///< its PatternImage::contentId (0 = unknown)
-    int width = 1024, height = 1024;
-    /// The layout the maps live in (SPEC §8) and its rest-surface map at width×height (the latter
-    /// set when any placement is a surface placement). Shared, immutable, cached per model.
-    std::shared_ptr<const TextureLayout> layout;
-    std::shared_ptr<const RestSurfaceMap> rest;
-};
-
 /// A frame's overrides of the scene (query parameters, --time, --size). Absent = the scene's.
 struct FrameOverrides {
     std::optional<double> time; ///< overrides pose.time

@@ -112,6 +112,7 @@ struct SurfaceFrame {
 float surfacePlacementHeight(const BakePlacement& p, glm::dvec3 position, glm::dvec3 normal);
 
 struct RestSurfaceMap; // texture_layout.hpp
+struct TextureLayout;  // texture_layout.hpp
 
 /// Texel rectangle of `rest` (clipped to the map) outside which surface placement `p` adds
 /// nothing: the union of the rest map's tiles whose bounds come within SurfaceFrame::reach of
@@ -123,6 +124,19 @@ bool surfaceTileNear(const SurfaceFrame& frame, const RestSurfaceMap& rest, std:
 
 struct HeightMaps {
     HeightImage bump, displacement;
+};
+
+/// What both height-map stages take: the CPU reference (bakeHeightMaps,
+/// frame_plan.hpp) and the GPU pass (gl/renderer.hpp).
+struct HeightMapInput {
+    std::vector<BakePlacement> placements; ///< document order; `pattern` points into live images
+    const HeightImage* base = nullptr;     ///< optional static bump map
+    std::uint64_t baseId = 0;              ///< its PatternImage::contentId (0 = unknown)
+    int width = 1024, height = 1024;
+    /// The layout the maps live in (SPEC §8) and its rest-surface map at width×height (the latter
+    /// set when any placement is a surface placement). Shared, immutable, cached per model.
+    std::shared_ptr<const TextureLayout> layout;
+    std::shared_ptr<const RestSurfaceMap> rest;
 };
 
 struct BakeSettings {

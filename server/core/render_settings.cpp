@@ -1,5 +1,7 @@
 #include "render_settings.hpp"
 
+#include "scene.hpp" // the document's bounds (kMaxTurnAngle, …)
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -14,6 +16,34 @@ std::string fmt(double d) {
 }
 
 } // namespace
+
+std::string_view toString(DisplacementMode m) {
+    return m == DisplacementMode::Tessellated ? "tessellated" : "vertex";
+}
+
+std::optional<DisplacementMode> displacementModeFromString(std::string_view s) {
+    if (s == "vertex") return DisplacementMode::Vertex;
+    if (s == "tessellated") return DisplacementMode::Tessellated;
+    return std::nullopt;
+}
+
+std::string_view toString(AntiAliasing a) {
+    switch (a) {
+    case AntiAliasing::Msaa: return "msaa";
+    case AntiAliasing::Post: return "post";
+    case AntiAliasing::None: return "none";
+    case AntiAliasing::Auto: break;
+    }
+    return "auto";
+}
+
+std::optional<AntiAliasing> antiAliasingFromString(std::string_view s) {
+    if (s == "auto") return AntiAliasing::Auto;
+    if (s == "msaa") return AntiAliasing::Msaa;
+    if (s == "post") return AntiAliasing::Post;
+    if (s == "none") return AntiAliasing::None;
+    return std::nullopt;
+}
 
 std::string_view toString(FrameView v) {
     switch (v) {

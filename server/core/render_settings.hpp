@@ -1,4 +1,5 @@
-// Dermis core — the one check of render settings (SPEC §2b "render"): every shell that changes
+// Dermis core — a frame's render settings (SPEC §2b "render": size, camera, displacement,
+// bump strength, anti-aliasing) and the one check of them: every shell that changes
 // them (scene documents, frame query parameters, the command line's --size, the renderer's own
 // entry) applies its overrides to a RenderSettings first and then calls this, so a range is
 // written once.
@@ -8,13 +9,51 @@
 #pragma once
 
 #include "result.hpp"
-#include "scene.hpp"
+
+#include <array>
 
 #include <optional>
 #include <string>
 #include <string_view>
 
 namespace dermis {
+
+/// Largest frame side a scene document, a query or the command line may ask for.
+constexpr int kMaxRenderSize = 8192;
+
+struct Camera {
+    double yaw = 0.0, pitch = 10.0;
+    std::optional<double> distance; ///< absent = "auto"
+    /// The world point looked at (and orbited about); absent = the centre of the posed bounds.
+    /// Set by a frame's `target` query parameter (the editor's pan, frame-selection and
+    /// orbit-about); not a member of the scene document.
+    std::optional<std::array<double, 3>> target;
+};
+
+enum class DisplacementMode { Vertex, Tessellated };
+std::string_view toString(DisplacementMode m);
+std::optional<DisplacementMode> displacementModeFromString(std::string_view s);
+
+/// How a frame is anti-aliased (`render.aa`). Auto: MSAA with `msaa` samples on a GPU, Post on a
+/// software rasterizer (Mesa llvmpipe / softpipe), where MSAA 4 costs 2–2.6× the skin pass;
+/// Msaa: always `msaa` samples (1 = none); Post: one full-screen edge pass (FXAA, shaders/
+/// fxaa.frag) over a 1-sample frame; None: 1 sample, no pass. resolveAntiAliasing
+/// (render_settings.hpp) is the one place Auto becomes a mode.
+enum class AntiAliasing { Auto, Msaa, Post, None };
+std::string_view toString(AntiAliasing a);
+std::optional<AntiAliasing> antiAliasingFromString(std::string_view s);
+
+struct RenderSettings {
+    std::array<int, 2> size{1024, 1024};
+    Camera camera;
+    std::optional<double> displacementScale; ///< absent = "auto"
+    double bumpStrength = 1.0;
+    int msaa = 4; ///< 1, 2 or 4: the samples when `aa` resolves to MSAA
+    AntiAliasing aa = AntiAliasing::Auto;
+    /// "vertex": displace the mesh's own vertices (the paper); "tessellated": subdivide each
+    /// triangle on the GPU first, so that bulges smaller than a triangle still move the surface.
+    DisplacementMode displacement = DisplacementMode::Vertex;
+};
 
 /// What a frame shows of the posed, displaced character (a frame's choice, like its camera
 /// overrides: not part of scene documents). Shaded is the picture; the others are unlit

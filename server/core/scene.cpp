@@ -1,6 +1,6 @@
 // Dermis core — serialisation of the scene document `dermis.scene/1` (SPEC §2b): toJson(Scene)
 // writes every field explicitly ("auto" where optional values are absent), so that parse →
-// serialise → parse → serialise is byte-stable; and the names of DisplacementMode and Projection.
+// serialise → parse → serialise is byte-stable; and the names of Projection.
 // Parsing is in scene_parse.cpp, the pattern manifest in scene_manifest.cpp, the shared JSON
 // reader and predicates in scene_json.hpp.
 #include "scene.hpp"
@@ -16,34 +16,6 @@
 namespace dermis {
 
 using namespace scene_detail;
-
-std::string_view toString(DisplacementMode m) {
-    return m == DisplacementMode::Tessellated ? "tessellated" : "vertex";
-}
-
-std::optional<DisplacementMode> displacementModeFromString(std::string_view s) {
-    if (s == "vertex") return DisplacementMode::Vertex;
-    if (s == "tessellated") return DisplacementMode::Tessellated;
-    return std::nullopt;
-}
-
-std::string_view toString(AntiAliasing a) {
-    switch (a) {
-    case AntiAliasing::Msaa: return "msaa";
-    case AntiAliasing::Post: return "post";
-    case AntiAliasing::None: return "none";
-    case AntiAliasing::Auto: break;
-    }
-    return "auto";
-}
-
-std::optional<AntiAliasing> antiAliasingFromString(std::string_view s) {
-    if (s == "auto") return AntiAliasing::Auto;
-    if (s == "msaa") return AntiAliasing::Msaa;
-    if (s == "post") return AntiAliasing::Post;
-    if (s == "none") return AntiAliasing::None;
-    return std::nullopt;
-}
 
 std::string_view toString(Projection p) { return p == Projection::Surface ? "surface" : "uv"; }
 

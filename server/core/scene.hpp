@@ -10,6 +10,7 @@
 
 #include "deform.hpp"
 #include "heightmap.hpp"
+#include "render_settings.hpp"
 #include "result.hpp"
 #include "texture_layout.hpp"
 
@@ -123,40 +124,6 @@ struct Pose {
     std::map<std::string, JointPose> joints;
 };
 
-struct Camera {
-    double yaw = 0.0, pitch = 10.0;
-    std::optional<double> distance; ///< absent = "auto"
-    /// The world point looked at (and orbited about); absent = the centre of the posed bounds.
-    /// Set by a frame's `target` query parameter (the editor's pan, frame-selection and
-    /// orbit-about); not a member of the scene document.
-    std::optional<std::array<double, 3>> target;
-};
-
-enum class DisplacementMode { Vertex, Tessellated };
-std::string_view toString(DisplacementMode m);
-std::optional<DisplacementMode> displacementModeFromString(std::string_view s);
-
-/// How a frame is anti-aliased (`render.aa`). Auto: MSAA with `msaa` samples on a GPU, Post on a
-/// software rasterizer (Mesa llvmpipe / softpipe), where MSAA 4 costs 2–2.6× the skin pass;
-/// Msaa: always `msaa` samples (1 = none); Post: one full-screen edge pass (FXAA, shaders/
-/// fxaa.frag) over a 1-sample frame; None: 1 sample, no pass. resolveAntiAliasing
-/// (render_settings.hpp) is the one place Auto becomes a mode.
-enum class AntiAliasing { Auto, Msaa, Post, None };
-std::string_view toString(AntiAliasing a);
-std::optional<AntiAliasing> antiAliasingFromString(std::string_view s);
-
-struct RenderSettings {
-    std::array<int, 2> size{1024, 1024};
-    Camera camera;
-    std::optional<double> displacementScale; ///< absent = "auto"
-    double bumpStrength = 1.0;
-    int msaa = 4; ///< 1, 2 or 4: the samples when `aa` resolves to MSAA
-    AntiAliasing aa = AntiAliasing::Auto;
-    /// "vertex": displace the mesh's own vertices (the paper); "tessellated": subdivide each
-    /// triangle on the GPU first, so that bulges smaller than a triangle still move the surface.
-    DisplacementMode displacement = DisplacementMode::Vertex;
-};
-
 struct Scene {
     std::string model = "builtin:default";
     UvLayoutMode uvLayout = UvLayoutMode::Auto; ///< SPEC §8 "Height-map layout"
@@ -167,8 +134,6 @@ struct Scene {
     Pose pose;
     RenderSettings render;
 };
-
-constexpr int kMaxRenderSize = 8192;
 
 /// Parses and validates a scene document. `manifest` supplies the built-in pattern ids (a
 /// placement's pattern must be a key of "patterns" or a built-in id) and the per-kind defaults of

@@ -1,9 +1,9 @@
 // Stage 2 of the renderer: frame targets, the skin pass (skinning, displacement, bump mapping,
 // shading under the camera of core/camera.hpp), readback, and transform-feedback skinning
 // (see renderer_impl.hpp).
-#include "gl/renderer_impl.hpp"
+#include "renderer_impl.hpp"
 
-#include "gl/uniform_blocks.hpp"
+#include "uniform_blocks.hpp"
 
 #include "core/camera.hpp"
 #include "core/edge_aa.hpp"

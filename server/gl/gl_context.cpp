@@ -1,5 +1,5 @@
 // Headless GL contexts: EGL device platform, Mesa's surfaceless EGL, OSMesa (dlopen).
-#include "gl/gl_context.hpp"
+#include "gl_context.hpp"
 
 #include <glad/gl.h>
 

@@ -1,7 +1,7 @@
 // The renderer's GPU cache: pattern/base textures and model uploads under one byte budget,
 // freed least recently used first, or at once when their content is deleted (see renderer.hpp,
 // "Caches"). Everything here runs on the render thread but publishCacheStats' copy.
-#include "gl/renderer_impl.hpp"
+#include "renderer_impl.hpp"
 
 #include <limits>
 

@@ -1,8 +1,8 @@
 // The renderer's model uploads: buffers and textures once per Model object, the joint palette
 // per job (see renderer_impl.hpp).
-#include "gl/renderer_impl.hpp"
+#include "renderer_impl.hpp"
 
-#include "gl/uniform_blocks.hpp"
+#include "uniform_blocks.hpp"
 
 #include "core/camera.hpp"
 

@@ -4,9 +4,9 @@
 // two RGB32F textures are cached like patterns), readback and upload of maps (see
 // renderer_impl.hpp). On a software rasterizer a pass covering many map
 // areas is baked by the CPU and uploaded (RendererOptions::softwareCpuBakeCoverage).
-#include "gl/renderer_impl.hpp"
+#include "renderer_impl.hpp"
 
-#include "gl/uniform_blocks.hpp"
+#include "uniform_blocks.hpp"
 
 #include "core/texture_layout.hpp"
 

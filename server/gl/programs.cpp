@@ -1,6 +1,6 @@
-#include "gl/programs.hpp"
+#include "programs.hpp"
 
-#include "gl/shader_sources.hpp"
+#include "shader_sources.hpp"
 
 #include <glad/gl.h>
 

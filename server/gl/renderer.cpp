@@ -1,9 +1,11 @@
 // The GPU renderer's façade: the render thread and its job queue, GL start-up and shutdown,
 // introspection. The stages live in gpu_model.cpp, height_pass.cpp and frame_pass.cpp.
-#include "gl/renderer_impl.hpp"
+#include "renderer_impl.hpp"
 
-#include "gl/programs.hpp"
-#include "gl/uniform_blocks.hpp"
+#include "core/frame_plan.hpp"
+
+#include "programs.hpp"
+#include "uniform_blocks.hpp"
 
 #include <algorithm>
 #include <cstdio>

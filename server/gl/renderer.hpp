@@ -33,14 +33,14 @@
 // failures (shader compile log, incomplete framebuffer).
 #pragma once
 
-#include "core/bake.hpp"
+// The renderer draws models and maps, never scene documents: it includes the render settings
+// (core/render_settings.hpp), not core/scene.hpp (LayersTest checks this).
 #include "core/camera.hpp"
-#include "core/frame_plan.hpp"
 #include "core/heightmap.hpp"
 #include "core/model.hpp"
+#include "core/render_settings.hpp"
 #include "core/result.hpp"
 #include "core/rig.hpp"
-#include "core/scene.hpp"
 #include "gl/gl_backend.hpp"
 
 #include <glm/glm.hpp>
@@ -53,6 +53,8 @@
 #include <vector>
 
 namespace dermis {
+
+struct FramePlan; // core/frame_plan.hpp
 
 struct RendererInfo {
     std::string backend;    ///< the backend that started: "egl-device", "egl-surfaceless", "osmesa"

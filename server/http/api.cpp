@@ -1,7 +1,7 @@
 // Dermis HTTP shell — the plumbing every route family shares: the error mapping, body and query
 // parsing, the route table, authentication (bearer token or session cookie), registration with
 // httplib and Api's own methods. The routes themselves live in api_<family>.cpp.
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 #include <cctype>
 #include <cerrno>

@@ -18,7 +18,7 @@
 //     pre-routing, 413, a multipart body httplib gave up on, …) closes the connection: what is
 //     left of the body is dropped, never parsed as the next request (request smuggling);
 //   * closeAll() (Api::stop) shuts every connection, so stopping never waits for a slow client.
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>

@@ -4,7 +4,7 @@
 // Retry-After). A stream ends when the scene is
 // deleted, the client goes away or the server stops. Credentials are checked when the stream
 // opens (bearer token or session cookie); ending a session does not close its open streams.
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 namespace dermis::api_detail {
 

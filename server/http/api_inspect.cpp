@@ -2,7 +2,7 @@
 // activation (each placement's t over a clip, with flags), lint, pick (a frame pixel or a texture
 // point), a placement's footprint outline in the texture view (SPEC §8) and drivers (each
 // placement's θ and t now).
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 #include <cmath>
 

@@ -1,6 +1,6 @@
 // Dermis HTTP shell — model routes: list, upload (.glb body, or a .gltf with its external files
 // as multipart parts), details, delete, UV layout (JSON or PNG), base-colour texture (PNG).
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 namespace dermis::api_detail {
 

@@ -1,5 +1,5 @@
 // Dermis HTTP shell — pattern routes: the manifest, custom image uploads, previews, delete.
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 namespace dermis::api_detail {
 

@@ -3,7 +3,7 @@
 // /render), whose frames stream as multipart/mixed parts as they finish (its scene may name
 // content by address, the bytes sent along as multipart/form-data: SPEC §7). Renders go through
 // the Service to the renderer's thread (a full queue answers 503 + Retry-After).
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 #include <set>
 

@@ -3,7 +3,7 @@
 // document, revert) and presence. Every edit answers {"id", "revision", "scene"} with
 // `ETag: "r<revision>"`, honours `If-Match` (412 stale_revision with the current revision) and
 // records `X-Dermis-Client`; a failed edit changes nothing (the Service validates first).
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 namespace dermis::api_detail {
 

@@ -7,7 +7,7 @@
 // Both routes are open (they need no credentials). The cookie is HttpOnly (no script reads it)
 // and SameSite=Strict (no other site's page sends it). It has no Secure attribute: the server
 // speaks plain HTTP (put TLS in front of it when it is reachable from elsewhere).
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 #include <sys/random.h>
 

@@ -1,7 +1,7 @@
 // Dermis HTTP shell — system routes: liveness (open), server info with the configured limits
 // (the Service's, plus the HTTP layer's own session limits), the OpenAPI document and the JSON
 // Schema of dermis.scene/1.
-#include "http/api_internal.hpp"
+#include "api_internal.hpp"
 
 namespace dermis::api_detail {
 

@@ -2,7 +2,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/image_io.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <algorithm>
 #include <filesystem>

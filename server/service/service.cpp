@@ -1,11 +1,11 @@
 // The service's life: opening (built-in content, stored uploads and scenes), info, and the
 // document checks every scene change goes through.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "io/atomic_file.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/image_io.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 #include "io/scene_files.hpp"
 
 #include <chrono>

@@ -2,9 +2,9 @@
 // patterns as "sha256:<hex>" so that any replica can serve it. What a replica lacks it lists in a
 // MissingContent error; the client sends those bytes along (multipart parts named by address),
 // which are checked, decoded by the role the document gives them and kept in the content cache.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <algorithm>
 

@@ -1,6 +1,6 @@
 // Live change events: per-scene subscriptions of typed events (the HTTP layer frames them as
 // server-sent events), bounded per reader.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include <chrono>
 

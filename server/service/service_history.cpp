@@ -1,7 +1,7 @@
 // Scene history (SPEC §6 History): revisions listed newest first, any revision read back,
 // revert as a new revision; and presence — what each person has selected, broadcast and kept
 // for kPresenceSeconds after the last refresh.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include <algorithm>
 #include <cmath>

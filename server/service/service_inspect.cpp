@@ -4,7 +4,7 @@
 // unlocked. Lint and the picks read the model's UV index, rest skin, symmetry plane and clip
 // ranges from its entry (State::derivedOf: built once per model, core ModelDerived), not new ones
 // per request.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/activation.hpp"
 #include "core/deform.hpp"

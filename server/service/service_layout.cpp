@@ -4,7 +4,7 @@
 // content in memory and <data>/cache/layouts), the rest-surface maps surface placements are
 // projected through (cached per model, layout and size in the model's ModelDerived), and the
 // layout route (`GET /models/{id}/uv-layout`).
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/layout_gen.hpp"
 #include "core/uv_diagnosis.hpp"

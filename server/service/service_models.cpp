@@ -1,13 +1,13 @@
 // Characters: upload (.glb, or .gltf with its files), list, describe, delete, UV layout,
 // base-colour texture.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/model_derived.hpp"
 #include "core/preview.hpp"
 #include "core/uv_diagnosis.hpp"
 #include "io/frame_io.hpp"
 #include "io/gltf_loader.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <algorithm>
 #include <cmath>

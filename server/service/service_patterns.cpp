@@ -1,11 +1,11 @@
 // Pattern images: built-in library and uploads; list, preview, delete.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/preview.hpp"
 #include "io/frame_io.hpp"
 #include "io/image_header.hpp"
 #include "io/image_io.hpp"
-#include "io/sha256.hpp"
+#include "common/sha256.hpp"
 
 #include <algorithm>
 

@@ -2,7 +2,7 @@
 // range-of-motion analysis (core proposePatterns, cached per model in ModelDerived::proposals),
 // and another scene's placements carried onto it (core transferPlacements); each answered as a
 // list and, with apply, added in one revision (op "propose" / "transfer from <scene>").
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/mirror.hpp"
 #include "core/propose.hpp"

@@ -1,6 +1,6 @@
 // Renders: frames of stored scenes, their height maps, and stateless batches. Each takes a
 // snapshot under the shared lock and plans and renders without any lock held.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/bake.hpp"
 #include "core/normalmap.hpp"

@@ -1,5 +1,5 @@
 // Scene documents and their edits: create, replace, delete; placements; pose.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/mirror.hpp"
 

@@ -2,7 +2,7 @@
 // as one cell of a labelled PNG contact sheet. Steps are planned by core/sweep on the frame's
 // snapshot (current document or a revision, patterns=off / only= applied); each cell is a frame
 // planned by planFrame with the step's pose, rendered by the one renderer.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/contact_sheet.hpp"
 #include "core/sweep.hpp"

@@ -2,7 +2,7 @@
 // (core footprintRegion on the frame's posed skin) — and the turntable — the placement's range of
 // motion as an animated WebP: its driver joint swept θmin → θmax → θmin (core jointSweep's poses)
 // while the camera's yaw turns once, each frame rendered by the one renderer.
-#include "service/service_state.hpp"
+#include "service_state.hpp"
 
 #include "core/focus.hpp"
 #include "core/model_derived.hpp"

@@ -46,7 +46,7 @@ public:
     /// A fresh id: `prefix` + "_" + 16 random hex digits.
     static std::string newId(const std::string& prefix);
     /// A content address: `prefix` + "_" + the first 16 hex digits of `digestHex` (a SHA-256 in
-    /// lower-case hex, io/sha256 toHex), so it has the shape of newId's ids.
+    /// lower-case hex, common/sha256 toHex), so it has the shape of newId's ids.
     static std::string contentId(const std::string& prefix, const std::string& digestHex);
     /// True for ids this store generates (prefix "m", "p" or "s").
     static bool isGeneratedId(const std::string& id, char prefix);

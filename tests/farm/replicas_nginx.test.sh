@@ -11,7 +11,7 @@
 # Usage: replicas_nginx.test.sh DERMIS_SERVER DERMIS_CLIENT SOURCE_DIR
 set -euo pipefail
 server_exe=$1 client_exe=$2 src=$3
-models=${DERMIS_TEST_MODELS:-$src/../shared/models}
+models=${DERMIS_TEST_MODELS:-$src/tests/models}
 tmp=$(mktemp -d)
 pids=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; wait 2>/dev/null || true; rm -rf "$tmp"; }

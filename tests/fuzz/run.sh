@@ -18,13 +18,13 @@ seconds="$2"
 shift 2
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(gltf_fuzz image_fuzz scene_fuzz)
-shared="${DERMIS_SHARED_DIR:-$here/../shared}"
-if [ ! -d "$shared/models" ]; then
-  echo "fuzz: $shared/models is missing (the glTF seeds come from it)" >&2
+models="${DERMIS_TEST_MODELS:-$here/tests/models}"
+if [ ! -d "$models" ]; then
+  echo "fuzz: $models is missing (the glTF seeds come from it)" >&2
   exit 1
 fi
 
-python3 "$here/tests/fuzz/seeds.py" "$here" "$shared/models" "$build/corpus" || exit 1
+python3 "$here/tests/fuzz/seeds.py" "$here" "$models" "$build/corpus" || exit 1
 mkdir -p "$build/artifacts" "$build/fuzz-logs"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}"
 export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$here/tests/lsan.supp}"

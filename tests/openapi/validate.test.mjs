@@ -220,7 +220,7 @@ try {
   await api("DELETE", "/session", { expect: 204 });
 
   // models: a .glb, a .gltf with its buffer as multipart parts, details, UV layout, delete
-  const glb = readFileSync(join(source, "../shared/models/RiggedFigure/RiggedFigure.glb"));
+  const glb = readFileSync(join(source, "tests/models/RiggedFigure/RiggedFigure.glb"));
   const uploaded = (await api("POST", "/models", { query: "name=RiggedFigure", body: { raw: glb, type: "model/gltf-binary" }, expect: 201 })).json();
   // Content-addressed (issue #14): the same bytes again answer 200 with the same id.
   const again = (await api("POST", "/models", { query: "name=copy", body: { raw: glb, type: "model/gltf-binary" }, expect: 200 })).json();

@@ -234,7 +234,7 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       assert.ok(!(await doc(sceneId)).scene.placements.some((p) => /_mirror$/.test(p.id)), "no _mirror ids");
     }],
     ["1600 px: the scene menu names models, a long name keeps the toolbar one row, a new scene's notice counts joints", async () => {
-      const glb = readFileSync(new URL("../../../shared/models/CesiumMan/CesiumMan.glb", import.meta.url));
+      const glb = readFileSync(new URL("../models/CesiumMan/CesiumMan.glb", import.meta.url));
       const longName = "CesiumMan_with_a_very_long_name_from_the_asset_library_v042_final_final";
       await page.evaluate(async ([bytes, name]) => {
         const dt = new DataTransfer();

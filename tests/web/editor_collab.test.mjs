@@ -113,7 +113,7 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       assert.match(download.suggestedFilename(), /^s_[0-9a-f]+-r\d+\.scene\.json$/);
     }],
     ["dropping a .glb makes a new scene on that model", async () => {
-      const glb = readFileSync(new URL("../../../shared/models/CesiumMan/CesiumMan.glb", import.meta.url));
+      const glb = readFileSync(new URL("../models/CesiumMan/CesiumMan.glb", import.meta.url));
       await a.evaluate(async (bytes) => {
         const dt = new DataTransfer();
         dt.items.add(new File([new Uint8Array(bytes)], "CesiumMan.glb", { type: "model/gltf-binary" }));

@@ -25,8 +25,8 @@ import { fileURLToPath } from "node:url";
 import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, settled, settledFrameHash } from "./editor_lib.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
-const shared = process.env.DERMIS_SHARED_DIR || join(here, "../../../shared");
-const cesium = join(shared, "models/CesiumMan/CesiumMan.glb");
+const testModels = process.env.DERMIS_TEST_MODELS || join(here, "../models");
+const cesium = join(testModels, "CesiumMan/CesiumMan.glb");
 assert.ok(existsSync(cesium), `CesiumMan at ${cesium}`);
 
 const server = await startServer(process.argv[2], [], "dermis-editor-propose-");

@@ -19,7 +19,7 @@ import { fileURLToPath } from "node:url";
 import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, sleep, settledFrameHash } from "./editor_lib.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
-const barbarian = join(here, "../../../shared/models/KayKitBarbarian/Barbarian.glb");
+const barbarian = join(here, "../models/KayKitBarbarian/Barbarian.glb");
 
 const server = await startServer(process.argv[2], [], "dermis-editor-surface-");
 const api = apiClient(server.base);

@@ -14,7 +14,7 @@
 // triangle always is) and packing returns false only when nothing fits at any density.
 #pragma once
 
-#include "layout_gen.hpp"
+#include "core/layout_gen.hpp"
 
 #include <glm/glm.hpp>
 

@@ -18,7 +18,8 @@
 
 #include "core/camera.hpp"
 #include "core/render_settings.hpp"
-#include "gl/gl_context.hpp"
+#include "core/texture_layout.hpp"
+#include "gl_context.hpp"
 #include "gl/renderer.hpp"
 
 #include <glad/gl.h>

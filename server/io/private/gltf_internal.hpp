@@ -22,8 +22,8 @@
 #define TINYGLTF_NO_FS
 #include <tiny_gltf.h>
 
-#include "gltf_loader.hpp"
-#include "image_header.hpp"
+#include "io/gltf_loader.hpp"
+#include "io/image_header.hpp"
 
 #include "core/result.hpp"
 
