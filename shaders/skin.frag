@@ -3,10 +3,15 @@
 // screen-space derivatives), base colour, simple lighting. Writes linear colour; the sRGB render
 // target encodes it.
 //
-// Views (u_part.w, FrameView in server/core/render_settings.hpp): 0 shaded; unlit pictures of the
-// maps on the surface for authoring: 1 bump / 2 displacement height as grey byte 128 + 127·height
-// (clamped to [−1, 1]), 3 the perturbed world normal as bytes 255·(n·0.5 + 0.5). Those are
-// picture values: written through the sRGB EOTF so that the target's encoding gives them back.
+// Views (DERMIS_VIEW, FrameView in server/core/render_settings.hpp; one program per view, so that a
+// software rasterizer, which runs every branch for every pixel, shades only its view's code):
+// 0 shaded; unlit pictures of the maps on the surface for authoring: 1 bump / 2 displacement
+// height as grey byte 128 + 127·height (clamped to [−1, 1]), 3 the perturbed world normal as bytes
+// 255·(n·0.5 + 0.5). Those are picture values: written through the sRGB EOTF so that the
+// target's encoding gives them back.
+#ifndef DERMIS_VIEW
+#define DERMIS_VIEW 0
+#endif
 //
 // Outlines (OutlineBlock, common.glsl): footprint rectangles in the height maps' UV space, surface
 // decals' rectangles and the surface brush's circle on the rest surface, drawn over any view as a
@@ -115,17 +120,13 @@ void main() {
     if (dot(n, toCamera) < 0.0) n = -n; // two-sided: back faces are lit like front faces
     if (u_part.z != 0) n = perturbedNormal(n);
 
-    if (u_part.w == 1 || u_part.w == 2) { // bump or displacement height as grey
-        vec2 heights = u_part.z != 0 ? textureLod(u_heightMap, v_mapUv, 0.0).rg : vec2(0.0);
-        float height = clamp(u_part.w == 1 ? heights.r : heights.g, -1.0, 1.0);
-        o_color = vec4(outlined(pictureValue(vec3((128.0 + 127.0 * height) / 255.0))), 1.0);
-        return;
-    }
-    if (u_part.w == 3) { // the perturbed world normal
-        o_color = vec4(outlined(pictureValue(n * 0.5 + 0.5)), 1.0);
-        return;
-    }
-
+#if DERMIS_VIEW == 1 || DERMIS_VIEW == 2 // bump or displacement height as grey
+    vec2 heights = u_part.z != 0 ? textureLod(u_heightMap, v_mapUv, 0.0).rg : vec2(0.0);
+    float height = clamp(DERMIS_VIEW == 1 ? heights.r : heights.g, -1.0, 1.0);
+    o_color = vec4(outlined(pictureValue(vec3((128.0 + 127.0 * height) / 255.0))), 1.0);
+#elif DERMIS_VIEW == 3 // the perturbed world normal
+    o_color = vec4(outlined(pictureValue(n * 0.5 + 0.5)), 1.0);
+#else
     vec4 base = u_baseColor;
     if (u_part.y != 0) base *= texture(u_baseColorTexture, v_uv);
 
@@ -136,4 +137,5 @@ void main() {
     float specular = pow(max(dot(n, h), 0.0), 48.0) * 0.15 * step(0.0, dot(n, l));
     vec3 color = base.rgb * (0.85 * diffuse + u_lightDir.w * fill) + vec3(specular);
     o_color = vec4(outlined(color), 1.0);
+#endif
 }

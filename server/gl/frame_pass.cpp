@@ -151,8 +151,10 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
     uploadOutlineBlock(req.outlines);
     const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view);
+    auto program = skinProgramFor(rs.displacement == DisplacementMode::Tessellated, req.view);
+    if (!program) return program.error();
     const GLuint readFbo =
-        drawSkinPass(model, **gm, **parts, rs, heightSource->texture, partStride, samples);
+        drawSkinPass(model, **gm, **parts, rs, *program, heightSource->texture, partStride, samples);
     if (auto s = checkGl("skin pass"); !s) return s.error();
     if (req.profile) glFinish();
     out.timings.skinMs = msSince(t0);
@@ -228,7 +230,8 @@ void Renderer::Impl::uploadOutlineBlock(const std::vector<FrameOutline>& outline
 }
 
 /// One PartBlock per part in partUbo (bound by range per draw), each with the frame's view in
-/// part.w (shaders/skin.frag); returns the stride.
+/// part.w (informative: skin.frag's program variant, DERMIS_VIEW, draws the view); returns the
+/// stride.
 std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm,
                                              const std::vector<GpuModel::Part>& parts, FrameView view) {
     const std::size_t stride = uboStride(sizeof(PartBlock));
@@ -253,8 +256,8 @@ std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel&
 /// Draws every part into the frame targets and resolves MSAA; returns the framebuffer to read.
 GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
                                     const std::vector<GpuModel::Part>& parts,
-                                    const RenderSettings& rs, GLuint heightTexture,
-                                    std::size_t partStride, int samples) {
+                                    const RenderSettings& rs, GLuint skinProgram,
+                                    GLuint heightTexture, std::size_t partStride, int samples) {
     const int W = frame.width, H = frame.height;
     glBindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
     glViewport(0, 0, W, H);
@@ -270,7 +273,7 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
     glClearBufferfv(GL_COLOR, 0, background);
     glClearBufferfv(GL_DEPTH, 0, &one);
     const bool tess = rs.displacement == DisplacementMode::Tessellated;
-    glUseProgram(tess ? skinTessProgram : skinProgram);
+    glUseProgram(skinProgram);
     if (tess) glPatchParameteri(GL_PATCH_VERTICES, 3);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, heightTexture);

@@ -116,11 +116,6 @@ Status Renderer::Impl::buildPrograms() {
         {&heightSurfaceProgram,
          {{{GL_VERTEX_SHADER, "heightpass.vert"}, {GL_FRAGMENT_SHADER, "heightpass.frag"}}, {"DERMIS_SURFACE"}, {}}},
         {&heightBaseProgram, {{{GL_VERTEX_SHADER, "fullscreen.vert"}, {GL_FRAGMENT_SHADER, "heightbase.frag"}}, {}, {}}},
-        {&skinProgram, {{{GL_VERTEX_SHADER, "skin.vert"}, {GL_FRAGMENT_SHADER, "skin.frag"}}, {}, {}}},
-        {&skinTessProgram,
-         {{{GL_VERTEX_SHADER, "skin.vert"}, {GL_TESS_CONTROL_SHADER, "skin.tesc"},
-           {GL_TESS_EVALUATION_SHADER, "skin.tese"}, {GL_FRAGMENT_SHADER, "skin.frag"}},
-          {"DERMIS_TESSELLATED"}, {}}},
         {&captureProgram,
          {{{GL_VERTEX_SHADER, "skin.vert"}}, {"DERMIS_CAPTURE"}, {"v_position", "v_normal"}}},
     };
@@ -129,7 +124,28 @@ Status Renderer::Impl::buildPrograms() {
         if (!p) return p.error();
         *b.out = *p;
     }
+    for (bool tess : {false, true})
+        for (FrameView view : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal})
+            if (auto p = skinProgramFor(tess, view); !p) return p.error();
     return Ok{};
+}
+
+Result<GLuint> Renderer::Impl::skinProgramFor(bool tess, FrameView view) {
+    GLuint& slot = skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
+    if (slot) return slot;
+    ProgramDesc desc;
+    desc.stages = {{GL_VERTEX_SHADER, "skin.vert"}};
+    if (tess) {
+        desc.stages.push_back({GL_TESS_CONTROL_SHADER, "skin.tesc"});
+        desc.stages.push_back({GL_TESS_EVALUATION_SHADER, "skin.tese"});
+        desc.defines.push_back("DERMIS_TESSELLATED");
+    }
+    desc.stages.push_back({GL_FRAGMENT_SHADER, "skin.frag"});
+    desc.defines.push_back("DERMIS_VIEW " + std::to_string(static_cast<int>(view)));
+    auto p = buildProgram(desc);
+    if (!p) return p.error();
+    slot = *p;
+    return slot;
 }
 
 /// The vertex array, buffers and 1×1 textures every job shares.
@@ -169,9 +185,13 @@ void Renderer::Impl::shutdown() {
     dropPatternTextures();
     heights.destroy();
     frame.destroy();
-    for (GLuint p : {heightProgram, heightSurfaceProgram, heightBaseProgram, skinProgram, skinTessProgram,
-                     captureProgram})
+    for (GLuint p : {heightProgram, heightSurfaceProgram, heightBaseProgram, captureProgram})
         glDeleteProgram(p);
+    for (auto& byView : skinPrograms)
+        for (GLuint& p : byView) {
+            glDeleteProgram(p);
+            p = 0;
+        }
     GLuint bufs[6] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer, outlineUbo};
     glDeleteBuffers(6, bufs);
     glDeleteVertexArrays(1, &emptyVao);
@@ -182,7 +202,7 @@ void Renderer::Impl::shutdown() {
 }
 
 Result<Renderer::BlockLayout> Renderer::Impl::blockLayout(const std::string& block) {
-    GLuint program = block == "HeightPassBlock" ? heightProgram : skinTessProgram;
+    GLuint program = block == "HeightPassBlock" ? heightProgram : skinPrograms[1][0];
     const GLuint index = glGetUniformBlockIndex(program, block.c_str());
     if (index == GL_INVALID_INDEX)
         return makeError(ErrorCode::NotFound, kWhere, block, "no such uniform block");

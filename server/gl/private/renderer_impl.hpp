@@ -207,8 +207,15 @@ struct Renderer::Impl {
     // --- render-thread state ----------------------------------------------------------------------
     std::unique_ptr<gl::GlContext> context;
     RendererInfo info;
-    GLuint heightProgram = 0, heightSurfaceProgram = 0, heightBaseProgram = 0, skinProgram = 0,
-           skinTessProgram = 0, captureProgram = 0;
+    GLuint heightProgram = 0, heightSurfaceProgram = 0, heightBaseProgram = 0, captureProgram = 0;
+    /// The skin pass by [tessellated][FrameView]: skin.frag with DERMIS_VIEW = the view, so that a
+    /// software rasterizer, which runs every branch for every pixel, does not shade the unlit
+    /// views' code in a shaded frame (1024² skin pass on llvmpipe: 19 → 12 ms). All eight are
+    /// built at start (buildPrograms), none during a frame: with Mesa 22.3's llvmpipe, a program
+    /// linked from Mesa's on-disk shader cache between a frame's uniform uploads and its draw made
+    /// the draw read out of bounds (ASan: SEGV / heap-buffer-overflow in swrast_dri under
+    /// glDrawElements, InspectHttpTest with the cache warm).
+    GLuint skinPrograms[2][4] = {};
     GLuint emptyVao = 0, heightUbo = 0, frameUbo = 0, partUbo = 0, paletteSsbo = 0,
            feedbackBuffer = 0, outlineUbo = 0;
     GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
@@ -240,6 +247,9 @@ struct Renderer::Impl {
     Status init(GlBackend backend);
     void readDriverInfo();
     Status buildPrograms();
+    /// The skin program for `tess` and `view` (built by buildPrograms; builds it if not); fails
+    /// with the GL's log.
+    Result<GLuint> skinProgramFor(bool tess, FrameView view);
     void createSharedObjects();
     void shutdown();
     void dropPatternTextures(); ///< pattern and base textures, and what the targets were from
@@ -298,7 +308,7 @@ struct Renderer::Impl {
                                  const std::vector<gl::GpuModel::Part>& parts, FrameView view);
     GLuint drawSkinPass(const Model& model, const gl::GpuModel& gm,
                         const std::vector<gl::GpuModel::Part>& parts, const RenderSettings& rs,
-                        GLuint heightTexture, std::size_t partStride, int samples);
+                        GLuint skinProgram, GLuint heightTexture, std::size_t partStride, int samples);
     Status readFrame(GLuint readFbo, Image8& image);
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
                                                const std::vector<glm::mat4>& world);
