@@ -27,6 +27,13 @@ build: deps $(BUILD)/CMakeCache.txt
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# The container for real (root; not part of `make test`): builds docker/Dockerfile with buildah on
+# a debootstrapped debian:12, runs the server from the image and renders a frame
+# (tests/docker/image_test.sh, docs/container.md).
+.PHONY: test-image
+test-image:
+	bash tests/docker/image_test.sh
+
 # Same tests under AddressSanitizer + UndefinedBehaviorSanitizer.
 test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Debug -DDERMIS_SANITIZE=ON -DDERMIS_BUILD_BENCHMARKS=OFF
