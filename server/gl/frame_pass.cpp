@@ -151,10 +151,9 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
     uploadOutlineBlock(req.outlines);
     const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view);
-    auto program = skinProgramFor(rs.displacement == DisplacementMode::Tessellated, req.view);
-    if (!program) return program.error();
+    const GLuint program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view);
     const GLuint readFbo =
-        drawSkinPass(model, **gm, **parts, rs, *program, heightSource->texture, partStride, samples);
+        drawSkinPass(model, **gm, **parts, rs, program, heightSource->texture, partStride, samples);
     if (auto s = checkGl("skin pass"); !s) return s.error();
     if (req.profile) glFinish();
     out.timings.skinMs = msSince(t0);

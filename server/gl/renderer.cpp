@@ -126,13 +126,12 @@ Status Renderer::Impl::buildPrograms() {
     }
     for (bool tess : {false, true})
         for (FrameView view : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal})
-            if (auto p = skinProgramFor(tess, view); !p) return p.error();
+            if (auto p = buildSkinProgram(tess, view); !p) return p.error();
+            else skinPrograms[tess ? 1 : 0][static_cast<int>(view)] = *p;
     return Ok{};
 }
 
-Result<GLuint> Renderer::Impl::skinProgramFor(bool tess, FrameView view) {
-    GLuint& slot = skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
-    if (slot) return slot;
+Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view) {
     ProgramDesc desc;
     desc.stages = {{GL_VERTEX_SHADER, "skin.vert"}};
     if (tess) {
@@ -142,10 +141,7 @@ Result<GLuint> Renderer::Impl::skinProgramFor(bool tess, FrameView view) {
     }
     desc.stages.push_back({GL_FRAGMENT_SHADER, "skin.frag"});
     desc.defines.push_back("DERMIS_VIEW " + std::to_string(static_cast<int>(view)));
-    auto p = buildProgram(desc);
-    if (!p) return p.error();
-    slot = *p;
-    return slot;
+    return buildProgram(desc);
 }
 
 /// The vertex array, buffers and 1×1 textures every job shares.

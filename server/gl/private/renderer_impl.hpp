@@ -247,9 +247,13 @@ struct Renderer::Impl {
     Status init(GlBackend backend);
     void readDriverInfo();
     Status buildPrograms();
-    /// The skin program for `tess` and `view` (built by buildPrograms; builds it if not); fails
-    /// with the GL's log.
-    Result<GLuint> skinProgramFor(bool tess, FrameView view);
+    /// Links skin.vert/.frag (+ the tessellation stages when `tess`) with DERMIS_VIEW = `view`;
+    /// fails with the GL's log. Only buildPrograms calls it (never during a frame).
+    Result<GLuint> buildSkinProgram(bool tess, FrameView view);
+    /// The skin program of a frame (built at start by buildPrograms).
+    GLuint skinProgram(bool tess, FrameView view) const {
+        return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
+    }
     void createSharedObjects();
     void shutdown();
     void dropPatternTextures(); ///< pattern and base textures, and what the targets were from
