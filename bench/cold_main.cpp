@@ -8,6 +8,7 @@
 //   dermis-coldbench [--repeat N] [--server PATH] [--gl B]    → JSON on stdout: {"cold": {...}}
 //
 // Fails (exit 1, message on stderr) when a command exits non-zero.
+#include "BuildPaths.hpp"
 #include <nlohmann/json.hpp>
 
 #include <sys/resource.h>
@@ -102,7 +103,7 @@ nlohmann::json measure(const std::vector<std::string>& argv, int repeat, double 
 
 int main(int argc, char** argv) {
     int repeat = 5;
-    std::string server = DERMIS_SERVER_EXE, gl = "egl-surfaceless";
+    std::string server = dermis::build::serverExe(), gl = "egl-surfaceless";
     for (int k = 1; k < argc; ++k) {
         const std::string a = argv[k];
         if (a == "--repeat" && k + 1 < argc) repeat = std::max(1, std::atoi(argv[++k]));
@@ -113,7 +114,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    const std::string source = DERMIS_SOURCE_DIR;
+    const std::string source = dermis::build::sourceDir();
     const std::filesystem::path out =
         std::filesystem::temp_directory_path() / ("dermis-coldbench-" + std::to_string(getpid()));
     std::filesystem::create_directories(out);

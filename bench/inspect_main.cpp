@@ -16,6 +16,7 @@
 // first call builds the UV diagnosis (its uv_overlap); the model's details then read it. Mirror adds a placement (a durable edit, fsync included);
 // the twin is deleted again after each (`delete_placement`: that durable edit alone) so the
 // scene stays the same.
+#include "BuildPaths.hpp"
 #include "bench_common.hpp"
 
 #include "core/mirror.hpp"
@@ -259,7 +260,7 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> cases; // label, path ("" = built-in)
     if (models.empty()) {
         cases.emplace_back("builtin:default", "");
-        const std::string models = DERMIS_TEST_MODELS;
+        const std::string models = dermis::build::testModelsDir();
         for (auto [label, rel] :
              {std::pair{"CesiumMan", "/CesiumMan/CesiumMan.glb"},
               std::pair{"KayKitBarbarian", "/KayKitBarbarian/Barbarian.glb"}})

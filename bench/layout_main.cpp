@@ -14,6 +14,7 @@
 // nearer to what an idle one takes), charts, splits, degenerate triangles, texel density, and the
 // layout's check at 1024² (used fraction of [0,1]², overlapping texels, smallest gutter, area
 // stretch and conformal distortion, chart density spread). Single-threaded, like the generator.
+#include "BuildPaths.hpp"
 #include "core/layout_gen.hpp"
 #include "core/subdivide.hpp"
 #include "io/frame_io.hpp"
@@ -194,7 +195,7 @@ int main(int argc, char** argv) {
             results.push_back(benchModel(levels ? p + " ×" + std::to_string(1 << (2 * levels)) : p,
                                          subdivided(load(p), levels), repeat));
     } else {
-        const std::string shared = std::string(DERMIS_TEST_MODELS) + "/";
+        const std::string shared = std::string(dermis::build::testModelsDir()) + "/";
         const std::vector<std::pair<std::string, std::string>> models = {
             {"default", resolveModelPath("builtin:default", "", dermisContentDir())},
             {"CesiumMan", shared + "CesiumMan/CesiumMan.glb"},

@@ -8,6 +8,7 @@
 //
 // Single-threaded, like the server's analysis (built once per model, on the first propose or
 // pick). Wall time and the thread's CPU time (nearer an idle machine's on a busy one).
+#include "BuildPaths.hpp"
 #include "core/body_map.hpp"
 #include "core/model_derived.hpp"
 #include "core/motion.hpp"
@@ -59,7 +60,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    const std::string testModels = DERMIS_TEST_MODELS;
+    const std::string testModels = dermis::build::testModelsDir();
     auto source = loadSceneFile(dermisContentDir() + "/models/default.scene.json");
     if (!source) {
         std::cerr << source.error().message << "\n";

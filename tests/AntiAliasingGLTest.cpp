@@ -2,11 +2,12 @@
 // device where there is one): what `auto` resolves to on this GL, a reference frame of the
 // default character per mode (MSAA 4x, post-process, none), and each mode measured by SSIM
 // against a supersampled frame and against MSAA 4x (printed as JSON; post must beat none).
+#include "BuildPaths.hpp"
+#include "ImageCompare.hpp"
+#include "SceneFrame.hpp"
 #include "core/image_similarity.hpp"
 #include "gl/renderer.hpp"
 #include "io/scene_files.hpp"
-#include "ImageCompare.hpp"
-#include "SceneFrame.hpp"
 
 #include "RendererSuite.hpp"
 
@@ -19,7 +20,7 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
+const std::string kSource = dermis::build::sourceDir();
 
 class AntiAliasingGLTest : public RendererSuite {
 protected:

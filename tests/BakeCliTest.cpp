@@ -1,10 +1,11 @@
 // BakeCliTest — `dermis-server bake` end to end on a character from tests/models: the EXR
 // maps equal the in-process CPU reference, are non-zero exactly inside the footprints, and bad
 // scenes exit non-zero with the offending field on stderr. Needs the built dermis-server.
+#include "BuildPaths.hpp"
+#include "TestFiles.hpp"
 #include "core/bake.hpp"
 #include "io/image_io.hpp"
 #include "io/scene_files.hpp"
-#include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -18,9 +19,10 @@ using nlohmann::json;
 
 namespace {
 
-const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
+const std::string kCesium =
+    std::string(dermis::build::testModelsDir()) + "/CesiumMan/CesiumMan.glb";
 const std::string kRigged =
-    std::string(DERMIS_TEST_MODELS) + "/RiggedFigure/RiggedFigure.glb";
+    std::string(dermis::build::testModelsDir()) + "/RiggedFigure/RiggedFigure.glb";
 const char* kJoint = "Skeleton_torso_joint_2";
 
 

@@ -6,6 +6,7 @@
 // the same SHA-256 count; a small cache forgets (LRU) and frees the GPU copies; stored scenes never
 // name content by address; a cached model keeps its rest-surface map across batches. Plus
 // ContentCache itself.
+#include "BuildPaths.hpp"
 #include "ServiceFixture.hpp"
 
 #include "common/sha256.hpp"
@@ -24,7 +25,8 @@ class BatchContentTest : public ServiceFixture {
 protected:
     void SetUp() override {
         ServiceFixture::SetUp();
-        model_ = readBytes(std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb");
+        model_ =
+            readBytes(std::string(dermis::build::testModelsDir()) + "/CesiumMan/CesiumMan.glb");
         ASSERT_FALSE(model_.empty());
         pattern_ = patternPng(32, 32);
     }

@@ -7,6 +7,7 @@
 //   * `dermis frame` given a redirect (with a PNG body), a 2-byte image/png, a PNG under the wrong
 //     content type, 2 MB of headers before a 2-byte body, a 200 that breaks off: exit 1 or 3 and
 //     no file, no part file (before: each became f.png, exit 0); a real PNG is written (exit 0).
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
@@ -34,7 +35,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-const std::string kClient = DERMIS_CLIENT_EXE;
+const std::string kClient = dermis::build::clientExe();
 
 bool sendAll(int s, const std::string& bytes) {
     std::size_t done = 0;

@@ -12,6 +12,7 @@
 //     failure when a placement is moved, and --update fixes it;
 //   * the progress line ('\r', frames/s) appears under a pseudo-terminal (script from util-linux)
 //     and not when stdout is a file.
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
@@ -36,9 +37,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kClient = DERMIS_CLIENT_EXE;
-const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kRiggedFigure = std::string(DERMIS_TEST_MODELS) + "/RiggedFigure/RiggedFigure.glb";
+const std::string kClient = dermis::build::clientExe();
+const std::string kSource = dermis::build::sourceDir();
+const std::string kRiggedFigure =
+    std::string(dermis::build::testModelsDir()) + "/RiggedFigure/RiggedFigure.glb";
 
 std::string backend() {
     const char* env = std::getenv("DERMIS_TEST_GL");
@@ -71,11 +73,13 @@ public:
             const std::string data = dir + "/data", gl = backend();
             ::unsetenv("DERMIS_TOKEN");
             if (token.empty())
-                ::execl(DERMIS_SERVER_EXE, DERMIS_SERVER_EXE, "serve", "--port", "0", "--data", data.c_str(), "--gl", gl.c_str(),
+                ::execl(dermis::build::serverExe(), dermis::build::serverExe(), "serve", "--port",
+                        "0", "--data", data.c_str(), "--gl", gl.c_str(),
                         static_cast<char*>(nullptr));
             else
-                ::execl(DERMIS_SERVER_EXE, DERMIS_SERVER_EXE, "serve", "--port", "0", "--data", data.c_str(), "--gl", gl.c_str(),
-                        "--token", token.c_str(), static_cast<char*>(nullptr));
+                ::execl(dermis::build::serverExe(), dermis::build::serverExe(), "serve", "--port",
+                        "0", "--data", data.c_str(), "--gl", gl.c_str(), "--token", token.c_str(),
+                        static_cast<char*>(nullptr));
             ::_exit(127);
         }
         for (int i = 0; i < 600 && port_ == 0; ++i) {

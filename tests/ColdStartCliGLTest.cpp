@@ -3,6 +3,7 @@
 // single-frame renders at the same times; PNG and JPEG work without the OpenImageIO module
 // (patterns, textures and frames go through libpng / libjpeg-turbo); EXR without the module is a
 // clear error naming it; `--help` needs neither GL nor the module.
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
@@ -16,7 +17,7 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
+const std::string kSource = dermis::build::sourceDir();
 const std::string kDefaultScene = kSource + "/models/default.scene.json";
 const std::string kCesium = kSource + "/examples/cesiumman.scene.json";
 
@@ -55,9 +56,9 @@ TEST(ColdStartCliGLTest, PngAndJpegNeedNoImageModule) {
     // CesiumMan: a glTF with a texture, PNG patterns; frames as PNG and JPEG.
     const std::string env = "DERMIS_OIIO_MODULE=/nonexistent/libdermis_oiio.so ";
     for (const char* out : {"c.png", "c.jpg"}) {
-        const std::string cmd = env + DERMIS_SERVER_EXE + " render --scene " + kCesium + " --out " +
-                                (dir / out) + " --size 128x128" + gl() + " >/dev/null 2>" +
-                                (dir / "err.txt");
+        const std::string cmd = env + dermis::build::serverExe() + " render --scene " + kCesium +
+                                " --out " + (dir / out) + " --size 128x128" + gl() +
+                                " >/dev/null 2>" + (dir / "err.txt");
         EXPECT_EQ(std::system(cmd.c_str()), 0) << out << ": " << readText(dir / "err.txt");
         EXPECT_GT(readBytes(dir / out).size(), 100u) << out;
     }
@@ -66,9 +67,9 @@ TEST(ColdStartCliGLTest, PngAndJpegNeedNoImageModule) {
 TEST(ColdStartCliGLTest, ExrWithoutTheModuleIsAClearError) {
     TempDir dir;
     const std::string cmd = std::string("DERMIS_OIIO_MODULE=/nonexistent/libdermis_oiio.so ") +
-                            DERMIS_SERVER_EXE + " render --scene " + kDefaultScene + " --out " +
-                            (dir / "f.exr") + " --size 64x64" + gl() + " >/dev/null 2>" +
-                            (dir / "err.txt");
+                            dermis::build::serverExe() + " render --scene " + kDefaultScene +
+                            " --out " + (dir / "f.exr") + " --size 64x64" + gl() +
+                            " >/dev/null 2>" + (dir / "err.txt");
     const int status = std::system(cmd.c_str());
     EXPECT_EQ(WEXITSTATUS(status), 1);
     const std::string err = readText(dir / "err.txt");
@@ -80,7 +81,7 @@ TEST(ColdStartCliGLTest, ExrWithoutTheModuleIsAClearError) {
 TEST(ColdStartCliGLTest, HelpNeedsNeitherGlNorTheModule) {
     TempDir dir;
     const std::string cmd = std::string("DERMIS_OIIO_MODULE=/nonexistent ") +
-                            DERMIS_SERVER_EXE + " --help >" + (dir / "out.txt") + " 2>&1";
+                            dermis::build::serverExe() + " --help >" + (dir / "out.txt") + " 2>&1";
     EXPECT_EQ(std::system(cmd.c_str()), 0);
     EXPECT_NE(readText(dir / "out.txt").find("render"), std::string::npos);
 }

@@ -4,6 +4,7 @@
 // the committed files bit for bit and the Khronos glTF validator finds no error in them.
 // Runs the generator and `node tests/gltf-validator/validate.mjs` as subprocesses; the validator
 // needs `npm ci --prefix tests/gltf-validator` once (node_modules is not committed).
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 
 #include "core/model.hpp"
@@ -23,16 +24,12 @@
 #include <string>
 #include <vector>
 
-#ifndef DERMIS_CHARACTERGEN_EXE
-#error "DERMIS_CHARACTERGEN_EXE must name the dermis-charactergen executable (tests/CMakeLists.txt)"
-#endif
-
 namespace dermis {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kModelDir = std::string(DERMIS_SOURCE_DIR) + "/models";
+const std::string kModelDir = std::string(dermis::build::sourceDir()) + "/models";
 const std::string kGlb = kModelDir + "/default.glb";
 const std::string kCharts = kModelDir + "/default.charts.json";
 
@@ -471,8 +468,8 @@ TEST_F(DefaultCharacterTest, ForearmTwistAvoidsCandyWrapper) {
 
 TEST_F(DefaultCharacterTest, GeneratorReproducesTheCommittedFiles) {
     test::TempDir dir;
-    const std::string cmd =
-        std::string("\"") + DERMIS_CHARACTERGEN_EXE + "\" --quiet --out \"" + dir.str() + "\"";
+    const std::string cmd = std::string("\"") + dermis::build::charactergenExe() +
+                            "\" --quiet --out \"" + dir.str() + "\"";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
     for (const char* name : {"default.glb", "default.charts.json"}) {
         const auto fresh = test::readBytes(dir / name);
@@ -485,7 +482,8 @@ TEST_F(DefaultCharacterTest, GeneratorReproducesTheCommittedFiles) {
 }
 
 TEST_F(DefaultCharacterTest, KhronosValidatorReportsNoErrors) {
-    const std::string validatorDir = std::string(DERMIS_SOURCE_DIR) + "/tests/gltf-validator";
+    const std::string validatorDir =
+        std::string(dermis::build::sourceDir()) + "/tests/gltf-validator";
     ASSERT_TRUE(fs::exists(validatorDir + "/node_modules/gltf-validator"))
         << "the Khronos glTF validator is not installed: run `npm ci --prefix " << validatorDir
         << "`";

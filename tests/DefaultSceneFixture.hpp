@@ -4,6 +4,7 @@
 // failure fails SetUp). Read only: tests copy the scene before changing it.
 #pragma once
 
+#include "BuildPaths.hpp"
 #include "io/scene_files.hpp"
 
 #include <gtest/gtest.h>
@@ -12,7 +13,8 @@
 
 namespace dermis::test {
 
-inline const std::string kDefaultScene = std::string(DERMIS_SOURCE_DIR) + "/models/default.scene.json";
+inline const std::string kDefaultScene =
+    std::string(dermis::build::sourceDir()) + "/models/default.scene.json";
 
 class DefaultSceneTest : public ::testing::Test {
 protected:

@@ -2,6 +2,7 @@
 // character: it validates as a scene, places every built-in pattern, and at the key frames of
 // each clip its CPU height maps are non-zero only inside the placements' footprints, while every
 // placement is driven by at least one clip. Reads files of this repository.
+#include "BuildPaths.hpp"
 #include "core/bake.hpp"
 #include "io/scene_files.hpp"
 
@@ -12,7 +13,7 @@
 using namespace dermis;
 
 namespace {
-const std::string kScene = std::string(DERMIS_SOURCE_DIR) + "/models/default.scene.json";
+const std::string kScene = std::string(dermis::build::sourceDir()) + "/models/default.scene.json";
 
 bool inside(const Placement& p, glm::dvec2 uv) {
     Footprint f;

@@ -6,6 +6,7 @@
 // decode to unit vectors (|2c − 1| ≈ 1) and show the bump mapping. A request with a view that
 // FrameView does not name is refused. Frames without MSAA, so that no pixel mixes skin with the
 // background.
+#include "BuildPaths.hpp"
 #include "core/frame_plan.hpp"
 #include "gl/renderer.hpp"
 #include "io/scene_files.hpp"
@@ -22,7 +23,7 @@ using namespace dermis;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
+const std::string kSource = dermis::build::sourceDir();
 
 using test::requestedBackend;
 

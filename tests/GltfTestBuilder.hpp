@@ -9,6 +9,7 @@
 // everything is inline in dermis::test::gltf, so that both suites can include it.
 #pragma once
 
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 #include "core/rig.hpp"
 #include "io/gltf_loader.hpp"
@@ -30,7 +31,7 @@ namespace dermis::test::gltf {
 
 using json = nlohmann::json;
 
-inline const std::string kModels = std::string(DERMIS_TEST_MODELS) + "/";
+inline const std::string kModels = std::string(dermis::build::testModelsDir()) + "/";
 inline const std::string kCesiumMan = kModels + "CesiumMan/CesiumMan.glb";
 inline const std::string kRiggedFigure = kModels + "RiggedFigure/RiggedFigure.glb";
 inline const std::string kBarbarian = kModels + "KayKitBarbarian/Barbarian.glb";

@@ -8,6 +8,7 @@
 //   * the same with the default budget and forgetPattern after each pass: nothing is left cached;
 //   * models: forgetModel frees a model's buffers, a budget smaller than a model keeps nothing
 //     between frames and still renders the same image, a model whose owner is gone is dropped.
+#include "BuildPaths.hpp"
 #include "GlTestBackend.hpp"
 #include "gl/renderer.hpp"
 #include "io/gltf_loader.hpp"
@@ -25,7 +26,8 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
+const std::string kCesium =
+    std::string(dermis::build::testModelsDir()) + "/CesiumMan/CesiumMan.glb";
 
 /// Resident memory of this process in MB, from /proc/self/statm (pages).
 /// How much the resident memory may grow over 20 cycles: 100 MB (issue #12), plus, under

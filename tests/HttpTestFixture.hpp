@@ -8,6 +8,7 @@
 // dermis::test::http, so that any number of test files can include it.
 #pragma once
 
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 #include "http/api.hpp"
 #include "io/frame_io.hpp"
@@ -39,7 +40,7 @@ namespace dermis::test::http {
 
 using nlohmann::json;
 
-inline const std::string kTestModels = DERMIS_TEST_MODELS;
+inline const std::string kTestModels = dermis::build::testModelsDir();
 inline const std::string kApi = "/api/v1";
 inline const std::string kCesiumMan = kTestModels + "/CesiumMan/CesiumMan.glb";
 inline const std::string kBarbarian = kTestModels + "/KayKitBarbarian/Barbarian.glb";

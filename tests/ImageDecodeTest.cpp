@@ -4,10 +4,11 @@
 // interlaced), grey and colour JPEGs, the pattern library and the test models' image files; CMYK
 // JPEGs go to the module; a missing or wrong module is a clear Unavailable error.
 // Needs the module built (it is a dependency of dermis_io).
+#include "BuildPaths.hpp"
+#include "TestFiles.hpp"
 #include "io/image_decode.hpp"
 #include "io/image_io.hpp"
 #include "io/oiio_loader.hpp"
-#include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -183,14 +184,14 @@ std::vector<std::vector<std::uint8_t>> glbImages(const std::string& path) {
 
 TEST(ImageDecodeTest, PatternLibraryAndModelImagesDecodeAsOpenImageIoDoes) {
     int patterns = 0, textures = 0;
-    const std::string library = std::string(DERMIS_SOURCE_DIR) + "/patterns";
+    const std::string library = std::string(dermis::build::sourceDir()) + "/patterns";
     for (const auto& e : std::filesystem::directory_iterator(library))
         if (e.path().extension() == ".png") {
             expectSameAsModule(readBytes(e.path().string()), e.path().string());
             ++patterns;
         }
     EXPECT_GE(patterns, 10) << "the built-in pattern library";
-    const std::string models = std::string(DERMIS_TEST_MODELS);
+    const std::string models = std::string(dermis::build::testModelsDir());
     for (const auto& e : std::filesystem::recursive_directory_iterator(models))
         if (e.path().extension() == ".glb") {
             int k = 0;

@@ -11,6 +11,7 @@
 // Also where charts split (UV seams, creases), a triangle soup that fits and one that cannot get
 // its gutters, another resolution and gutter, the core's LSCM and grid packing on their own, and
 // the refusals. Loads glTF through io (no GL).
+#include "BuildPaths.hpp"
 #include "core/layout_gen.hpp"
 #include "core/uv_flatten.hpp"
 #include "core/uv_pack.hpp"
@@ -31,7 +32,7 @@ using namespace dermis;
 
 namespace {
 
-const std::string kTestModels = std::string(DERMIS_TEST_MODELS) + "/";
+const std::string kTestModels = std::string(dermis::build::testModelsDir()) + "/";
 constexpr int kRes = 1024;
 constexpr double kPi = 3.14159265358979323846;
 
@@ -439,7 +440,7 @@ TEST(LayoutGenTest, NonManifoldAndMisorientedEdgesAreChartBorders) {
 }
 
 TEST(LayoutGenTest, DefaultCharacter) {
-    const Model m = loadModel(resolveModelPath("builtin:default", "", DERMIS_SOURCE_DIR));
+    const Model m = loadModel(resolveModelPath("builtin:default", "", dermis::build::sourceDir()));
     const GeneratedLayout g = expectGoodLayout(m, "default character");
     EXPECT_GE(g.check.usedFraction, 0.4);
 }

@@ -8,6 +8,7 @@
 // on every region of CesiumMan and the default character get none of these; RiggedFigure's UV
 // placements get no_uvs, its surface placements not. No GL, no HTTP.
 #include "core/lint.hpp"
+#include "BuildPaths.hpp"
 #include "core/uv_diagnosis.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
@@ -255,7 +256,7 @@ TEST_F(LintTest, FindsAsymmetricMirrorPairs) {
 
 // --- the model's own UVs (SPEC §8 UV diagnosis): uv_overlap, no_uvs, no_influence on overlap ---
 
-const std::string kModels = std::string(DERMIS_TEST_MODELS) + "/";
+const std::string kModels = std::string(dermis::build::testModelsDir()) + "/";
 
 std::shared_ptr<const Model> loadShared(const std::string& path) {
     auto m = loadGltfFile(path);
@@ -358,7 +359,8 @@ TEST(LintUvTest, TheBarbariansOverlappingTexelsAreNamedAndNoLongerFoolNoInfluenc
 
 TEST(LintUvTest, CesiumManAndTheDefaultCharacterHaveNoUvFindings) {
     for (const std::string& path :
-         {kModels + "CesiumMan/CesiumMan.glb", resolveModelPath("builtin:default", "", DERMIS_SOURCE_DIR)}) {
+         {kModels + "CesiumMan/CesiumMan.glb",
+          resolveModelPath("builtin:default", "", dermis::build::sourceDir())}) {
         SCOPED_TRACE(path);
         auto model = loadShared(path);
         ASSERT_TRUE(model);

@@ -6,6 +6,7 @@
 // side tokens, its axis is written rounded (on the default character, CesiumMan and the KayKit
 // Barbarian), and a twin already in the scene is found (the route's 409). No GL, no HTTP.
 #include "core/mirror.hpp"
+#include "BuildPaths.hpp"
 #include "core/bake.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
@@ -19,9 +20,11 @@ using namespace dermis;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
-const std::string kBarbarian = std::string(DERMIS_TEST_MODELS) + "/KayKitBarbarian/Barbarian.glb";
+const std::string kSource = dermis::build::sourceDir();
+const std::string kCesium =
+    std::string(dermis::build::testModelsDir()) + "/CesiumMan/CesiumMan.glb";
+const std::string kBarbarian =
+    std::string(dermis::build::testModelsDir()) + "/KayKitBarbarian/Barbarian.glb";
 
 /// A point of `lookup`'s atlas: the first chart hit on a 0.05 grid.
 std::array<double, 2> somewhereOnTheAtlas(const UvLookup& lookup) {

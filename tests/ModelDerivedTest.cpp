@@ -9,11 +9,12 @@
 // Service (CPU, no renderer needed): pick by UV, mirror and lint answer what the core computes
 // with fresh data, repeatedly, and deleting the model frees it with its derived data. No GL, no
 // HTTP.
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 #include "core/lint.hpp"
 #include "core/model_derived.hpp"
-#include "core/propose.hpp"
 #include "core/pick.hpp"
+#include "core/propose.hpp"
 #include "gl/renderer.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
@@ -30,10 +31,11 @@ using json = nlohmann::json;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kCesium = std::string(DERMIS_TEST_MODELS) + "/CesiumMan/CesiumMan.glb";
+const std::string kSource = dermis::build::sourceDir();
+const std::string kCesium =
+    std::string(dermis::build::testModelsDir()) + "/CesiumMan/CesiumMan.glb";
 const std::string kBarbarian =
-    std::string(DERMIS_TEST_MODELS) + "/KayKitBarbarian/Barbarian.glb";
+    std::string(dermis::build::testModelsDir()) + "/KayKitBarbarian/Barbarian.glb";
 
 std::shared_ptr<const Model> loadShared(const std::string& path) {
     auto m = loadGltfFile(path);

@@ -1,6 +1,7 @@
 // The built-in pattern library (SPEC §3): the committed manifest and images in patterns/, their
 // shapes per kind (wrinkles, bulges, bones), and that the generator reproduces them bit for bit.
 // Runs the generator (dermis-patterngen) as a subprocess.
+#include "BuildPaths.hpp"
 #include "TestFiles.hpp"
 
 #include "core/deform.hpp"
@@ -21,16 +22,12 @@
 #include <string>
 #include <vector>
 
-#ifndef DERMIS_PATTERNGEN_EXE
-#error "DERMIS_PATTERNGEN_EXE must name the dermis-patterngen executable (tests/CMakeLists.txt)"
-#endif
-
 namespace dermis {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kLibraryDir = std::string(DERMIS_SOURCE_DIR) + "/patterns";
+const std::string kLibraryDir = std::string(dermis::build::sourceDir()) + "/patterns";
 constexpr float kLsb = 1.0f / 32767.0f; // one step of the 16-bit mapping
 
 PatternManifest loadManifest() {
@@ -323,8 +320,8 @@ TEST_F(PatternLibraryTest, BonesHaveACrestAtOneAndRevealMoreAsTheBiasOffsetDrops
 
 TEST_F(PatternLibraryTest, GeneratorReproducesTheCommittedFilesByteForByte) {
     test::TempDir tmp;
-    std::string cmd = std::string("\"") + DERMIS_PATTERNGEN_EXE + "\" --out \"" + tmp.str() +
-                      "\" > \"" + (tmp / "log.txt") + "\" 2>&1";
+    std::string cmd = std::string("\"") + dermis::build::patterngenExe() + "\" --out \"" +
+                      tmp.str() + "\" > \"" + (tmp / "log.txt") + "\" 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << test::readBytes(tmp / "log.txt").size();
     fs::remove(tmp / "log.txt");
 
@@ -350,7 +347,7 @@ TEST_F(PatternLibraryTest, GeneratorReproducesTheCommittedFilesByteForByte) {
 
 TEST_F(PatternLibraryTest, GeneratorHonoursSizeAndRejectsBadArguments) {
     test::TempDir tmp;
-    std::string exe = std::string("\"") + DERMIS_PATTERNGEN_EXE + "\"";
+    std::string exe = std::string("\"") + dermis::build::patterngenExe() + "\"";
     std::string quiet = " > /dev/null 2>&1";
     ASSERT_EQ(std::system((exe + " --out \"" + tmp.str() + "\" --size 64" + quiet).c_str()), 0);
     for (const PatternInfo& p : manifest_.patterns) {

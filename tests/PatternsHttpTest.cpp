@@ -4,6 +4,7 @@
 //   * patterns: the built-in manifest and previews, a custom PNG upload used by id and through a
 //     scene's alias map, 409 while in use, 204 once unused (an alias no placement names is
 //     dropped); previews of tall patterns keep the aspect ratio.
+#include "BuildPaths.hpp"
 #include "HttpTestFixture.hpp"
 #include "common/sha256.hpp"
 
@@ -163,7 +164,9 @@ TEST_F(PatternsHttpTest, SameBytesUploadTwiceGiveTheSameId) {
     EXPECT_EQ(again.js()["id"], id);
     EXPECT_EQ(again.js()["name"], "dome");
     EXPECT_EQ(h.get("/patterns").js()["patterns"].size(), before + 1);
-    Reply third = h.upload("/patterns", readBytes(std::string(DERMIS_SOURCE_DIR) + "/patterns/crease.png"), "image/png");
+    Reply third = h.upload(
+        "/patterns", readBytes(std::string(dermis::build::sourceDir()) + "/patterns/crease.png"),
+        "image/png");
     ASSERT_EQ(third.status, 201) << third;
     EXPECT_NE(third.js()["id"], id);
     EXPECT_EQ(h.del("/patterns/" + id).status, 204);

@@ -3,6 +3,7 @@
 // the character and misses on the background (away from silhouette edges), and the pixel where
 // the left elbow crease changes the frame most picks a UV inside that placement's footprint, with
 // forearm.l among its skin weights and a suggested driver.
+#include "BuildPaths.hpp"
 #include "core/pick.hpp"
 #include "gl/renderer.hpp"
 #include "io/scene_files.hpp"
@@ -17,7 +18,7 @@ using namespace dermis;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
+const std::string kSource = dermis::build::sourceDir();
 
 using test::requestedBackend;
 

@@ -5,11 +5,12 @@
 // fully on where the clips bend it most and off at the rest pose, twins that are mirror images,
 // deterministic; the default set transferred onto CesiumMan and the Barbarian lands on the
 // matching body parts. No GL, no HTTP.
+#include "core/propose.hpp"
+#include "BuildPaths.hpp"
 #include "core/body_map.hpp"
 #include "core/deform.hpp"
 #include "core/model_derived.hpp"
 #include "core/motion.hpp"
-#include "core/propose.hpp"
 #include "core/surface_query.hpp"
 #include "core/transfer.hpp"
 #include "io/gltf_loader.hpp"
@@ -25,8 +26,8 @@ using namespace dermis;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kModels = std::string(DERMIS_TEST_MODELS) + "/";
+const std::string kSource = dermis::build::sourceDir();
+const std::string kModels = std::string(dermis::build::testModelsDir()) + "/";
 
 std::shared_ptr<const Model> load(const std::string& path) {
     auto m = loadGltfFile(path);

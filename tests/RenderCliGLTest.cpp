@@ -4,9 +4,10 @@
 // writes a normal map, `render` writes PNG/JPEG/EXR frames, animation ranges and height maps,
 // `--view` chooses what a frame shows, and bad scenes, models and options exit non-zero with a
 // message.
+#include "BuildPaths.hpp"
+#include "TestFiles.hpp"
 #include "io/frame_io.hpp"
 #include "io/image_io.hpp"
-#include "TestFiles.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -21,8 +22,8 @@ using nlohmann::json;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kTestModels = DERMIS_TEST_MODELS;
+const std::string kSource = dermis::build::sourceDir();
+const std::string kTestModels = dermis::build::testModelsDir();
 const std::string kDefaultScene = kSource + "/models/default.scene.json";
 
 std::string backend() {

@@ -10,13 +10,14 @@
 // skinning within 1e-4 (CesiumMan, default character); reference images of the default
 // character in three poses; frames of CesiumMan and KayKit Barbarian are non-empty and change
 // with time; MSAA, tessellation, displacement.
+#include "BuildPaths.hpp"
+#include "ImageCompare.hpp"
+#include "SceneFrame.hpp"
 #include "core/bake.hpp"
 #include "gl/renderer.hpp"
-#include "SceneFrame.hpp"
-#include "uniform_blocks.hpp"
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
-#include "ImageCompare.hpp"
+#include "uniform_blocks.hpp"
 
 #include "RendererSuite.hpp"
 
@@ -33,8 +34,8 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kTestModels = DERMIS_TEST_MODELS;
-const std::string kSource = DERMIS_SOURCE_DIR;
+const std::string kTestModels = dermis::build::testModelsDir();
+const std::string kSource = dermis::build::sourceDir();
 const std::string kCesium = kTestModels + "/CesiumMan/CesiumMan.glb";
 const std::string kBarbarian = kTestModels + "/KayKitBarbarian/Barbarian.glb";
 

@@ -2,6 +2,7 @@
 // and one test per kind of bad input, each checking the exact JSON pointer that the error names.
 // Pure: no files, no GL. (The pattern manifest: PatternManifestTest.)
 #include "core/scene.hpp"
+#include "BuildPaths.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -707,7 +708,7 @@ INSTANTIATE_TEST_SUITE_P(Table, SceneBadInput, testing::ValuesIn(kBadCases),
 // of a placement, of render and of the pose has at least one bad case that the parser refuses
 // naming that member (a member added to the schema without one fails here).
 TEST(SceneTest, BadCasesCoverEverySchemaMember) {
-    std::ifstream in(std::string(DERMIS_SOURCE_DIR) + "/server/http/schemas/scene.json");
+    std::ifstream in(std::string(dermis::build::sourceDir()) + "/server/http/schemas/scene.json");
     ASSERT_TRUE(in) << "server/http/schemas/scene.json";
     const nlohmann::json schema = nlohmann::json::parse(in);
     std::vector<std::string> prefixes;

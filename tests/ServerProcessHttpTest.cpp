@@ -2,6 +2,7 @@
 // $DERMIS_TEST_GL): every acknowledged edit survives kill -9 and a restart on the same data
 // directory; 8 concurrent clients mixing edits and renders for 2,000 requests get no 5xx other
 // than 503 back-pressure, and the server's memory stops growing.
+#include "BuildPaths.hpp"
 #include "ProcessStats.hpp"
 #include "TestFiles.hpp"
 
@@ -48,13 +49,21 @@ public:
             // memory test measures the server, not the sanitizer).
             if (const char* asan = std::getenv("ASAN_OPTIONS"))
                 ::setenv("ASAN_OPTIONS", (std::string(asan) + ":quarantine_size_mb=4").c_str(), 1);
-            std::vector<std::string> args = {DERMIS_SERVER_EXE, "serve", "--port", "0", "--data", dataDir,
-                                             "--gl", gl, "--queue", "64"};
+            std::vector<std::string> args = {dermis::build::serverExe(),
+                                             "serve",
+                                             "--port",
+                                             "0",
+                                             "--data",
+                                             dataDir,
+                                             "--gl",
+                                             gl,
+                                             "--queue",
+                                             "64"};
             args.insert(args.end(), extra.begin(), extra.end());
             std::vector<char*> argv;
             for (std::string& x : args) argv.push_back(x.data());
             argv.push_back(nullptr);
-            ::execv(DERMIS_SERVER_EXE, argv.data());
+            ::execv(dermis::build::serverExe(), argv.data());
             ::_exit(127);
         }
         // Wait for "serving http://127.0.0.1:<port>/".

@@ -3,9 +3,10 @@
 // Service*Test suites (pure: no GL, no HTTP).
 #pragma once
 
-#include "service/service.hpp"
+#include "BuildPaths.hpp"
 #include "FakeRenderer.hpp"
 #include "TestFiles.hpp"
+#include "service/service.hpp"
 
 #include "io/frame_io.hpp"
 
@@ -21,7 +22,7 @@ namespace dermis::test {
 
 using json = nlohmann::json;
 
-inline const std::string kSource = DERMIS_SOURCE_DIR;
+inline const std::string kSource = dermis::build::sourceDir();
 
 /// Width and height from a PNG's IHDR chunk.
 inline std::pair<int, int> pngSize(const std::vector<std::uint8_t>& b) {

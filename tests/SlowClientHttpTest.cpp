@@ -11,6 +11,7 @@
 // a new one once one of the four has gone; --timeout 2 resets a connection whose 64 MB answer is
 // never read. The time bounds are correctness bounds (before the fix: no answer for as long as
 // the slow clients go on), not benchmarks.
+#include "BuildPaths.hpp"
 #include "ProcessStats.hpp"
 #include "TestFiles.hpp"
 
@@ -57,7 +58,7 @@ public:
             ::dup2(fd, 2);
             const char* gl = std::getenv("DERMIS_TEST_GL");
             const char* exe = std::getenv("DERMIS_TEST_SERVER_EXE"); // another build, to compare
-            if (!exe || !*exe) exe = DERMIS_SERVER_EXE;
+            if (!exe || !*exe) exe = dermis::build::serverExe();
             std::vector<std::string> args = {exe, "serve", "--port", "0", "--data", data,
                                              "--gl", gl && *gl ? gl : "auto",
                                              "--max-upload-mb", "2"};

@@ -9,6 +9,7 @@
 // the decal's reach (else of the nearest triangle), a UV placement's is its center; on the KayKit
 // Barbarian (tests/models) through its generated layout, a decal at a pick anchor on the forearm
 // gives pieces inside [0,1]² holding the picked point, which is its anchor UV.
+#include "BuildPaths.hpp"
 #include "core/bake.hpp"
 #include "core/heightmap.hpp"
 #include "core/layout_gen.hpp"
@@ -391,7 +392,8 @@ TEST(SurfaceOutlineTest, TheAnchorUvPrefersASurfaceFacingTheAnchorWithinReach) {
 // --- a real character --------------------------------------------------------------------------
 
 TEST(SurfaceOutlineTest, TheBarbariansForearmDecalInItsGeneratedLayout) {
-    auto loaded = loadGltfFile(std::string(DERMIS_TEST_MODELS) + "/KayKitBarbarian/Barbarian.glb");
+    auto loaded = loadGltfFile(std::string(dermis::build::testModelsDir()) +
+                               "/KayKitBarbarian/Barbarian.glb");
     ASSERT_TRUE(loaded) << loaded.error().message;
     const Model& own = *loaded;
     auto layout = generateTextureLayout(own);

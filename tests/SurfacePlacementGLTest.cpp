@@ -6,6 +6,7 @@
 // copy of the model's own layout is the same frame; a frame with another layout (the second UV
 // attribute) keeps the base colour and shows the same decal; a surface placement changes a frame
 // only near its anchor.
+#include "BuildPaths.hpp"
 #include "core/bake.hpp"
 #include "core/camera.hpp"
 #include "core/frame_plan.hpp"
@@ -27,8 +28,8 @@ using namespace dermis::test;
 
 namespace {
 
-const std::string kTestModels = DERMIS_TEST_MODELS;
-const std::string kSource = DERMIS_SOURCE_DIR;
+const std::string kTestModels = dermis::build::testModelsDir();
+const std::string kSource = dermis::build::sourceDir();
 const std::string kCesium = kTestModels + "/CesiumMan/CesiumMan.glb";
 
 class SurfacePlacementGLTest : public RendererSuite {

@@ -3,6 +3,7 @@
 // a tiny multi-file glTF.
 #pragma once
 
+#include "BuildPaths.hpp"
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -75,10 +76,10 @@ struct CliRun {
     std::string err, out;
 };
 
-/// Runs `DERMIS_SERVER_EXE <args>` (a test target defines it), capturing stdout and stderr in `dir`.
+/// Runs `dermis-server <args>` (dermis::build::serverExe()), capturing stdout and stderr in `dir`.
 inline CliRun runServer(const TempDir& dir, const std::string& args) {
-    const std::string cmd = std::string(DERMIS_SERVER_EXE) + " " + args + " >" + (dir / "out.txt") +
-                            " 2>" + (dir / "err.txt");
+    const std::string cmd = std::string(dermis::build::serverExe()) + " " + args + " >" +
+                            (dir / "out.txt") + " 2>" + (dir / "err.txt");
     const int status = std::system(cmd.c_str());
     CliRun r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

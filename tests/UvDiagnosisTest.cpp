@@ -7,6 +7,7 @@
 // KayKit Barbarian's palette atlas overlaps (regions named, left and right forearm paired),
 // CesiumMan and the default character are usable with no overlap, RiggedFigure has no UVs. The
 // diagnosis is deterministic and built once per model. No GL, no HTTP.
+#include "BuildPaths.hpp"
 #include "core/model_derived.hpp"
 #include "core/uv_diagnosis.hpp"
 #include "io/gltf_loader.hpp"
@@ -24,8 +25,8 @@ using namespace dermis;
 
 namespace {
 
-const std::string kSource = DERMIS_SOURCE_DIR;
-const std::string kModels = std::string(DERMIS_TEST_MODELS) + "/";
+const std::string kSource = dermis::build::sourceDir();
+const std::string kModels = std::string(dermis::build::testModelsDir()) + "/";
 
 std::shared_ptr<const Model> loadShared(const std::string& path) {
     auto m = loadGltfFile(path);
