@@ -1,9 +1,11 @@
 // dermis-bench part 3: every frame format's encode time and size on a real frame (the default
 // scene, posed, 512² and 1024²), as the server encodes them: PNG and lossless WebP without alpha
-// (the frame route's), JPEG quality 90, EXR half RGBA (encodeFrame).
+// (the frame route's), JPEG quality 90, EXR half RGBA (encodeFrame; reported unavailable where
+// the OpenImageIO module is not there).
 #include "bench_parts.hpp"
 
 #include "io/frame_io.hpp"
+#include "io/image_io.hpp"
 #include "io/webp_encode.hpp"
 
 #include <functional>
@@ -42,12 +44,18 @@ int benchEncoders(Renderer& renderer, const DefaultScene& ds, int repeat, nlohma
                 const auto t0 = std::chrono::steady_clock::now();
                 auto encoded = encode();
                 const double t = msSince(t0);
+                if (!encoded && encoded.error().code == ErrorCode::Unavailable) break;
                 if (!encoded) {
                     std::cerr << encoded.error().message << "\n";
                     return 1;
                 }
                 bytes = encoded->size();
                 if (r > 0) ms.push_back(t);
+            }
+            if (ms.empty()) {
+                // A build or image without the OpenImageIO module (docs/container.md): no EXR.
+                out.push_back({{"format", name}, {"frame_size", size}, {"unavailable", true}});
+                continue;
             }
             out.push_back({{"format", name},
                            {"frame_size", size},
@@ -56,6 +64,51 @@ int benchEncoders(Renderer& renderer, const DefaultScene& ds, int repeat, nlohma
                            {"repetitions", ms.size()}});
         }
     }
+    return 0;
+}
+
+int benchHeightmapFetch(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann::json& out) {
+    std::vector<double> changed, same, f32, png16;
+    for (int r = 0; r <= repeat; ++r) {
+        FrameOverrides overrides;
+        overrides.time = ds.clipDuration * (0.2 + 0.6 * r / (repeat + 1.0));
+        auto plan = planFrame(ds.scene, *ds.model, ds.images, nullptr, overrides);
+        if (!plan) {
+            std::cerr << plan.error().message << "\n";
+            return 1;
+        }
+        auto t0 = std::chrono::steady_clock::now();
+        auto maps = renderer.bakeHeightMaps(plan->heights);
+        const double tChanged = msSince(t0);
+        t0 = std::chrono::steady_clock::now();
+        auto again = renderer.bakeHeightMaps(plan->heights);
+        const double tSame = msSince(t0);
+        if (!maps || !again) {
+            std::cerr << (maps ? again.error() : maps.error()).message << "\n";
+            return 1;
+        }
+        t0 = std::chrono::steady_clock::now();
+        auto a = encodeF32(maps->displacement);
+        const double tF32 = msSince(t0);
+        t0 = std::chrono::steady_clock::now();
+        auto b = encodeHeight16Png(maps->bump);
+        const double tPng = msSince(t0);
+        if (!a || !b) {
+            std::cerr << (a ? b.error() : a.error()).message << "\n";
+            return 1;
+        }
+        if (r == 0) continue; // the first bake pays for uploads
+        changed.push_back(tChanged);
+        same.push_back(tSame);
+        f32.push_back(tF32);
+        png16.push_back(tPng);
+    }
+    out = {{"map_size", ds.scene.heightmapSize[0]},
+           {"bake_new_pose_ms", round2(medianMs(changed))},
+           {"bake_same_inputs_ms", round2(medianMs(same))},
+           {"encode_f32_ms", round2(medianMs(f32))},
+           {"encode_png16_ms", round2(medianMs(png16))},
+           {"repetitions", changed.size()}};
     return 0;
 }
 

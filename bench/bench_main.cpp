@@ -15,7 +15,9 @@
 //    separated by glFinish. "aa_quality": SSIM of one 1024² frame per mode against MSAA 4x and
 //    against a supersampled frame (2048² MSAA 4x, 2×2 blocks averaged).
 // 3. encoders (JSON "encoders"): PNG, JPEG, lossless WebP and EXR encode time and size of a
-//    512² and a 1024² frame of that scene (bench_encoders.cpp).
+//    512² and a 1024² frame of that scene (bench_encoders.cpp). "heightmap_fetch": the height-map
+//    route's work at 1024² (bake after a pose change, bake of the same inputs = read-back only,
+//    f32 and 16-bit PNG encodes; bench_encoders.cpp).
 // 4. scaling (JSON "scaling"): frame time against placements, map size, triangles and joints,
 //    GPU and CPU height maps (bench_scaling.cpp; bench/plot_scaling.py draws docs/scaling.png).
 #include "core/heightmap.hpp"
@@ -278,7 +280,7 @@ int main(int argc, char** argv) {
                              {"repetitions", ms.size()}});
         }
     nlohmann::json gpuInfo = nullptr;
-    nlohmann::json encoders = nullptr, scalingOut = nullptr, aaQuality = nullptr;
+    nlohmann::json encoders = nullptr, scalingOut = nullptr, aaQuality = nullptr, heightmapFetch = nullptr;
     if (gpu || scaling) {
         auto renderer = Renderer::create(backend);
         if (!renderer) {
@@ -298,6 +300,7 @@ int main(int argc, char** argv) {
             encoders = nlohmann::json::array();
             if (int rc = benchEncoders(**renderer, *ds, std::max(5, repeat), encoders); rc != 0)
                 return rc;
+            if (int rc = benchHeightmapFetch(**renderer, *ds, repeat, heightmapFetch); rc != 0) return rc;
         }
         if (scaling) {
             scalingOut = nlohmann::json::array();
@@ -310,6 +313,7 @@ int main(int argc, char** argv) {
                           {"results", cases},
                           {"aa_quality", aaQuality},
                           {"encoders", encoders},
+                          {"heightmap_fetch", heightmapFetch},
                           {"scaling", scalingOut}};
     std::cout << out.dump(2) << "\n";
     return 0;

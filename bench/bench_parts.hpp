@@ -17,6 +17,11 @@ Result<DefaultScene> loadDefaultScene();
 /// (bench_encoders.cpp).
 int benchEncoders(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann::json& out);
 
+/// The height-map route's work (GET /scenes/{id}/heightmaps/{map}, 1024² maps): a bake whose pose
+/// changed (height pass and read-back), a bake of the same inputs (read-back only), and the f32 and
+/// 16-bit PNG encodes; medians of `repeat` (bench_encoders.cpp).
+int benchHeightmapFetch(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann::json& out);
+
 /// Frame time against placements, map size, triangles and joints (bench_scaling.cpp).
 int benchScaling(Renderer& renderer, const DefaultScene& ds, nlohmann::json& out);
 
