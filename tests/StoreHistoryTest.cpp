@@ -77,14 +77,16 @@ json sceneOf(int n) {
 }
 
 /// One random edit of the kind an editor makes: a placement's field, a new placement (anywhere),
-/// a deleted one, one moved, the pose, an odd value (−0.0, 1 vs 1.0, a key with "/" and "~").
+/// a deleted one, one moved, the pose, an odd value (−0.0, 1 vs 1.0, a key with "/" and "~"), a
+/// placement's member that sorts first or last, or is written with escapes, added and removed
+/// (the text splices of a chunk's replay).
 void randomEdit(json& doc, std::mt19937& rng, int& nextId) {
     std::uniform_real_distribution<double> u(0.0, 1.0);
     if (!doc.contains("placements") || !doc["placements"].is_array()) doc["placements"] = json::array();
     json& pl = doc["placements"];
     const std::size_t n = pl.size();
     auto any = [&](std::size_t m) { return static_cast<std::size_t>(rng() % std::max<std::size_t>(1, m)); };
-    switch (rng() % 10) {
+    switch (rng() % 11) {
     case 0: case 1: case 2: case 3:
         if (n) pl[any(n)]["center"] = {u(rng), u(rng)};
         break;
@@ -107,6 +109,15 @@ void randomEdit(json& doc, std::mt19937& rng, int& nextId) {
     case 8:
         doc["pose"]["time"] = u(rng);
         doc["pose"]["joints"]["upper/arm~l"] = {{"axis_angles", {{"x", u(rng) * 90}, {"y", 0.0}, {"z", 0.0}}}};
+        break;
+    case 9:
+        if (n) {
+            json& p = pl[any(n)];
+            static const char* const kOdd[] = {"aa_first", "zz_last", "q\"uote", "sl/ash~t", "\u00e9t\u00e9"};
+            const std::string key = kOdd[rng() % 5];
+            if (p.contains(key) && rng() % 2) p.erase(key);
+            else p[key] = (rng() % 2) ? json(u(rng)) : json::array({1, "x", nullptr});
+        }
         break;
     default:
         if (n) {

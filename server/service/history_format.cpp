@@ -201,7 +201,8 @@ std::optional<std::size_t> indexToken(const std::string& t, std::size_t limit) {
 /// document whole first.
 class PartedDoc {
 public:
-    /// Splits compact object text (as dump() writes it); false when it is not of that shape.
+    /// Splits compact object text (as dump() writes it); false when it is not of that shape. The
+    /// "placements" array is split into its elements in the same pass (one scan of the text).
     bool load(std::string_view text) {
         std::size_t i = 0;
         if (text.size() < 2 || text[0] != '{') return false;
@@ -213,7 +214,9 @@ public:
             if (k == std::string_view::npos || k >= text.size() || text[k] != ':') return false;
             const json key = json::parse(text.substr(i, k - i), nullptr, false);
             if (!key.is_string()) return false;
-            const std::size_t v = skipValue(text, k + 1);
+            const bool placements = key.get_ref<const std::string&>() == "placements" &&
+                                    k + 1 < text.size() && text[k + 1] == '[';
+            const std::size_t v = placements ? splitElements(text, k + 1) : skipValue(text, k + 1);
             if (v == std::string_view::npos || v >= text.size()) return false;
             if (!members_.empty() && !(members_.back().first < key.get_ref<const std::string&>()))
                 return false; // dump() writes members once each, in key order
@@ -222,22 +225,7 @@ public:
             if (text[v] == '}') break;
             if (text[v] != ',') return false;
         }
-        if (i != text.size()) return false;
-        if (Part* p = member("placements"); p && p->text.size() >= 2 && p->text[0] == '[') {
-            const std::string_view a = p->text;
-            split_ = true;
-            if (a == "[]") return true;
-            for (std::size_t j = 1; j < a.size();) {
-                const std::size_t e = skipValue(a, j);
-                if (e == std::string_view::npos || e >= a.size()) return false;
-                elements_.push_back(Part{a.substr(j, e - j), std::nullopt});
-                if (a[e] == ']') return e + 1 == a.size();
-                if (a[e] != ',') return false;
-                j = e + 1;
-            }
-            return false;
-        }
-        return true;
+        return i == text.size();
     }
     /// The fallback: `text` parsed whole. False when it is not JSON.
     bool loadWhole(std::string_view text) {
@@ -300,6 +288,7 @@ public:
             }
             const auto k = indexToken(t[1], elements_.empty() ? 0 : elements_.size() - 1);
             if (!k || elements_.empty()) return fail("no such element");
+            if (t.size() == 3 && spliceMember(elements_[*k], name, t[2], op)) return Ok{};
             return applyWithin(elements_[*k], t, 2, op, where);
         }
         return applyWithin(at->second, t, 1, op, where);
@@ -329,23 +318,103 @@ public:
 
 private:
     struct Part {
-        std::string_view text;       ///< as stored, while `value` is empty
-        std::optional<json> value;   ///< parsed (or replaced) once an operation touched it
+        std::string_view text;       ///< as stored, while `value` is empty and `edited` unset
+        std::optional<json> value;   ///< parsed (or replaced) once an operation needed the tree
+        std::optional<std::string> edited = std::nullopt; ///< the text after spliceMember
+        std::string_view view() const { return edited ? std::string_view(*edited) : text; }
         json& get() {
-            if (!value) value = json::parse(text, nullptr, false);
+            if (!value) value = json::parse(view(), nullptr, false);
             return *value;
         }
         void appendTo(std::string& out) const {
             if (value) out += value->dump();
-            else out.append(text);
+            else out.append(view());
         }
     };
 
-    Part* member(const std::string& key) {
-        for (auto& m : members_)
-            if (m.first == key) return &m.second;
-        return nullptr;
+    /// `op` (add, replace or remove of member `key` of the object `part` holds as compact text)
+    /// applied to the text itself: the member's value replaced by the new value's dump(), a new
+    /// member put where dump() puts it (key order), a removed one cut out with its comma. No parse
+    /// of the object: the drag of a placement ("replace /placements/i/center") costs a scan of
+    /// that placement's text. False, and nothing changed, where the text path does not apply (a
+    /// key written with escapes, a replace or remove of a missing member, text not of that
+    /// shape): the caller parses instead and gets the tree's answer.
+    static bool spliceMember(Part& part, const std::string& name, const std::string& key, const json& op) {
+        if (part.value) return false;
+        const std::string_view t = part.view();
+        if (t.size() < 2 || t[0] != '{' || t.back() != '}') return false;
+        // Each member as [begin of key, end of value); keys compared as written (no escapes).
+        std::size_t insertAt = t.size() - 1, i = 1;
+        bool found = false, first = true;
+        std::size_t mBegin = 0, vBegin = 0, vEnd = 0;
+        if (t[i] != '}') {
+            while (true) {
+                if (t[i] != '"') return false;
+                const std::size_t k = skipString(t, i);
+                if (k == std::string_view::npos || k >= t.size() || t[k] != ':') return false;
+                const std::string_view raw = t.substr(i + 1, k - i - 2);
+                if (raw.find('\\') != std::string_view::npos) return false;
+                const std::size_t v = skipValue(t, k + 1);
+                if (v == std::string_view::npos || v >= t.size()) return false;
+                if (raw == key) {
+                    found = true;
+                    mBegin = i, vBegin = k + 1, vEnd = v;
+                    first = mBegin == 1;
+                    break;
+                }
+                if (insertAt == t.size() - 1 && key < raw) insertAt = i;
+                if (t[v] == '}') break;
+                if (t[v] != ',') return false;
+                i = v + 1;
+            }
+        }
+        std::string out;
+        if (name == "remove") {
+            if (!found) return false;
+            // Cut "key":value and the comma after it, or the comma before it when it is last.
+            std::size_t cutBegin = mBegin, cutEnd = vEnd;
+            if (t[vEnd] == ',') ++cutEnd;
+            else if (!first) --cutBegin;
+            out.assign(t.substr(0, cutBegin));
+            out.append(t.substr(cutEnd));
+        } else if (found) { // add of an existing member replaces it, as replace does
+            out.assign(t.substr(0, vBegin));
+            out += op["value"].dump();
+            out.append(t.substr(vEnd));
+        } else {
+            if (name != "add") return false;
+            const std::string member = json(key).dump() + ":" + op["value"].dump();
+            out.assign(t.substr(0, insertAt));
+            if (insertAt == t.size() - 1) { // at the end
+                if (t.size() > 2) out += ',';
+                out += member;
+            } else {
+                out += member;
+                out += ',';
+            }
+            out.append(t.substr(insertAt));
+        }
+        part.edited = std::move(out);
+        return true;
     }
+
+    /// The elements of the array at text[at] ('[') into elements_; the index just past the array,
+    /// or npos when it is not closed.
+    std::size_t splitElements(std::string_view text, std::size_t at) {
+        split_ = true;
+        elements_.clear();
+        if (text.substr(at, 2) == "[]") return at + 2;
+        for (std::size_t j = at + 1; j < text.size();) {
+            const std::size_t e = skipValue(text, j);
+            if (e == std::string_view::npos || e >= text.size()) return std::string_view::npos;
+            elements_.push_back(Part{text.substr(j, e - j), std::nullopt});
+            if (text[e] == ']') return e + 1;
+            if (text[e] != ',') return std::string_view::npos;
+            j = e + 1;
+        }
+        return std::string_view::npos;
+    }
+
     /// `op` applied inside `part`, at the path's tokens from `from` on.
     static Status applyWithin(Part& part, const std::vector<std::string>& t, std::size_t from,
                               const json& op, const char* where) {
