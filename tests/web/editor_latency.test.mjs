@@ -121,6 +121,7 @@ async function drag(page, proxy, rtt, limit, direct = false, ms = DRAG_MS) {
     server_ms: shown.pipeline ? shown.pipeline.serverMs : null, net_ms: shown.pipeline ? shown.pipeline.rttMs : null,
     server_dur_p50_ms: quantile(frames.map((f) => f.dur).filter((x) => x !== null && x !== undefined), 0.5),
     final_frame_ms: last ? +(last.shownAt - times.upAt).toFixed(1) : null,
+    preview_side_p50: quantile(frames.map((f) => f.side), 0.5),
   };
   if (process.env.LAT_DEBUG) writeFileSync(join(shotDir, `lat-trace-${direct ? "direct" : rtt}-${limit || "k"}.json`), JSON.stringify({ times, tr }, null, 1));
   return { run, shown, tr };
@@ -142,6 +143,7 @@ async function checkDrag({ run, shown, tr }) {
   const seqs = tr.frames.map((f) => f.seq);
   for (let i = 1; i < seqs.length; ++i) assert.ok(seqs[i] > seqs[i - 1], `${what}: frame ${seqs[i]} went on screen after ${seqs[i - 1]}`);
   assert.ok(run.frames_shown > 0, `${what}: frames during the drag`);
+  assert.ok(/[?&]width=512(&|$)/.test(shown.url), `${what}: the final frame is full size: ${shown.url.slice(0, 200)}`);
 }
 
 await runSuite("WebEditorLatencyBrowserTest", async () => {
@@ -179,6 +181,8 @@ await runSuite("WebEditorLatencyBrowserTest", async () => {
     assert.ok(after.run.peak_in_flight > 1, `at most ${after.run.peak_in_flight} frame request(s) in flight`);
     assert.ok(after.run.peak_in_flight <= 4, `${after.run.peak_in_flight} frame requests in flight (≤ 4: the event stream and an edit keep their connections)`);
     assert.equal(before.run.peak_in_flight, 1, "capped at one, one in flight");
+    // Over the slow link the drag's previews are half size (frame_view.js shownParams).
+    assert.equal(after.run.preview_side_p50, 256, `the previews during the 100 ms drag are 256² (median side ${after.run.preview_side_p50})`);
   }]);
   const failures = await runChecks("WebEditorLatencyBrowserTest", checks);
   const figures = { benchmark: "editor_remote_drag", frame: "512x512", drag_ms: DRAG_MS, gl: process.env.DERMIS_TEST_GL || "auto", runs };

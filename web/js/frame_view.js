@@ -262,7 +262,8 @@ export function initFrameView(section, theApi) {
   let stageDrag = false;
   mainLoader = new FrameLoader(img, (job, now) => {
     frameStats.shown++;
-    if (trace.on) trace.frames.push({ t0: job.t0, shownAt: now, issuedAt: job.issuedAt, bodyAt: job.bodyAt, seq: job.seq, dur: job.dur, pipelined: job.pipelined });
+    if (trace.on) trace.frames.push({ t0: job.t0, shownAt: now, issuedAt: job.issuedAt, bodyAt: job.bodyAt, seq: job.seq, dur: job.dur, pipelined: job.pipelined,
+                                      side: +((/[?&]width=(\d+)/.exec(job.url) || [])[1] || 0) });
     frameStats.times.push(now - job.t0);
     if (frameStats.times.length > 1000) frameStats.times.shift();
     img.alt = "rendered frame";
@@ -425,14 +426,33 @@ function fetchFrame(url) {
   return api.raw("POST", path, { body });
 }
 
+// Over a slow link a gesture's previews are half the frame's side (issue #28): a quarter of the
+// pixels to render (llvmpipe: ~25 → ~8 ms at 512²), encode, send (19 → ~6 KB of JPEG: 8 → 3 ms
+// at 20 Mbit/s) and decode, which is what a frame's age over RTT is made of there
+// (docs/remote-authoring.md "Where the time goes"). The <img> scales it to the view; the frame
+// after the gesture is full size and lossless. "Slow" is the pipeline's rtt estimate (the rest of
+// a request beside the server's time) above REMOTE_RTT_MS: loopback measures 8–25 ms and keeps
+// full-size previews, a 100 ms round trip ~120 ms.
+const REMOTE_RTT_MS = 50;
+
+/// The frame parameters the 3D view loads now: frameParams(), at half size during a gesture
+/// over a slow link (above).
+function shownParams(outlines) {
+  const p = frameParams(outlines);
+  const slow = mainLoader && mainLoader.rttMs !== null && mainLoader.rttMs >= REMOTE_RTT_MS;
+  if (!(store.gestures > 0) || !slow) return p;
+  const side = Math.max(128, Math.round(frameSize / 2));
+  return { ...p, width: side, height: side };
+}
+
 export function frameUrl() {
-  return framePath(store.sceneId, frameParams(store.compare.mode === "off"));
+  return framePath(store.sceneId, shownParams(store.compare.mode === "off"));
 }
 
 export function refresh() {
   if (!store.sceneId || !store.doc) return;
   const cmp = store.compare;
-  const p = frameParams(cmp.mode === "off");
+  const p = shownParams(cmp.mode === "off");
   const against = cmp.against === "off" ? { patterns: "off" } : { revision: +cmp.against };
   if (cmp.mode === "diff") {
     mainLoader.load(frameDiffPath(store.sceneId, { ...p, against: cmp.against }));
