@@ -427,8 +427,8 @@ function fetchFrame(url) {
 }
 
 // Over a slow link a gesture's previews are half the frame's side (issue #28): a quarter of the
-// pixels to render (llvmpipe: ~25 → ~8 ms at 512²), encode, send (19 → ~6 KB of JPEG: 8 → 3 ms
-// at 20 Mbit/s) and decode, which is what a frame's age over RTT is made of there
+// pixels to render (llvmpipe, measured in the latency test: 25–34 → 16–19 ms a preview, queueing
+// included), encode, send (~19 → ~8 KB of JPEG: 8 → 3 ms at 20 Mbit/s) and decode, which is what a frame's age over RTT is made of there
 // (docs/remote-authoring.md "Where the time goes"). The <img> scales it to the view; the frame
 // after the gesture is full size and lossless. "Slow" is the pipeline's rtt estimate (the rest of
 // a request beside the server's time) above REMOTE_RTT_MS: loopback measures 8–25 ms and keeps
@@ -441,8 +441,10 @@ function shownParams(outlines) {
   const p = frameParams(outlines);
   const slow = mainLoader && mainLoader.rttMs !== null && mainLoader.rttMs >= REMOTE_RTT_MS;
   if (!(store.gestures > 0) || !slow) return p;
+  // The scene's anti-aliasing, not frameParams' msaa=1: a 2× upscale doubles every stair of an
+  // unsmoothed edge (on llvmpipe the post pass costs ~0.7 ms at 256²).
   const side = Math.max(128, Math.round(frameSize / 2));
-  return { ...p, width: side, height: side };
+  return { ...p, width: side, height: side, msaa: undefined };
 }
 
 export function frameUrl() {
