@@ -345,7 +345,7 @@ private:
         if (t.size() < 2 || t[0] != '{' || t.back() != '}') return false;
         // Each member as [begin of key, end of value); keys compared as written (no escapes).
         std::size_t insertAt = t.size() - 1, i = 1;
-        bool found = false, first = true;
+        bool found = false;
         std::size_t mBegin = 0, vBegin = 0, vEnd = 0;
         if (t[i] != '}') {
             while (true) {
@@ -359,7 +359,6 @@ private:
                 if (raw == key) {
                     found = true;
                     mBegin = i, vBegin = k + 1, vEnd = v;
-                    first = mBegin == 1;
                     break;
                 }
                 if (insertAt == t.size() - 1 && key < raw) insertAt = i;
@@ -374,7 +373,7 @@ private:
             // Cut "key":value and the comma after it, or the comma before it when it is last.
             std::size_t cutBegin = mBegin, cutEnd = vEnd;
             if (t[vEnd] == ',') ++cutEnd;
-            else if (!first) --cutBegin;
+            else if (mBegin != 1) --cutBegin; // not the first member: a comma before it
             out.assign(t.substr(0, cutBegin));
             out.append(t.substr(cutEnd));
         } else if (found) { // add of an existing member replaces it, as replace does
