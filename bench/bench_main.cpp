@@ -10,7 +10,8 @@
 // 2. frame: the paper's per-frame loop on the default character (~4.3k triangles, ~50 joints)
 //    with the first 15 placements of models/default.scene.json and 1024² maps, the pose moving
 //    along the squat clip: height pass, skin pass, post-process AA, readback, PNG encode and
-//    total, at 512² and 1024², anti-aliasing off, post (render.aa "post") and MSAA 4x, with GPU
+//    total, at 512² and 1024², anti-aliasing off, post (render.aa "post") and MSAA 4x, legacy and
+//    pbr shading (render.shading; pbr with GPU maps only), with GPU
 //    height maps and with CPU height maps (the paper's "CPU" configuration). Stages are
 //    separated by glFinish. "aa_quality": SSIM of one 1024² frame per mode against MSAA 4x and
 //    against a supersampled frame (2048² MSAA 4x, 2×2 blocks averaged).
@@ -88,10 +89,14 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
     const double duration = ds.clipDuration;
     HeightMaps cpuHeights; // reused: no per-frame allocation
     for (bool cpuMaps : {false, true})
+        for (const Shading shading : {Shading::Legacy, Shading::Pbr})
         for (int size : {512, 1024})
             for (const AntiAliasing aa : {AntiAliasing::None, AntiAliasing::Post, AntiAliasing::Msaa}) {
+                // The pbr shading's cost is measured with GPU maps only.
+                if (cpuMaps && shading == Shading::Pbr) continue;
                 // Off, the post-process edge pass (render.aa "post"), MSAA 4x.
                 const int msaa = aa == AntiAliasing::Msaa ? 4 : 1;
+                scene.render.shading = shading;
                 scene.render.size = {size, size};
                 scene.render.msaa = msaa;
                 scene.render.aa = aa;
@@ -145,6 +150,7 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                     }
                 cases.push_back({{"name", "frame"},
                                  {"heightmaps", cpuMaps ? "cpu" : "gpu"},
+                                 {"shading", toString(shading)},
                                  {"frame_size", size},
                                  {"map_size", 1024},
                                  {"aa", toString(aa)},

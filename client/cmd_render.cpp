@@ -16,7 +16,7 @@ namespace dermis::cli {
 namespace {
 
 struct FrameOptions {
-    std::string id, sceneFile, out, frames, size, view = "shaded", map, format, aa;
+    std::string id, sceneFile, out, frames, size, view = "shaded", map, format, aa, shading;
     double time = -1, yaw = 0, pitch = 0, distance = 0;
     int width = 0, height = 0, msaa = 0, revision = 0, batch = 100, parallel = 1;
     bool hasYaw = false, hasPitch = false, hasDistance = false, resume = false;
@@ -51,6 +51,8 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
     frame->add_option("--msaa", o->msaa, "MSAA with 1, 2 or 4 samples")->check(CLI::IsMember({1, 2, 4}));
     frame->add_option("--aa", o->aa, "Anti-aliasing: auto (post on software rasterizers, else MSAA), msaa, post or none")
         ->check(CLI::IsMember({"auto", "msaa", "post", "none"}));
+    frame->add_option("--shading", o->shading, "legacy or pbr (the model's glTF material under image-based light)")
+        ->check(CLI::IsMember({"legacy", "pbr"}));
     frame->add_option("--view", o->view, "shaded, or bump / displacement / normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
     frame->add_option("--revision", o->revision, "The scene as it was at this revision")->check(CLI::PositiveNumber);
@@ -65,6 +67,7 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             if (o->time >= 0) q.push_back({"time", nlohmann::json(o->time).dump()});
             if (o->msaa) q.push_back({"msaa", std::to_string(o->msaa)});
             if (!o->aa.empty()) q.push_back({"aa", o->aa});
+            if (!o->shading.empty()) q.push_back({"shading", o->shading});
             if (o->view != "shaded") q.push_back({"view", o->view});
             if (o->revision) q.push_back({"revision", std::to_string(o->revision)});
             if (frame->count("--yaw")) q.push_back({"yaw", nlohmann::json(o->yaw).dump()});

@@ -50,4 +50,22 @@ layout(std140, binding = 2) uniform PartBlock {
                        // layout in use covers the part), view (0 shaded, 1 bump, 2 displacement,
                        // 3 normal: FrameView in server/core/render_settings.hpp; the same for
                        // every part of a frame)
+    // glTF metallic-roughness (DERMIS_PBR programs only; core/model.hpp Material):
+    vec4 u_emissive;   // emissive factor (× KHR_materials_emissive_strength), alpha cutoff
+    vec4 u_material;   // metallic, roughness, normal scale, occlusion strength
+    ivec4 u_maps;      // textures present (bits: 1 base colour, 2 metallic-roughness, 4 normal,
+                       // 8 occlusion, 16 emissive), alpha mode (0 opaque, 1 mask, 2 blend),
+                       // flags (1 unlit, 2 vertex tangents, 4 vertex colours), UV set (bit k
+                       // set: texture k of the order above reads TEXCOORD_1)
+    vec4 u_uvTransform[10]; // per texture (same order) two rows of its KHR_texture_transform:
+                            // uv' = (dot(row0.xyz, (uv, 1)), dot(row1.xyz, (uv, 1)))
+};
+
+// Image-based light of the DERMIS_PBR programs (core/environment.hpp): the environment's
+// irradiance as order-2 spherical harmonics, its GGX-prefiltered radiance (u_envSpecular, one
+// mip level per roughness step) and the split-sum table (u_brdfLut).
+layout(std140, binding = 4) uniform EnvironmentBlock {
+    vec4 u_irradianceSh[9]; // rgb coefficients of E(n)/π (evalIrradiance)
+    vec4 u_envParams;       // exposure, cos(rotation), sin(rotation), last specular level
+    ivec4 u_envMode;        // tone mapping (0 none, 1 Khronos PBR Neutral, 2 ACES filmic), 0, 0, 0
 };

@@ -1,7 +1,9 @@
 // Skin pass, fragment stage: bump mapping from the height maps without precomputed tangents
 // (Mikkelsen, "Bump Mapping Unparametrized Surfaces on the GPU", 2010: the surface gradient from
-// screen-space derivatives), base colour, simple lighting. Writes linear colour; the sRGB render
-// target encodes it.
+// screen-space derivatives), then one of two shadings: "legacy", the base colour under one
+// Blinn-Phong key light and a hemisphere fill, or — DERMIS_PBR, `render.shading` "pbr" — glTF
+// metallic-roughness under image-based light (pbr.glsl), exposure and tone mapping. Writes linear
+// colour; the sRGB render target encodes it.
 //
 // Views (DERMIS_VIEW, FrameView in server/core/render_settings.hpp; one program per view, so that a
 // software rasterizer, which runs every branch for every pixel, shades only its view's code):
@@ -32,6 +34,11 @@ in vec2 v_uv;    // the model's TEXCOORD_0: base colour
 in vec2 v_mapUv; // the height-map layout's UV (SPEC §8): heights and UV outlines
 in vec3 v_restPosition; // bind space: surface decal outlines (SPEC §8)
 in vec3 v_restNormal;
+#ifdef DERMIS_PBR
+in vec4 v_tangent;
+in vec2 v_uv1;
+in vec4 v_color;
+#endif
 
 layout(location = 0) out vec4 o_color;
 
@@ -41,7 +48,9 @@ float surfaceHeight(vec2 uv) {
     return dot(textureLod(u_heightMap, uv, 0.0).rg, u_heights.yx);
 }
 
-vec3 perturbedNormal(vec3 n) {
+// The bump map's surface gradient (Mikkelsen 2010/2020): the normal bumped by the height maps is
+// normalize(n − bumpGradient(n)); zero where the part has no height-map UVs.
+vec3 bumpGradient(vec3 n) {
     // dH/du, dH/dv by differences one texel apart (three samples of the RG map).
     vec2 e = u_heightmapSize.zw;
     vec2 uv0 = v_mapUv - 0.5 * e;
@@ -54,9 +63,12 @@ vec3 perturbedNormal(vec3 n) {
     vec3 sigmaS = dFdx(v_position), sigmaT = dFdy(v_position);
     vec3 r1 = cross(sigmaT, n), r2 = cross(n, sigmaS);
     float det = dot(sigmaS, r1);
-    if (abs(det) < 1e-20) return n;
-    vec3 grad = sign(det) * (dBs * r1 + dBt * r2);
-    return normalize(abs(det) * n - grad);
+    if (abs(det) < 1e-20) return vec3(0.0);
+    return sign(det) * (dBs * r1 + dBt * r2) / abs(det);
+}
+
+vec3 perturbedNormal(vec3 n) {
+    return normalize(n - bumpGradient(n));
 }
 
 // The linear value the sRGB target encodes to picture value c (exact sRGB EOTF).
@@ -118,7 +130,9 @@ void main() {
     vec3 n = normalize(v_normal);
     vec3 toCamera = normalize(u_cameraPos.xyz - v_position);
     if (dot(n, toCamera) < 0.0) n = -n; // two-sided: back faces are lit like front faces
+#ifndef DERMIS_PBR
     if (u_part.z != 0) n = perturbedNormal(n);
+#endif
 
 #if DERMIS_VIEW == 1 || DERMIS_VIEW == 2 // bump or displacement height as grey
     vec2 heights = u_part.z != 0 ? textureLod(u_heightMap, v_mapUv, 0.0).rg : vec2(0.0);
@@ -126,6 +140,43 @@ void main() {
     o_color = vec4(outlined(pictureValue(vec3((128.0 + 127.0 * height) / 255.0))), 1.0);
 #elif DERMIS_VIEW == 3 // the perturbed world normal
     o_color = vec4(outlined(pictureValue(n * 0.5 + 0.5)), 1.0);
+#elif defined(DERMIS_PBR)
+    // glTF metallic-roughness under the environment (pbr.glsl); the model's normal map and the
+    // bump compose as surface gradients on the geometric normal.
+    vec3 ng = normalize(v_normal);
+    bool back = dot(ng, toCamera) < 0.0;
+    if (back) ng = -ng;
+    vec4 base = u_baseColor;
+    if ((u_maps.z & 4) != 0) base *= v_color;
+    if (hasMap(1)) base *= texture(u_baseColorTexture, materialUv(0, v_uv, v_uv1));
+    if (u_maps.y == 1 && base.a < u_emissive.w) discard;
+    vec3 color;
+    if ((u_maps.z & 1) != 0) {
+        color = base.rgb; // KHR_materials_unlit
+    } else {
+        vec3 gradient = u_part.z != 0 ? bumpGradient(ng) : vec3(0.0);
+        if (hasMap(4)) {
+            vec3 g = normalMapGradient(ng, materialUv(2, v_uv, v_uv1), v_tangent, v_position);
+            gradient += back ? -g : g;
+        }
+        vec3 nn = normalize(ng - gradient);
+        float metallic = u_material.x, roughness = u_material.y;
+        if (hasMap(2)) {
+            vec4 mr = texture(u_metallicRoughnessTexture, materialUv(1, v_uv, v_uv1));
+            roughness *= mr.g;
+            metallic *= mr.b;
+        }
+        metallic = clamp(metallic, 0.0, 1.0);
+        roughness = clamp(roughness, 0.03, 1.0);
+        float occlusion = 1.0;
+        if (hasMap(8))
+            occlusion = 1.0 + u_material.w * (texture(u_occlusionTexture, materialUv(3, v_uv, v_uv1)).r - 1.0);
+        color = shadePbr(base.rgb, metallic, roughness, occlusion, nn, toCamera);
+        vec3 emissive = u_emissive.rgb;
+        if (hasMap(16)) emissive *= texture(u_emissiveTexture, materialUv(4, v_uv, v_uv1)).rgb;
+        color += emissive;
+    }
+    o_color = vec4(outlined(toneMap(color)), u_maps.y == 2 ? clamp(base.a, 0.0, 1.0) : 1.0);
 #else
     vec4 base = u_baseColor;
     if (u_part.y != 0) base *= texture(u_baseColorTexture, v_uv);

@@ -15,6 +15,14 @@ out vec2 tc_uv[];
 out vec2 tc_mapUv[];
 out vec3 tc_restPosition[];
 out vec3 tc_restNormal[];
+#ifdef DERMIS_PBR
+in vec4 v_tangent[];
+in vec2 v_uv1[];
+in vec4 v_color[];
+out vec4 tc_tangent[];
+out vec2 tc_uv1[];
+out vec4 tc_color[];
+#endif
 
 vec2 toScreen(vec3 p) {
     vec4 c = u_viewProj * vec4(p, 1.0);
@@ -33,6 +41,11 @@ void main() {
     tc_mapUv[gl_InvocationID] = v_mapUv[gl_InvocationID];
     tc_restPosition[gl_InvocationID] = v_restPosition[gl_InvocationID];
     tc_restNormal[gl_InvocationID] = v_restNormal[gl_InvocationID];
+#ifdef DERMIS_PBR
+    tc_tangent[gl_InvocationID] = v_tangent[gl_InvocationID];
+    tc_uv1[gl_InvocationID] = v_uv1[gl_InvocationID];
+    tc_color[gl_InvocationID] = v_color[gl_InvocationID];
+#endif
     if (gl_InvocationID == 0) {
         // Outer level i is the edge opposite corner i.
         gl_TessLevelOuter[0] = edgeLevel(1, 2);

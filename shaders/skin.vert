@@ -10,6 +10,11 @@ layout(location = 2) in vec2 a_uv;
 layout(location = 3) in uvec4 a_joints;
 layout(location = 4) in vec4 a_weights;
 layout(location = 5) in vec2 a_mapUv; // the height maps' layout (SPEC §8); a_uv keeps the model's
+#ifdef DERMIS_PBR
+layout(location = 6) in vec4 a_tangent; // TANGENT (u_maps.z & 2), bind space
+layout(location = 7) in vec2 a_uv1;     // TEXCOORD_1 (zero when the model has none)
+layout(location = 8) in vec4 a_color;   // COLOR_0 (u_maps.z & 4)
+#endif
 
 // world(node_k) · inverseBind_k of every influence of every part; a part starts at u_part.x.
 layout(std430, binding = 0) readonly buffer Palette {
@@ -24,6 +29,11 @@ out vec2 v_uv;    // the model's TEXCOORD_0: base colour
 out vec2 v_mapUv; // the height-map layout's UV: bump, displacement, outlines
 out vec3 v_restPosition; // bind space (the rest surface, SPEC §8): surface decal outlines
 out vec3 v_restNormal;   // bind space, not normalised
+#ifdef DERMIS_PBR
+out vec4 v_tangent; // world space xyz (not normalised), w the bitangent's sign
+out vec2 v_uv1;
+out vec4 v_color;
+#endif
 
 void main() {
     int base = u_part.x;
@@ -38,6 +48,11 @@ void main() {
     v_mapUv = a_mapUv;
     v_restPosition = a_position;
     v_restNormal = a_normal;
+#ifdef DERMIS_PBR
+    v_tangent = vec4(mat3(m) * a_tangent.xyz, a_tangent.w);
+    v_uv1 = a_uv1;
+    v_color = a_color;
+#endif
 #if !defined(DERMIS_TESSELLATED) && !defined(DERMIS_CAPTURE)
     if (u_part.z != 0) p += n * (textureLod(u_heightMap, a_mapUv, 0.0).g * u_heights.x);
 #endif

@@ -332,6 +332,15 @@ int main(int argc, char** argv) {
                           "Anti-aliasing: auto (post on software rasterizers, else MSAA), msaa, post or none "
                           "(overrides render.aa)")
         ->check(CLI::IsMember({"auto", "msaa", "post", "none"}));
+    renderCmd->add_option("--shading", render.shading,
+                          "legacy (one key light, the look before PBR) or pbr (the model's glTF material "
+                          "under image-based light; overrides render.shading)")
+        ->check(CLI::IsMember({"legacy", "pbr"}));
+    renderCmd->add_option("--exposure", render.exposure, "pbr: light scale before tone mapping (overrides render.exposure)")
+        ->check(CLI::Range(0.0, 64.0));
+    renderCmd->add_option("--tone-mapping", render.toneMapping,
+                          "pbr: neutral (Khronos PBR Neutral), aces or none (overrides render.tone_mapping)")
+        ->check(CLI::IsMember({"neutral", "aces", "none"}));
     renderCmd->add_option("--view", render.view,
                           "shaded (default), or unlit: bump / displacement height as grey, normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));

@@ -67,6 +67,9 @@ int runRender(const RenderArgs& a) {
     overrides.view = frameViewFromString(a.view).value_or(FrameView::Shaded); // checked by CLI11
     if (a.msaa) overrides.msaa = a.msaa;
     if (!a.aa.empty()) overrides.aa = antiAliasingFromString(a.aa);
+    if (!a.shading.empty()) overrides.shading = shadingFromString(a.shading);
+    if (!a.toneMapping.empty()) overrides.toneMapping = toneMappingFromString(a.toneMapping);
+    if (a.exposure >= 0.0) overrides.exposure = a.exposure;
     if (!a.size.empty()) {
         int w = 0, h = 0;
         char tail = 0;

@@ -23,6 +23,9 @@ struct RenderArgs {
     double time = 0.0;
     int msaa = 0; ///< 0: the scene's render.msaa (given: MSAA with that many samples)
     std::string aa; ///< "": the scene's render.aa (or MSAA when msaa is given); auto|msaa|post|none
+    std::string shading;     ///< "": the scene's render.shading; legacy|pbr
+    std::string toneMapping; ///< "": the scene's render.tone_mapping; neutral|aces|none
+    double exposure = -1.0;  ///< < 0: the scene's render.exposure
     bool hasTime = false, heightmaps = false, resume = false;
     /// Print where the time went as one JSON line on stderr: start-up (context, programs, scene
     /// load, the wait for the renderer), the first frame's stages (with a GL sync between them)

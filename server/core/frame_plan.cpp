@@ -19,6 +19,9 @@ Result<FramePlan> planFrame(const Scene& scene, const Model& model, const Patter
         r.aa = AntiAliasing::Msaa;
     }
     if (o.aa) r.aa = *o.aa;
+    if (o.shading) r.shading = *o.shading;
+    if (o.exposure) r.exposure = *o.exposure;
+    if (o.toneMapping) r.toneMapping = *o.toneMapping;
     if (o.yaw) r.camera.yaw = *o.yaw;
     if (o.pitch) r.camera.pitch = *o.pitch;
     if (o.distance) r.camera.distance = *o.distance;

@@ -32,6 +32,9 @@ struct FrameOverrides {
     /// `msaa=1` is a frame without anti-aliasing); `aa` given sets the mode.
     std::optional<int> width, height, msaa;
     std::optional<AntiAliasing> aa;
+    std::optional<Shading> shading;         ///< render.shading
+    std::optional<double> exposure;         ///< render.exposure
+    std::optional<ToneMapping> toneMapping; ///< render.tone_mapping
     std::optional<double> yaw, pitch, distance;
     std::optional<std::array<double, 3>> target; ///< the camera's target (Camera::target)
     FrameView view = FrameView::Shaded; ///< what the frame shows (never in the scene)

@@ -31,6 +31,16 @@ int Model::findClip(const std::string& name) const {
     return -1;
 }
 
+glm::mat3 TextureUv::matrix() const {
+    // glTF KHR_texture_transform: T · R · S with R = [[cos, sin], [−sin, cos]] (rows).
+    const float c = std::cos(rotation), s = std::sin(rotation);
+    glm::mat3 m(1.0f);
+    m[0] = glm::vec3(c * scale.x, -s * scale.x, 0.0f);
+    m[1] = glm::vec3(s * scale.y, c * scale.y, 0.0f);
+    m[2] = glm::vec3(offset, 1.0f);
+    return m;
+}
+
 int Model::dominantBaseColorImage() const {
     std::vector<std::size_t> covered(images.size(), 0);
     for (const MeshPart& part : parts) {

@@ -40,6 +40,11 @@ struct MeshPart {
     std::vector<glm::vec3> positions;
     std::vector<glm::vec3> normals;       ///< unit; computed (area-weighted) when the file has none
     std::vector<glm::vec2> uvs;           ///< TEXCOORD_0; empty when the file has none
+    std::vector<glm::vec2> uvs1;          ///< TEXCOORD_1; empty when the file has none
+    /// TANGENT: unit xyz, w = ±1 the bitangent's sign (b = w·n × t); empty when the file has none
+    /// (the shading then builds the tangent frame per pixel from the UV derivatives).
+    std::vector<glm::vec4> tangents;
+    std::vector<glm::vec4> colors;        ///< COLOR_0 as linear RGBA; empty when the file has none
     std::vector<glm::u16vec4> joints;     ///< indices into `influences`, one per vertex
     std::vector<glm::vec4> weights;       ///< normalised (sum 1), one per vertex
     std::vector<std::uint32_t> indices;   ///< triangle list, 3 per triangle
@@ -53,10 +58,49 @@ struct Image8 {
     std::vector<std::uint8_t> rgba; ///< width·height·4 bytes
 };
 
+/// Which UV set a material's texture reads and its KHR_texture_transform:
+/// uv' = offset + R(rotation)·(scale ∘ uv), R rotating by `rotation` radians counter-clockwise in
+/// the extension's sense (glTF: T·R·S; a point (1, 0) scaled by 1 goes to (cos r, −sin r)).
+struct TextureUv {
+    int texCoord = 0; ///< 0: MeshPart::uvs (TEXCOORD_0), 1: MeshPart::uvs1 (TEXCOORD_1)
+    glm::vec2 offset{0.0f};
+    glm::vec2 scale{1.0f};
+    float rotation = 0.0f;
+    /// The 3×3 matrix of the transform (column-major, applied to (u, v, 1)).
+    glm::mat3 matrix() const;
+    bool operator==(const TextureUv&) const = default;
+};
+
+/// glTF 2.0 §3.9.4 alpha modes.
+enum class AlphaMode { Opaque, Mask, Blend };
+
+/// A glTF 2.0 metallic-roughness material (§3.9) with KHR_materials_emissive_strength and
+/// KHR_materials_unlit. Texture members are indices into Model::images (−1 for none); the images
+/// are plain RGBA8: base colour and emissive hold sRGB-encoded colour, the others linear data
+/// (metallic in B, roughness in G; occlusion in R; the normal map's xyz in RGB). Every value is as
+/// the file gives it, checked to be finite; the shading clamps ranges.
 struct Material {
     std::string name;
     glm::vec4 baseColorFactor{1.0f};
     int baseColorTexture = -1; ///< index into Model::images, −1 for none
+    TextureUv baseColorUv;
+    float metallicFactor = 1.0f;
+    float roughnessFactor = 1.0f;
+    int metallicRoughnessTexture = -1;
+    TextureUv metallicRoughnessUv;
+    int normalTexture = -1; ///< tangent space, OpenGL convention (+Y up in the image)
+    float normalScale = 1.0f;
+    TextureUv normalUv;
+    int occlusionTexture = -1;
+    float occlusionStrength = 1.0f;
+    TextureUv occlusionUv;
+    glm::vec3 emissiveFactor{0.0f}; ///< times KHR_materials_emissive_strength
+    int emissiveTexture = -1;
+    TextureUv emissiveUv;
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    float alphaCutoff = 0.5f;
+    bool doubleSided = false;
+    bool unlit = false; ///< KHR_materials_unlit: base colour only
 };
 
 enum class Interpolation { Linear, Step, CubicSpline };

@@ -45,6 +45,32 @@ std::optional<AntiAliasing> antiAliasingFromString(std::string_view s) {
     return std::nullopt;
 }
 
+std::string_view toString(Shading s) {
+    return s == Shading::Pbr ? "pbr" : "legacy";
+}
+
+std::optional<Shading> shadingFromString(std::string_view s) {
+    if (s == "legacy") return Shading::Legacy;
+    if (s == "pbr") return Shading::Pbr;
+    return std::nullopt;
+}
+
+std::string_view toString(ToneMapping t) {
+    switch (t) {
+    case ToneMapping::None: return "none";
+    case ToneMapping::Aces: return "aces";
+    case ToneMapping::Neutral: break;
+    }
+    return "neutral";
+}
+
+std::optional<ToneMapping> toneMappingFromString(std::string_view s) {
+    if (s == "none") return ToneMapping::None;
+    if (s == "neutral") return ToneMapping::Neutral;
+    if (s == "aces") return ToneMapping::Aces;
+    return std::nullopt;
+}
+
 std::string_view toString(FrameView v) {
     switch (v) {
     case FrameView::Shaded: return "shaded";
@@ -116,6 +142,12 @@ Status validateRenderSettings(const RenderSettings& r, const RenderLimits& limit
                    "must be in [0, " + fmt(kMaxBumpStrength) + "], got " + fmt(r.bumpStrength));
     if (r.msaa != 1 && r.msaa != 2 && r.msaa != 4)
         return bad("/render/msaa", "must be 1, 2 or 4, got " + std::to_string(r.msaa));
+    if (!(std::isfinite(r.exposure) && r.exposure >= 0.0 && r.exposure <= kMaxExposure))
+        return bad("/render/exposure", "must be in [0, " + fmt(kMaxExposure) + "], got " + fmt(r.exposure));
+    if (!(std::isfinite(r.environmentRotation) && std::abs(r.environmentRotation) <= kMaxTurnAngle))
+        return bad("/render/environment_rotation", "must be in [" + fmt(-kMaxTurnAngle) + ", " +
+                                                       fmt(kMaxTurnAngle) + "], got " +
+                                                       fmt(r.environmentRotation));
     return Ok{};
 }
 

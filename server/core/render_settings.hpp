@@ -43,6 +43,24 @@ enum class AntiAliasing { Auto, Msaa, Post, None };
 std::string_view toString(AntiAliasing a);
 std::optional<AntiAliasing> antiAliasingFromString(std::string_view s);
 
+/// How the skin pass shades (`render.shading`). Legacy: the base colour under one Blinn-Phong key
+/// light and a hemisphere fill (Dermis ≤ 2026-11; kept for comparisons). Pbr: the model's glTF
+/// metallic-roughness material (base colour, metallic-roughness, normal, occlusion and emissive
+/// textures, alpha modes, vertex colours, KHR_texture_transform, unlit) under image-based light
+/// from the default studio environment (core/environment.hpp), with exposure and tone mapping.
+enum class Shading { Legacy, Pbr };
+std::string_view toString(Shading s);
+std::optional<Shading> shadingFromString(std::string_view s);
+
+/// The display transform of `pbr` shading (`render.tone_mapping`): None clamps; Neutral is
+/// Khronos PBR Neutral; Aces the ACES filmic fit three.js uses (ACESFilmicToneMapping).
+enum class ToneMapping { None, Neutral, Aces };
+std::string_view toString(ToneMapping t);
+std::optional<ToneMapping> toneMappingFromString(std::string_view s);
+
+/// Largest `render.exposure` (a linear scale of the light before tone mapping).
+constexpr double kMaxExposure = 64.0;
+
 struct RenderSettings {
     std::array<int, 2> size{1024, 1024};
     Camera camera;
@@ -53,6 +71,10 @@ struct RenderSettings {
     /// "vertex": displace the mesh's own vertices (the paper); "tessellated": subdivide each
     /// triangle on the GPU first, so that bulges smaller than a triangle still move the surface.
     DisplacementMode displacement = DisplacementMode::Vertex;
+    Shading shading = Shading::Legacy;
+    double exposure = 1.0;                        ///< pbr: light × exposure before tone mapping
+    ToneMapping toneMapping = ToneMapping::Neutral; ///< pbr only
+    double environmentRotation = 0.0; ///< pbr: degrees the environment turns about +Y
 };
 
 /// What a frame shows of the posed, displaced character (a frame's choice, like its camera
@@ -95,7 +117,8 @@ ResolvedAntiAliasing resolveAntiAliasing(const RenderSettings& render, bool soft
 /// size sides in [1, kMaxRenderSize] (InvalidArgument) and ≤ limits.maxSide (TooLarge);
 /// camera yaw in [−kMaxTurnAngle, kMaxTurnAngle], pitch in [−90, 90], distance in (0, kMaxCameraDistance]
 /// when set; displacement_scale in [0, kMaxDisplacementScale] when set; bump_strength in
-/// [0, kMaxBumpStrength] (bounds in scene.hpp); msaa 1, 2 or 4.
+/// [0, kMaxBumpStrength] (bounds in scene.hpp); msaa 1, 2 or 4; exposure in [0, kMaxExposure];
+/// environment_rotation in [−kMaxTurnAngle, kMaxTurnAngle].
 /// `where` names the calling function in the message.
 Status validateRenderSettings(const RenderSettings& render, const RenderLimits& limits = {},
                               const char* where = "dermis::validateRenderSettings");

@@ -112,6 +112,15 @@ json toJson(const Scene& scene) {
     render["msaa"] = r.msaa;
     render["aa"] = std::string(toString(r.aa));
     render["displacement"] = std::string(toString(r.displacement));
+    // The shading members are written when they differ from their defaults, so that documents
+    // from before them keep their exact text (history, hashes).
+    const RenderSettings defaults;
+    if (r.shading != defaults.shading) render["shading"] = std::string(toString(r.shading));
+    if (r.exposure != defaults.exposure) render["exposure"] = r.exposure;
+    if (r.toneMapping != defaults.toneMapping)
+        render["tone_mapping"] = std::string(toString(r.toneMapping));
+    if (r.environmentRotation != defaults.environmentRotation)
+        render["environment_rotation"] = r.environmentRotation;
     doc["render"] = std::move(render);
     return doc;
 }

@@ -552,6 +552,27 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
         if (!e) return e.error();
         render.displacement = *e;
     }
+    if (const json* sh = Reader::find(v, "shading")) {
+        auto e = rd.enumeration(*sh, ptr + "/shading", shadingFromString, "\"legacy\" or \"pbr\"");
+        if (!e) return e.error();
+        render.shading = *e;
+    }
+    if (const json* ex = Reader::find(v, "exposure")) {
+        auto d = rd.number(*ex, ptr + "/exposure");
+        if (!d) return d.error();
+        render.exposure = *d;
+    }
+    if (const json* tm = Reader::find(v, "tone_mapping")) {
+        auto e = rd.enumeration(*tm, ptr + "/tone_mapping", toneMappingFromString,
+                                "\"neutral\", \"aces\" or \"none\"");
+        if (!e) return e.error();
+        render.toneMapping = *e;
+    }
+    if (const json* er = Reader::find(v, "environment_rotation")) {
+        auto d = rd.number(*er, ptr + "/environment_rotation");
+        if (!d) return d.error();
+        render.environmentRotation = *d;
+    }
     return validateRenderSettings(render, {}, kSceneWhere);
 }
 

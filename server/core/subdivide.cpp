@@ -61,6 +61,8 @@ Result<MeshPart> subdivideMidpoint(const MeshPart& part) {
     out.indices.reserve(part.indices.size() * 4);
     const bool hasNormals = part.normals.size() == nv, hasUVs = part.uvs.size() == nv;
     const bool hasSkin = part.joints.size() == nv && part.weights.size() == nv;
+    const bool hasUVs1 = part.uvs1.size() == nv, hasTangents = part.tangents.size() == nv,
+               hasColors = part.colors.size() == nv;
     std::unordered_map<std::uint64_t, std::uint32_t> midpoints;
     midpoints.reserve(part.indices.size());
     auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
@@ -74,6 +76,14 @@ Result<MeshPart> subdivideMidpoint(const MeshPart& part) {
             out.normals.push_back(len > 0.0f ? n / len : out.normals[a]);
         }
         if (hasUVs) out.uvs.push_back(0.5f * (out.uvs[a] + out.uvs[b]));
+        if (hasUVs1) out.uvs1.push_back(0.5f * (out.uvs1[a] + out.uvs1[b]));
+        if (hasColors) out.colors.push_back(0.5f * (out.colors[a] + out.colors[b]));
+        if (hasTangents) {
+            const glm::vec3 t = glm::vec3(out.tangents[a]) + glm::vec3(out.tangents[b]);
+            const float len = glm::length(t);
+            out.tangents.push_back(len > 0.0f ? glm::vec4(t / len, out.tangents[a].w)
+                                              : out.tangents[a]);
+        }
         if (hasSkin) {
             auto [j, w] = blendSkin(out.joints[a], out.weights[a], out.joints[b], out.weights[b]);
             out.joints.push_back(j);

@@ -64,6 +64,9 @@ Model modelThroughLayout(const Model& model, const TextureLayout& layout) {
         part.normals = gather(src.normals);
         part.joints = gather(src.joints);
         part.weights = gather(src.weights);
+        part.uvs1 = gather(src.uvs1);
+        part.tangents = gather(src.tangents);
+        part.colors = gather(src.colors);
         part.uvs = pl.uvs;
         part.indices = pl.indices;
     }

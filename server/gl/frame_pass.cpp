@@ -142,7 +142,8 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     const double dispScale = rs.displacementScale ? *rs.displacementScale : (*gm)->autoDisplacement;
     const double bumpScale = 0.25 * (*gm)->autoDisplacement * rs.bumpStrength;
     // Framed on the posed bounds (CPU skinning of the same pose: cheap at these sizes).
-    const Bounds bounds = framingBounds(skin(model, req.world));
+    const std::vector<SkinnedPart> posed = skin(model, req.world);
+    const Bounds bounds = framingBounds(posed);
     out.boundsMin = bounds.min;
     out.boundsMax = bounds.max;
     const FrameCamera camera = frameCamera(bounds.min, bounds.max, dispScale, rs.camera, W, H);
@@ -150,10 +151,18 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     out.cameraDistance = camera.distance;
     uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
     uploadOutlineBlock(req.outlines);
-    const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view);
-    const GLuint program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view);
-    const GLuint readFbo =
-        drawSkinPass(model, **gm, **parts, rs, program, heightSource->texture, partStride, samples);
+    const bool pbr = rs.shading == Shading::Pbr && req.view == FrameView::Shaded;
+    if (pbr) {
+        ensureEnvironment();
+        uploadEnvironmentBlock(rs);
+    }
+    const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view, pbr);
+    const GLuint program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr);
+    std::vector<std::size_t> order(parts.value()->size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    if (pbr) order = pbrDrawOrder(model, **parts, posed, camera.eye);
+    const GLuint readFbo = drawSkinPass(model, **gm, **parts, rs, program, heightSource->texture,
+                                        partStride, samples, pbr ? &order : nullptr);
     if (auto s = checkGl("skin pass"); !s) return s.error();
     if (req.profile) glFinish();
     out.timings.skinMs = msSince(t0);
@@ -232,7 +241,8 @@ void Renderer::Impl::uploadOutlineBlock(const std::vector<FrameOutline>& outline
 /// part.w (informative: skin.frag's program variant, DERMIS_VIEW, draws the view); returns the
 /// stride.
 std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm,
-                                             const std::vector<GpuModel::Part>& parts, FrameView view) {
+                                             const std::vector<GpuModel::Part>& parts, FrameView view,
+                                             bool pbr) {
     const std::size_t stride = uboStride(sizeof(PartBlock));
     std::vector<std::uint8_t> partBlocks(stride * std::max<std::size_t>(1, parts.size()), 0);
     for (std::size_t pi = 0; pi < parts.size(); ++pi) {
@@ -244,6 +254,7 @@ std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel&
         const bool textured = gm.baseColorTexture(model, gp) != 0 && gp.hasUVs;
         pb.part = glm::ivec4(gp.paletteOffset, textured ? 1 : 0, gp.hasMapUVs ? 1 : 0,
                              static_cast<int>(view));
+        if (pbr) fillMaterialBlock(pb, model, gm, gp);
         std::memcpy(partBlocks.data() + stride * pi, &pb, sizeof pb);
     }
     glBindBuffer(GL_UNIFORM_BUFFER, partUbo);
@@ -256,7 +267,8 @@ std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel&
 GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
                                     const std::vector<GpuModel::Part>& parts,
                                     const RenderSettings& rs, GLuint skinProgram,
-                                    GLuint heightTexture, std::size_t partStride, int samples) {
+                                    GLuint heightTexture, std::size_t partStride, int samples,
+                                    const std::vector<std::size_t>* pbrOrder) {
     const int W = frame.width, H = frame.height;
     glBindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
     glViewport(0, 0, W, H);
@@ -276,18 +288,37 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
     if (tess) glPatchParameteri(GL_PATCH_VERTICES, 3);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, heightTexture);
-    for (std::size_t pi = 0; pi < parts.size(); ++pi) {
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        const std::size_t pi = pbrOrder ? (*pbrOrder)[k] : k;
         const GpuModel::Part& gp = parts[pi];
         if (gp.indexCount == 0) continue;
         glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
                           static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));
-        glActiveTexture(GL_TEXTURE2);
-        const GLuint colorTex = gm.baseColorTexture(model, gp);
-        glBindTexture(GL_TEXTURE_2D, colorTex ? colorTex : whiteTexture);
+        if (pbrOrder) {
+            bindMaterialTextures(model, gm, gp, whiteTexture);
+            // glTF BLEND: over what is behind, without hiding what is drawn after it.
+            const bool blend = gp.material >= 0 &&
+                               static_cast<std::size_t>(gp.material) < model.materials.size() &&
+                               model.materials[static_cast<std::size_t>(gp.material)].alphaMode == AlphaMode::Blend;
+            if (blend) {
+                glEnable(GL_BLEND);
+                glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+                glDepthMask(GL_FALSE);
+            } else {
+                glDisable(GL_BLEND);
+                glDepthMask(GL_TRUE);
+            }
+        } else {
+            glActiveTexture(GL_TEXTURE2);
+            const GLuint colorTex = gm.baseColorTexture(model, gp);
+            glBindTexture(GL_TEXTURE_2D, colorTex ? colorTex : whiteTexture);
+        }
         glBindVertexArray(gp.vao);
         glDrawElements(tess ? GL_PATCHES : GL_TRIANGLES, gp.indexCount, GL_UNSIGNED_INT, nullptr);
     }
     glBindVertexArray(0);
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
     GLuint readFbo = frame.fbo;
     if (samples > 1) {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, frame.fbo);

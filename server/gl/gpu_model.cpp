@@ -27,7 +27,7 @@ namespace {
 void destroyParts(std::vector<GpuModel::Part>& parts) {
     for (GpuModel::Part& p : parts) {
         glDeleteVertexArrays(1, &p.vao);
-        glDeleteBuffers(7, p.buffers);
+        glDeleteBuffers(10, p.buffers);
     }
     parts.clear();
 }
@@ -40,6 +40,9 @@ void GpuModel::destroy() {
     layouts.clear();
     if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
     textures.clear();
+    for (GLuint& t : dataTextures)
+        if (t) glDeleteTextures(1, &t);
+    dataTextures.clear();
 }
 
 namespace {
@@ -65,7 +68,7 @@ struct SrgbTables {
 /// source texels, colour averaged in linear light, alpha as stored. What glGenerateMipmap does
 /// for sRGB textures, on the CPU: llvmpipe's blit-based glGenerateMipmap took 150–300 ms for a
 /// 1024² texture (the JIT of its blit shaders, on every process start), this takes ~5 ms.
-Image8 halveSrgb(const Image8& src, const SrgbTables& t) {
+Image8 halveSrgb(const Image8& src, const SrgbTables& t, bool linear = false) {
     Image8 dst;
     dst.width = std::max(1, src.width / 2);
     dst.height = std::max(1, src.height / 2);
@@ -79,21 +82,24 @@ Image8 halveSrgb(const Image8& src, const SrgbTables& t) {
                 for (int i = 0; i < sx; ++i) {
                     const std::uint8_t* p =
                         &src.rgba[(static_cast<std::size_t>(y * sy + j) * src.width + x * sx + i) * 4];
-                    acc[0] += t.toLinear[p[0]];
-                    acc[1] += t.toLinear[p[1]];
-                    acc[2] += t.toLinear[p[2]];
+                    for (int c = 0; c < 3; ++c)
+                        acc[c] += linear ? p[c] / 255.0f : t.toLinear[p[c]];
                     acc[3] += p[3];
                 }
             std::uint8_t* d = &dst.rgba[(static_cast<std::size_t>(y) * dst.width + x) * 4];
             for (int c = 0; c < 3; ++c)
-                d[c] = t.toSrgb[std::min(65535, static_cast<int>(acc[c] * inv * 65536.0f))];
+                d[c] = linear ? static_cast<std::uint8_t>(std::lround(acc[c] * inv * 255.0f))
+                              : t.toSrgb[std::min(65535, static_cast<int>(acc[c] * inv * 65536.0f))];
             d[3] = static_cast<std::uint8_t>(std::lround(acc[3] * inv));
         }
     return dst;
 }
 
-/// An sRGB texture of `img` with mipmaps; a 1×1 white one when `img` is empty or malformed.
-GLuint uploadImage(const Image8& img) {
+/// An sRGB texture of `img` with mipmaps (`linear`: RGBA8, for data such as normal maps, mips
+/// averaged as stored); a 1×1 white one when `img` is empty or malformed. Wraps (glTF's default
+/// sampler).
+GLuint uploadImage(const Image8& img, bool linear = false) {
+    const GLenum format = linear ? GL_RGBA8 : GL_SRGB8_ALPHA8;
     GLuint tex = 0;
     glGenTextures(1, &tex);
     glBindTexture(GL_TEXTURE_2D, tex);
@@ -101,7 +107,7 @@ GLuint uploadImage(const Image8& img) {
         img.rgba.size() == static_cast<std::size_t>(img.width) * img.height * 4) {
         const int levels =
             1 + static_cast<int>(std::floor(std::log2(std::max(img.width, img.height))));
-        glTexStorage2D(GL_TEXTURE_2D, levels, GL_SRGB8_ALPHA8, img.width, img.height);
+        glTexStorage2D(GL_TEXTURE_2D, levels, format, img.width, img.height);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
         glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, img.width, img.height, GL_RGBA, GL_UNSIGNED_BYTE,
                         img.rgba.data());
@@ -109,7 +115,7 @@ GLuint uploadImage(const Image8& img) {
         Image8 level;
         const Image8* prev = &img;
         for (int k = 1; k < levels; ++k) {
-            level = halveSrgb(*prev, tables);
+            level = halveSrgb(*prev, tables, linear);
             glTexSubImage2D(GL_TEXTURE_2D, k, 0, 0, level.width, level.height, GL_RGBA,
                             GL_UNSIGNED_BYTE, level.rgba.data());
             prev = &level;
@@ -118,7 +124,7 @@ GLuint uploadImage(const Image8& img) {
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
     } else {
         const std::uint8_t white[4] = {255, 255, 255, 255};
-        glTexStorage2D(GL_TEXTURE_2D, 1, GL_SRGB8_ALPHA8, 1, 1);
+        glTexStorage2D(GL_TEXTURE_2D, 1, format, 1, 1);
         glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, white);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     }
@@ -131,9 +137,15 @@ GLuint uploadImage(const Image8& img) {
 std::size_t uploadBytes(const Model& m) {
     std::size_t bytes = 0;
     for (const MeshPart& part : m.parts)
-        bytes += part.positions.size() * 56 + part.indices.size() * 4;
+        bytes += part.positions.size() * 56 + part.indices.size() * 4 +
+                 (part.tangents.size() + part.colors.size()) * 16 + part.uvs1.size() * 8;
     for (const Image8& img : m.images)
         bytes += static_cast<std::size_t>(std::max(img.width, 1)) * std::max(img.height, 1) * 4 * 4 / 3;
+    for (const Material& mat : m.materials) // the linear copies (counted per use: an upper bound)
+        for (int t : {mat.metallicRoughnessTexture, mat.normalTexture, mat.occlusionTexture})
+            if (t >= 0 && static_cast<std::size_t>(t) < m.images.size())
+                bytes += static_cast<std::size_t>(std::max(m.images[static_cast<std::size_t>(t)].width, 1)) *
+                         std::max(m.images[static_cast<std::size_t>(t)].height, 1) * 4 * 4 / 3;
     return bytes;
 }
 
@@ -143,6 +155,9 @@ std::size_t uploadBytes(const Model& m) {
 struct PartAttributes {
     std::vector<glm::vec3> normals;
     std::vector<glm::vec2> uvs;
+    std::vector<glm::vec4> tangents; ///< empty, or one per vertex (MeshPart::tangents)
+    std::vector<glm::vec2> uvs1;     ///< empty, or one per vertex
+    std::vector<glm::vec4> colors;   ///< empty, or one per vertex
     std::vector<glm::u16vec4> joints;
     std::vector<glm::vec4> weights;
     std::vector<std::uint32_t> indices;
@@ -153,6 +168,9 @@ PartAttributes partAttributes(const MeshPart& part, bool hasUVs) {
     PartAttributes a;
     a.normals = part.normals.size() == nv ? part.normals : computeNormals(part.positions, part.indices);
     a.uvs = hasUVs ? part.uvs : std::vector<glm::vec2>(nv, glm::vec2(0.0f));
+    if (part.tangents.size() == nv) a.tangents = part.tangents;
+    if (part.uvs1.size() == nv) a.uvs1 = part.uvs1;
+    if (part.colors.size() == nv) a.colors = part.colors;
     a.joints.assign(nv, glm::u16vec4(0));
     a.weights.assign(nv, glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
     if (part.joints.size() == nv && part.weights.size() == nv) {
@@ -197,6 +215,23 @@ void uploadArrays(GpuModel::Part& gp, const std::vector<glm::vec3>& positions,
     glGenVertexArrays(1, &gp.vao);
     glBindVertexArray(gp.vao);
     glGenBuffers(mapUvs ? 7 : 6, gp.buffers);
+    // Slots 6–8 only where the part has them (the shader reads them only when PartBlock says so).
+    const std::vector<glm::vec4>* extras4[2] = {&a.tangents, &a.colors};
+    const int extraSlots4[2] = {6, 8};
+    const int extraBuffers4[2] = {7, 9};
+    for (int k = 0; k < 2; ++k) {
+        if (extras4[k]->size() != nv || nv == 0) continue;
+        glGenBuffers(1, &gp.buffers[extraBuffers4[k]]);
+        attribute(gp.buffers[extraBuffers4[k]], extraSlots4[k], extras4[k]->data(),
+                  nv * sizeof(glm::vec4), 4, GL_FLOAT, false);
+    }
+    if (a.uvs1.size() == nv && nv > 0) {
+        glGenBuffers(1, &gp.buffers[8]);
+        attribute(gp.buffers[8], 7, a.uvs1.data(), nv * sizeof(glm::vec2), 2, GL_FLOAT, false);
+    }
+    gp.hasTangents = a.tangents.size() == nv && nv > 0;
+    gp.hasColors = a.colors.size() == nv && nv > 0;
+    gp.hasUVs1 = a.uvs1.size() == nv && nv > 0;
     attribute(gp.buffers[0], 0, positions.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
     attribute(gp.buffers[1], 1, a.normals.data(), nv * sizeof(glm::vec3), 3, GL_FLOAT, false);
     attribute(gp.buffers[2], 2, a.uvs.data(), nv * sizeof(glm::vec2), 2, GL_FLOAT, false);
@@ -247,6 +282,9 @@ std::size_t uploadLayoutPart(const MeshPart& part, const PartLayout& pl, GpuMode
     a.uvs.resize(lv);
     a.joints.resize(lv);
     a.weights.resize(lv);
+    if (!src.tangents.empty()) a.tangents.resize(lv);
+    if (!src.uvs1.empty()) a.uvs1.resize(lv);
+    if (!src.colors.empty()) a.colors.resize(lv);
     for (std::size_t v = 0; v < lv; ++v) {
         const std::uint32_t s = source[v];
         positions[v] = nv ? part.positions[s] : glm::vec3(0.0f);
@@ -254,6 +292,9 @@ std::size_t uploadLayoutPart(const MeshPart& part, const PartLayout& pl, GpuMode
         a.uvs[v] = nv ? src.uvs[s] : glm::vec2(0.0f);
         a.joints[v] = nv ? src.joints[s] : glm::u16vec4(0);
         a.weights[v] = nv ? src.weights[s] : glm::vec4(1, 0, 0, 0);
+        if (!a.tangents.empty()) a.tangents[v] = src.tangents[s];
+        if (!a.uvs1.empty()) a.uvs1[v] = src.uvs1[s];
+        if (!a.colors.empty()) a.colors[v] = src.colors[s];
     }
     std::vector<glm::vec2> mapUvs(pl.uvs.begin(), pl.uvs.begin() + static_cast<long>(lv));
     for (std::size_t i = 0; i + 2 < pl.indices.size(); i += 3)
@@ -296,8 +337,15 @@ Result<GpuModel*> Renderer::Impl::modelFor(const std::shared_ptr<const Model>& m
     gm.bytes = uploadBytes(m);
     gm.lastUse = useCounter;
     makeRoom(gm.bytes);
-    for (const Image8& img : m.images)
-        gm.textures.push_back(uploadImage(img));
+    // Images a material reads as data get a linear texture too (the sRGB one decodes colour).
+    std::vector<char> asData(m.images.size(), 0);
+    for (const Material& mat : m.materials)
+        for (int t : {mat.metallicRoughnessTexture, mat.normalTexture, mat.occlusionTexture})
+            if (t >= 0 && static_cast<std::size_t>(t) < asData.size()) asData[static_cast<std::size_t>(t)] = 1;
+    for (std::size_t i = 0; i < m.images.size(); ++i) {
+        gm.textures.push_back(uploadImage(m.images[i]));
+        gm.dataTextures.push_back(asData[i] ? uploadImage(m.images[i], true) : 0);
+    }
     for (const MeshPart& part : m.parts) {
         GpuModel::Part gp;
         const std::size_t nv = part.positions.size();

@@ -51,7 +51,18 @@ Result<unsigned> buildProgram(const ProgramDesc& desc) {
             cleanup();
             return makeError(ErrorCode::Internal, where, std::string(file), "no such embedded shader");
         }
-        const std::string text = header + "#line 1\n" + std::string(body);
+        std::string text = header;
+        for (const auto& [stage, include] : desc.includes) {
+            if (stage != type) continue;
+            const std::string_view inc = shaderSource(include);
+            if (inc.empty()) {
+                cleanup();
+                return makeError(ErrorCode::Internal, where, std::string(include),
+                                 "no such embedded shader");
+            }
+            text += "#line 1\n" + std::string(inc);
+        }
+        text += "#line 1\n" + std::string(body);
         const char* src = text.c_str();
         GLuint sh = glCreateShader(type);
         shaders.push_back(sh);

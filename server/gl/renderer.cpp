@@ -124,14 +124,17 @@ Status Renderer::Impl::buildPrograms() {
         if (!p) return p.error();
         *b.out = *p;
     }
-    for (bool tess : {false, true})
+    for (bool tess : {false, true}) {
         for (FrameView view : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal})
             if (auto p = buildSkinProgram(tess, view); !p) return p.error();
             else skinPrograms[tess ? 1 : 0][static_cast<int>(view)] = *p;
+        if (auto p = buildSkinProgram(tess, FrameView::Shaded, true); !p) return p.error();
+        else pbrPrograms[tess ? 1 : 0] = *p;
+    }
     return Ok{};
 }
 
-Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view) {
+Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool pbr) {
     ProgramDesc desc;
     desc.stages = {{GL_VERTEX_SHADER, "skin.vert"}};
     if (tess) {
@@ -141,6 +144,10 @@ Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view) {
     }
     desc.stages.push_back({GL_FRAGMENT_SHADER, "skin.frag"});
     desc.defines.push_back("DERMIS_VIEW " + std::to_string(static_cast<int>(view)));
+    if (pbr) {
+        desc.defines.push_back("DERMIS_PBR");
+        desc.includes.push_back({GL_FRAGMENT_SHADER, "pbr.glsl"});
+    }
     return buildProgram(desc);
 }
 
@@ -188,6 +195,14 @@ void Renderer::Impl::shutdown() {
             glDeleteProgram(p);
             p = 0;
         }
+    for (GLuint& p : pbrPrograms) {
+        glDeleteProgram(p);
+        p = 0;
+    }
+    glDeleteTextures(1, &envSpecularTexture);
+    glDeleteTextures(1, &brdfLutTexture);
+    glDeleteBuffers(1, &environmentUbo);
+    envSpecularTexture = brdfLutTexture = environmentUbo = 0;
     GLuint bufs[6] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer, outlineUbo};
     glDeleteBuffers(6, bufs);
     glDeleteVertexArrays(1, &emptyVao);
@@ -198,7 +213,8 @@ void Renderer::Impl::shutdown() {
 }
 
 Result<Renderer::BlockLayout> Renderer::Impl::blockLayout(const std::string& block) {
-    GLuint program = block == "HeightPassBlock" ? heightProgram : skinPrograms[1][0];
+    // The tessellated PBR program uses every member of the skin pass's blocks.
+    GLuint program = block == "HeightPassBlock" ? heightProgram : pbrPrograms[1];
     const GLuint index = glGetUniformBlockIndex(program, block.c_str());
     if (index == GL_INVALID_INDEX)
         return makeError(ErrorCode::NotFound, kWhere, block, "no such uniform block");

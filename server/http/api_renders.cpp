@@ -70,7 +70,8 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
     if (!intParam(req, res, "width", p.width) || !intParam(req, res, "height", p.height) ||
         !intParam(req, res, "msaa", p.msaa) || !numberParam(req, res, "yaw", p.yaw) ||
         !numberParam(req, res, "pitch", p.pitch) || !numberParam(req, res, "distance", p.distance) ||
-        !numberParam(req, res, "time", p.time) || !targetParam(req, res, p.target))
+        !numberParam(req, res, "time", p.time) || !numberParam(req, res, "exposure", p.exposure) ||
+        !targetParam(req, res, p.target))
         return false;
     if (req.has_param("highlight")) {
         p.highlight = idList(req.get_param_value("highlight"));
@@ -124,6 +125,23 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
             return false;
         }
         p.aa = *aa;
+    }
+    if (req.has_param("shading")) {
+        const auto shading = shadingFromString(req.get_param_value("shading"));
+        if (!shading) {
+            sendError(res, 422, "invalid_argument", "dermis::Api: shading: must be legacy or pbr", "shading");
+            return false;
+        }
+        p.shading = *shading;
+    }
+    if (req.has_param("tone_mapping")) {
+        const auto tm = toneMappingFromString(req.get_param_value("tone_mapping"));
+        if (!tm) {
+            sendError(res, 422, "invalid_argument", "dermis::Api: tone_mapping: must be neutral, aces or none",
+                      "tone_mapping");
+            return false;
+        }
+        p.toneMapping = *tm;
     }
     if (req.has_param("view")) {
         const auto view = frameViewFromString(req.get_param_value("view"));
@@ -229,6 +247,7 @@ bool framePostParams(const Req& req, Res& res, Req& out) {
     static const std::set<std::string> known = {"format", "width", "height", "msaa", "aa", "yaw", "pitch",
                                                 "distance", "time", "target", "highlight", "hover",
                                                 "brush", "surface_brush", "view", "patterns", "only",
+                                                "shading", "exposure", "tone_mapping",
                                                 "preview", "revision"};
     json body;
     if (!jsonBody(req, res, body)) return false;

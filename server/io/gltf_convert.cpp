@@ -1,5 +1,5 @@
 // glTF → Model for the loader of gltf_loader.hpp: the Converter reads the tinygltf model (nodes
-// with rest TRS and parents, skins, materials with base-colour textures, the triangle primitives
+// with rest TRS and parents, skins, metallic-roughness materials, the triangle primitives
 // of the default scene's meshes, skin weights or rigid influences, animations), validating
 // everything it reads; accessors go through readAccessor (gltf_accessors.cpp).
 #include "gltf_internal.hpp"
@@ -188,49 +188,158 @@ class Converter {
         return Ok{};
     }
 
-    // --- materials: base colour factor and texture → compact Model::images --------------------
+    // --- materials: glTF metallic-roughness → Material, textures → compact Model::images -------
+    std::map<int, int> imageSlot_; // glTF image → index in Model::images
+
+    /// The Model::images index of glTF texture `tex` (its image captured for decoding on first
+    /// use); −1 for a texture with no core `source` (e.g. only KHR_texture_basisu: untextured).
+    Result<int> textureImage(int tex, const std::string& field) {
+        if (static_cast<std::size_t>(tex) >= g_.textures.size())
+            return parseError(field + "/index", "texture " + str(tex) + " does not exist");
+        const int image = g_.textures[static_cast<std::size_t>(tex)].source;
+        if (image < 0) return -1;
+        if (static_cast<std::size_t>(image) >= g_.images.size())
+            return parseError("/textures/" + str(tex) + "/source",
+                              "image " + str(image) + " does not exist");
+        auto [it, inserted] = imageSlot_.emplace(image, static_cast<int>(imageSlot_.size()));
+        if (inserted) {
+            auto cap = captured_.images.find(image);
+            if (cap == captured_.images.end())
+                return makeError(ErrorCode::NotFound, kWhere, "/images/" + str(image),
+                                 "image data not available (external file missing "
+                                 "or outside the model's folder)");
+            PendingImages::Entry e = std::move(cap->second);
+            e.imageIndex = it->second;
+            pending_.entries.push_back(std::move(e));
+        }
+        return it->second;
+    }
+
+    /// A finite number (in float range) from the extension value `v` into `out`; false if not.
+    static bool number(const tg::Value& v, float& out) {
+        if (!v.IsNumber() || !fitsFloat(v.GetNumberAsDouble())) return false;
+        out = static_cast<float>(v.GetNumberAsDouble());
+        return true;
+    }
+    /// `n` finite numbers from the extension value `v` into `out`; false if not.
+    static bool numbers(const tg::Value& v, int n, float* out) {
+        if (!v.IsArray() || v.ArrayLen() != static_cast<std::size_t>(n)) return false;
+        for (int k = 0; k < n; ++k)
+            if (!number(v.Get(k), out[k])) return false;
+        return true;
+    }
+
+    /// A textureInfo (index, texCoord, KHR_texture_transform) into `image` and `uv`. A texCoord
+    /// other than 0 or 1 leaves the texture out (Dermis reads two UV sets).
+    Status textureInfo(const tg::TextureInfo& info, const std::string& field, int& image,
+                       TextureUv& uv) {
+        return textureRef(info.index, info.texCoord, info.extensions, field, image, uv);
+    }
+    Status textureRef(int index, int texCoord, const tg::ExtensionMap& extensions,
+                      const std::string& field, int& image, TextureUv& uv) {
+        if (index < 0) return Ok{};
+        uv.texCoord = texCoord;
+        if (auto ext = extensions.find("KHR_texture_transform"); ext != extensions.end()) {
+            const tg::Value& t = ext->second;
+            const std::string f = field + "/extensions/KHR_texture_transform";
+            if (t.Has("offset") && !numbers(t.Get("offset"), 2, &uv.offset.x))
+                return parseError(f + "/offset", "must be 2 finite numbers");
+            if (t.Has("scale") && !numbers(t.Get("scale"), 2, &uv.scale.x))
+                return parseError(f + "/scale", "must be 2 finite numbers");
+            if (t.Has("rotation") && !number(t.Get("rotation"), uv.rotation))
+                return parseError(f + "/rotation", "must be a finite number");
+            if (t.Has("texCoord")) {
+                const tg::Value& tc = t.Get("texCoord");
+                if (!tc.IsInt()) return parseError(f + "/texCoord", "must be an integer");
+                uv.texCoord = tc.Get<int>();
+            }
+        }
+        if (uv.texCoord < 0 || uv.texCoord > 1) return Ok{}; // TEXCOORD_2+: not read
+        auto img = textureImage(index, field);
+        if (!img) return img.error();
+        image = *img;
+        return Ok{};
+    }
+
     Status materials() {
-        std::map<int, int> imageSlot; // glTF image → index in Model::images
         for (std::size_t i = 0; i < g_.materials.size(); ++i) {
             const tg::Material& src = g_.materials[i];
-            const std::string field = "/materials/" + str(i) + "/pbrMetallicRoughness";
+            const std::string mfield = "/materials/" + str(i);
+            const std::string field = mfield + "/pbrMetallicRoughness";
+            const tg::PbrMetallicRoughness& pbr = src.pbrMetallicRoughness;
             Material dst;
             dst.name = src.name;
-            const auto& f = src.pbrMetallicRoughness.baseColorFactor;
+            const auto& f = pbr.baseColorFactor;
             if (!f.empty()) {
                 if (f.size() != 4 || !allFitFloat(f))
                     return parseError(field + "/baseColorFactor", "must be 4 finite float numbers");
                 dst.baseColorFactor = glm::vec4(glm::dvec4(f[0], f[1], f[2], f[3]));
             }
-            const int tex = src.pbrMetallicRoughness.baseColorTexture.index;
-            if (tex >= 0) {
-                if (static_cast<std::size_t>(tex) >= g_.textures.size())
-                    return parseError(field + "/baseColorTexture/index",
-                                      "texture " + str(tex) + " does not exist");
-                const int image = g_.textures[static_cast<std::size_t>(tex)].source;
-                if (image >= 0) {
-                    if (static_cast<std::size_t>(image) >= g_.images.size())
-                        return parseError("/textures/" + str(tex) + "/source",
-                                          "image " + str(image) + " does not exist");
-                    auto [it, inserted] =
-                        imageSlot.emplace(image, static_cast<int>(imageSlot.size()));
-                    if (inserted) {
-                        auto cap = captured_.images.find(image);
-                        if (cap == captured_.images.end())
-                            return makeError(ErrorCode::NotFound, kWhere, "/images/" + str(image),
-                                             "image data not available (external file missing "
-                                             "or outside the model's folder)");
-                        PendingImages::Entry e = std::move(cap->second);
-                        e.imageIndex = it->second;
-                        pending_.entries.push_back(std::move(e));
-                    }
-                    dst.baseColorTexture = it->second;
-                }
-                // A texture with no core `source` (e.g. only KHR_texture_basisu): untextured.
+            if (!fitsFloat(pbr.metallicFactor))
+                return parseError(field + "/metallicFactor", "must be a finite float number");
+            if (!fitsFloat(pbr.roughnessFactor))
+                return parseError(field + "/roughnessFactor", "must be a finite float number");
+            dst.metallicFactor = static_cast<float>(pbr.metallicFactor);
+            dst.roughnessFactor = static_cast<float>(pbr.roughnessFactor);
+            if (auto s = textureInfo(pbr.baseColorTexture, field + "/baseColorTexture",
+                                     dst.baseColorTexture, dst.baseColorUv);
+                !s)
+                return s;
+            if (auto s = textureInfo(pbr.metallicRoughnessTexture,
+                                     field + "/metallicRoughnessTexture",
+                                     dst.metallicRoughnessTexture, dst.metallicRoughnessUv);
+                !s)
+                return s;
+            const tg::NormalTextureInfo& nt = src.normalTexture;
+            if (auto s = textureRef(nt.index, nt.texCoord, nt.extensions, mfield + "/normalTexture",
+                                    dst.normalTexture, dst.normalUv);
+                !s)
+                return s;
+            if (!fitsFloat(nt.scale))
+                return parseError(mfield + "/normalTexture/scale", "must be a finite float number");
+            dst.normalScale = static_cast<float>(nt.scale);
+            const tg::OcclusionTextureInfo& ot = src.occlusionTexture;
+            if (auto s = textureRef(ot.index, ot.texCoord, ot.extensions,
+                                    mfield + "/occlusionTexture", dst.occlusionTexture,
+                                    dst.occlusionUv);
+                !s)
+                return s;
+            if (!fitsFloat(ot.strength))
+                return parseError(mfield + "/occlusionTexture/strength",
+                                  "must be a finite float number");
+            dst.occlusionStrength = static_cast<float>(ot.strength);
+            if (auto s = textureInfo(src.emissiveTexture, mfield + "/emissiveTexture",
+                                     dst.emissiveTexture, dst.emissiveUv);
+                !s)
+                return s;
+            if (!src.emissiveFactor.empty()) {
+                const auto& e = src.emissiveFactor;
+                if (e.size() != 3 || !allFitFloat(e))
+                    return parseError(mfield + "/emissiveFactor", "must be 3 finite float numbers");
+                dst.emissiveFactor = glm::vec3(glm::dvec3(e[0], e[1], e[2]));
             }
+            if (auto ext = src.extensions.find("KHR_materials_emissive_strength");
+                ext != src.extensions.end() && ext->second.Has("emissiveStrength")) {
+                float strength = 1.0f;
+                if (!number(ext->second.Get("emissiveStrength"), strength) || strength < 0.0f)
+                    return parseError(mfield + "/extensions/KHR_materials_emissive_strength/"
+                                               "emissiveStrength",
+                                      "must be a finite number ≥ 0");
+                dst.emissiveFactor *= strength;
+            }
+            if (src.alphaMode == "MASK") dst.alphaMode = AlphaMode::Mask;
+            else if (src.alphaMode == "BLEND") dst.alphaMode = AlphaMode::Blend;
+            else if (src.alphaMode != "OPAQUE" && !src.alphaMode.empty())
+                return parseError(mfield + "/alphaMode",
+                                  "must be OPAQUE, MASK or BLEND, not \"" + src.alphaMode + "\"");
+            if (!fitsFloat(src.alphaCutoff))
+                return parseError(mfield + "/alphaCutoff", "must be a finite float number");
+            dst.alphaCutoff = static_cast<float>(src.alphaCutoff);
+            dst.doubleSided = src.doubleSided;
+            dst.unlit = src.extensions.count("KHR_materials_unlit") != 0;
             m_.materials.push_back(std::move(dst));
         }
-        m_.images.resize(imageSlot.size());
+        m_.images.resize(imageSlot_.size());
         return Ok{};
     }
 
@@ -413,6 +522,53 @@ class Converter {
                 part.uvs[v] = glm::vec2(glm::dvec2((*uv)->at(v, 0), (*uv)->at(v, 1)));
         }
 
+        // TEXCOORD_1 (a texture's texCoord may name it)
+        auto uv1 = attribute(prim, "TEXCOORD_1", TINYGLTF_TYPE_VEC2, Want::Float, {}, field, nv);
+        if (!uv1) return uv1.error();
+        if (*uv1) {
+            part.uvs1.resize(nv);
+            for (std::size_t v = 0; v < nv; ++v)
+                part.uvs1[v] = glm::vec2(glm::dvec2((*uv1)->at(v, 0), (*uv1)->at(v, 1)));
+        }
+
+        // TANGENT (xyz unit, w ±1): kept only when every tangent is usable; else the shading
+        // builds the frame per pixel.
+        auto tan = attribute(prim, "TANGENT", TINYGLTF_TYPE_VEC4, Want::Float,
+                             {TINYGLTF_COMPONENT_TYPE_FLOAT}, field, nv);
+        if (!tan) return tan.error();
+        if (*tan) {
+            part.tangents.resize(nv);
+            for (std::size_t v = 0; v < nv && !part.tangents.empty(); ++v) {
+                const glm::dvec3 t((*tan)->at(v, 0), (*tan)->at(v, 1), (*tan)->at(v, 2));
+                const double len = glm::length(t);
+                if (!(len > 1e-6)) part.tangents.clear();
+                else part.tangents[v] = glm::vec4(glm::vec3(t / len), (*tan)->at(v, 3) < 0.0 ? -1.0f : 1.0f);
+            }
+        }
+
+        // COLOR_0 (RGB or RGBA; float or normalised integers), linear
+        if (auto it = prim.attributes.find("COLOR_0"); it != prim.attributes.end()) {
+            const bool rgb = it->second >= 0 &&
+                             static_cast<std::size_t>(it->second) < g_.accessors.size() &&
+                             g_.accessors[static_cast<std::size_t>(it->second)].type ==
+                                 TINYGLTF_TYPE_VEC3;
+            auto col = attribute(prim, "COLOR_0", rgb ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC4,
+                                 Want::Float,
+                                 {TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                                 field, nv);
+            if (!col) return col.error();
+            if (isIntegerType((*col)->componentType) && !(*col)->normalized)
+                return parseError(field + "/attributes/COLOR_0",
+                                  "integer colours must be normalized");
+            part.colors.resize(nv);
+            for (std::size_t v = 0; v < nv; ++v)
+                part.colors[v] = glm::vec4(glm::dvec4((*col)->at(v, 0), (*col)->at(v, 1),
+                                                      (*col)->at(v, 2),
+                                                      rgb ? 1.0 : (*col)->at(v, 3)));
+        }
+
         // Skinned (node has a skin and the primitive has JOINTS_0), else rigid on the node.
         const tg::Node& node = g_.nodes[static_cast<std::size_t>(nodeIndex)];
         const bool skinned = node.skin >= 0 && prim.attributes.count("JOINTS_0") != 0;
@@ -529,6 +685,16 @@ class Converter {
                     const glm::dvec3 n = nm * glm::dvec3(part.normals[v]);
                     const double len = glm::length(n);
                     if (len > 0.0 && std::isfinite(len)) part.normals[v] = glm::vec3(n / len);
+                    if (!part.tangents.empty()) {
+                        // Tangents move with the surface (the matrix, not its inverse
+                        // transpose); a mirroring transform flips the bitangent's sign.
+                        const glm::dvec3 t = glm::dmat3(dworld) * glm::dvec3(part.tangents[v]);
+                        const double tl = glm::length(t);
+                        if (tl > 0.0 && std::isfinite(tl))
+                            part.tangents[v] = glm::vec4(glm::vec3(t / tl),
+                                                         det < 0.0 ? -part.tangents[v].w
+                                                                   : part.tangents[v].w);
+                    }
                 }
             }
         }

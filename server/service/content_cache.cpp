@@ -64,7 +64,8 @@ std::size_t ContentCache::approxBytes(const Model& m) {
     std::size_t n = sizeof(Model) + m.nodes.size() * sizeof(Node) + m.joints.size() * sizeof(int);
     for (const MeshPart& p : m.parts)
         n += sizeof(MeshPart) + p.positions.size() * sizeof(glm::vec3) + p.normals.size() * sizeof(glm::vec3) +
-             p.uvs.size() * sizeof(glm::vec2) + p.joints.size() * sizeof(glm::u16vec4) +
+             (p.uvs.size() + p.uvs1.size()) * sizeof(glm::vec2) +
+             (p.tangents.size() + p.colors.size()) * sizeof(glm::vec4) + p.joints.size() * sizeof(glm::u16vec4) +
              p.weights.size() * sizeof(glm::vec4) + p.indices.size() * sizeof(std::uint32_t) +
              p.influences.size() * sizeof(Influence);
     for (const Image8& img : m.images) n += img.rgba.size() + img.rgba.size() / 3; // + CPU mip chain

@@ -102,6 +102,9 @@ struct FrameParams {
     std::string format = "png"; ///< png | jpeg | webp (lossless); see isFrameFormat
     std::optional<int> width, height, msaa;
     std::optional<AntiAliasing> aa; ///< `aa`; see FrameOverrides for how it meets `msaa`
+    std::optional<Shading> shading;         ///< `shading`: legacy | pbr (render.shading)
+    std::optional<double> exposure;         ///< `exposure` (render.exposure)
+    std::optional<ToneMapping> toneMapping; ///< `tone_mapping` (render.tone_mapping)
     std::optional<double> yaw, pitch, distance, time;
     std::optional<std::array<double, 3>> target; ///< the camera's target (core Camera::target)
     // Outlines on the skin (the editor's selection, hover and place brush; nothing when empty:

@@ -21,6 +21,9 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     o.height = p.height;
     o.msaa = p.msaa;
     o.aa = p.aa;
+    o.shading = p.shading;
+    o.exposure = p.exposure;
+    o.toneMapping = p.toneMapping;
     o.yaw = p.yaw;
     o.pitch = p.pitch;
     o.distance = p.distance;

@@ -18,7 +18,9 @@
 
 #include "core/camera.hpp"
 #include "core/render_settings.hpp"
+#include "core/rig.hpp"
 #include "core/texture_layout.hpp"
+#include "uniform_blocks.hpp"
 #include "gl_context.hpp"
 #include "gl/renderer.hpp"
 
@@ -57,13 +59,15 @@ struct GpuModel {
     struct Part {
         GLuint vao = 0;
         /// position, normal, uv, joints, weights, indices, map uv (attribute slots 0–4 and 5;
-        /// the model's own parts read slot 5 from the uv buffer and leave buffers[6] at 0)
-        GLuint buffers[7] = {};
+        /// the model's own parts read slot 5 from the uv buffer and leave buffers[6] at 0),
+        /// then tangent, uv1, colour (slots 6–8, 0 when the part has none)
+        GLuint buffers[10] = {};
         GLsizei indexCount = 0, vertexCount = 0;
         int paletteOffset = 0;
         int material = -1;
         bool hasUVs = false;    ///< the model's TEXCOORD_0 (base colour)
         bool hasMapUVs = false; ///< height-map UVs (the layout covers the part)
+        bool hasTangents = false, hasUVs1 = false, hasColors = false; ///< slots 6, 7, 8
     };
     std::vector<Part> parts; ///< with the model's own UVs as the maps' layout
     /// The parts drawn with another height-map layout (SPEC §8): vertices split as the layout's
@@ -79,6 +83,9 @@ struct GpuModel {
     };
     std::map<const TextureLayout*, LayoutParts> layouts;
     std::vector<GLuint> textures; ///< one per Model::images entry, sRGB
+    /// One per Model::images entry: linear RGBA8 for the images a material reads as data
+    /// (metallic-roughness, normal, occlusion), 0 for the others.
+    std::vector<GLuint> dataTextures;
     int paletteSize = 0;
     double autoDisplacement = 0.01;
     std::size_t bytes = 0;     ///< estimated GPU bytes of the buffers and textures
@@ -149,6 +156,20 @@ struct HeightSource {
     glm::vec2 size{1.0f};
 };
 
+// pbr_pass.cpp: the pbr shading's per-part material.
+/// The glTF material of `gp` (of `model`, uploaded as `gm`) into pb's PBR members: factors,
+/// which textures it samples (those whose image was uploaded and whose UV set the part has),
+/// their UV sets and KHR_texture_transform, alpha mode and flags. A part without a material
+/// gets the legacy skin tone as a rough dielectric.
+void fillMaterialBlock(PartBlock& pb, const Model& model, const GpuModel& gm, const GpuModel::Part& gp);
+/// Binds the material's textures of `gp` to units 2–6 (pbr.glsl), `white` where it has none.
+void bindMaterialTextures(const Model& model, const GpuModel& gm, const GpuModel::Part& gp, GLuint white);
+/// The order to draw `parts` in: opaque and masked parts first (as given), then blended ones
+/// farthest first by the distance from `eye` to the centre of their posed bounds (`posed`,
+/// skin(model, world), indexed like parts).
+std::vector<std::size_t> pbrDrawOrder(const Model& model, const std::vector<GpuModel::Part>& parts,
+                                      const std::vector<SkinnedPart>& posed, glm::vec3 eye);
+
 } // namespace dermis::gl
 
 namespace dermis {
@@ -216,6 +237,14 @@ struct Renderer::Impl {
     /// the draw read out of bounds (ASan: SEGV / heap-buffer-overflow in swrast_dri under
     /// glDrawElements, InspectHttpTest with the cache warm).
     GLuint skinPrograms[2][4] = {};
+    /// The shaded view with `render.shading` pbr by [tessellated]: skin.frag + pbr.glsl with
+    /// DERMIS_PBR (built at start with the others).
+    GLuint pbrPrograms[2] = {};
+    /// The image-based light of the pbr programs, made by the first PBR frame from the default
+    /// studio environment (core/environment.hpp; ensureEnvironment): GGX-prefiltered radiance with one
+    /// mip level per roughness step, the split-sum table, and the block with its irradiance.
+    GLuint envSpecularTexture = 0, brdfLutTexture = 0, environmentUbo = 0;
+    gl::EnvironmentBlock environment{};
     GLuint emptyVao = 0, heightUbo = 0, frameUbo = 0, partUbo = 0, paletteSsbo = 0,
            feedbackBuffer = 0, outlineUbo = 0;
     GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
@@ -247,13 +276,23 @@ struct Renderer::Impl {
     Status init(GlBackend backend);
     void readDriverInfo();
     Status buildPrograms();
-    /// Links skin.vert/.frag (+ the tessellation stages when `tess`) with DERMIS_VIEW = `view`;
-    /// fails with the GL's log. Only buildPrograms calls it (never during a frame).
-    Result<GLuint> buildSkinProgram(bool tess, FrameView view);
-    /// The skin program of a frame (built at start by buildPrograms).
-    GLuint skinProgram(bool tess, FrameView view) const {
+    /// Links skin.vert/.frag (+ the tessellation stages when `tess`) with DERMIS_VIEW = `view`
+    /// (+ DERMIS_PBR and pbr.glsl when `pbr`); fails with the GL's log. Only buildPrograms calls
+    /// it (never during a frame).
+    Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false);
+    /// The skin program of a frame (built at start by buildPrograms): the PBR one for a shaded
+    /// frame with `pbr`.
+    GLuint skinProgram(bool tess, FrameView view, bool pbr = false) const {
+        if (pbr && view == FrameView::Shaded) return pbrPrograms[tess ? 1 : 0];
         return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
     }
+    /// The default environment's textures and block (envSpecularTexture, brdfLutTexture,
+    /// environment, environmentUbo), computed on the CPU by the first PBR frame (legacy frames
+    /// never pay for it) and kept; later calls do nothing.
+    void ensureEnvironment();
+    /// The frame's exposure, environment rotation and tone mapping into the environment block,
+    /// bound with the environment's textures (units 7, 8).
+    void uploadEnvironmentBlock(const RenderSettings& rs);
     void createSharedObjects();
     void shutdown();
     void dropPatternTextures(); ///< pattern and base textures, and what the targets were from
@@ -309,10 +348,14 @@ struct Renderer::Impl {
                           glm::vec2 heightmapSize);
     void uploadOutlineBlock(const std::vector<FrameOutline>& outlines);
     std::size_t uploadPartBlocks(const Model& model, const gl::GpuModel& gm,
-                                 const std::vector<gl::GpuModel::Part>& parts, FrameView view);
+                                 const std::vector<gl::GpuModel::Part>& parts, FrameView view,
+                                 bool pbr);
+    /// `pbrOrder` (pbr shading; null otherwise): the parts' draw order (pbrDrawOrder), with
+    /// their material textures bound and blending for glTF BLEND parts.
     GLuint drawSkinPass(const Model& model, const gl::GpuModel& gm,
                         const std::vector<gl::GpuModel::Part>& parts, const RenderSettings& rs,
-                        GLuint skinProgram, GLuint heightTexture, std::size_t partStride, int samples);
+                        GLuint skinProgram, GLuint heightTexture, std::size_t partStride, int samples,
+                        const std::vector<std::size_t>* pbrOrder);
     Status readFrame(GLuint readFbo, Image8& image);
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
                                                const std::vector<glm::mat4>& world);

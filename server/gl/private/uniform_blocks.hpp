@@ -43,6 +43,31 @@ struct PartBlock {
     /// first palette matrix, has a base-colour texture and UVs to sample it, has height-map UVs
     /// (the layout in use covers the part), view (FrameView as int)
     glm::ivec4 part;
+    // glTF metallic-roughness (the DERMIS_PBR programs):
+    glm::vec4 emissive; ///< emissive factor, alpha cutoff
+    glm::vec4 material; ///< metallic, roughness, normal scale, occlusion strength
+    /// textures present (kMap* bits), alpha mode (0 opaque, 1 mask, 2 blend), flags (kPart*
+    /// bits), UV set per texture (bit k: texture k reads TEXCOORD_1)
+    glm::ivec4 maps;
+    glm::vec4 uvTransform[10]; ///< per texture two rows of its KHR_texture_transform matrix
+};
+
+/// PartBlock::maps.x bits, in the texture order of uvTransform and maps.w.
+enum MaterialMapBit : int {
+    kMapBaseColor = 1,
+    kMapMetallicRoughness = 2,
+    kMapNormal = 4,
+    kMapOcclusion = 8,
+    kMapEmissive = 16,
+};
+/// PartBlock::maps.z bits.
+enum PartFlagBit : int { kPartUnlit = 1, kPartTangents = 2, kPartColors = 4 };
+
+/// EnvironmentBlock, binding 4: the image-based light of the DERMIS_PBR programs.
+struct EnvironmentBlock {
+    glm::vec4 irradianceSh[9]; ///< rgb coefficients of E(n)/π, order of core/environment.hpp
+    glm::vec4 params;          ///< exposure, cos(rotation), sin(rotation), last specular level
+    glm::ivec4 mode;           ///< tone mapping (0 none, 1 PBR Neutral, 2 ACES filmic), 0, 0, 0
 };
 
 /// OutlineBlock, binding 3: the outlines of a frame's skin pass (FrameOutline in renderer.hpp).
@@ -62,13 +87,15 @@ enum BlockBinding : unsigned {
     kFrameBinding = 1,
     kPartBinding = 2,
     kOutlineBinding = 3,
+    kEnvironmentBinding = 4,
     kPaletteBinding = 0, // shader storage buffer binding
 };
 
 static_assert(sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
 static_assert(sizeof(HeightPassBlock) == 144);
 static_assert(sizeof(FrameBlock) == 144);
-static_assert(sizeof(PartBlock) == 32);
+static_assert(sizeof(PartBlock) == 32 + 3 * 16 + 10 * 16);
+static_assert(sizeof(EnvironmentBlock) == 9 * 16 + 2 * 16);
 static_assert(sizeof(OutlineBlock) == 16 + 5 * 8 * 16);
 
 } // namespace dermis::gl

@@ -1,0 +1,188 @@
+// PbrShadingGLTest — `render.shading: "pbr"` end to end through `dermis-server render` (issue
+// #26), on the backend named by $DERMIS_TEST_GL: the Khronos material models of
+// tests/models/fidelity shaded by their glTF materials under the default studio environment, and
+// the characters still drawn. What each test checks is what the material says: alpha-mask holes,
+// blended cards that let the background through, exposure and tone mapping, and that the default
+// (legacy) frame is untouched.
+#include "BuildPaths.hpp"
+#include "GltfTestBuilder.hpp"
+#include "TestFiles.hpp"
+#include "io/frame_io.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+
+using namespace dermis;
+using namespace dermis::test;
+using nlohmann::json;
+
+namespace {
+
+const std::string kTestModels = dermis::build::testModelsDir();
+const std::string kHelmet = kTestModels + "/fidelity/DamagedHelmet/DamagedHelmet.glb";
+const std::string kAlpha = kTestModels + "/fidelity/AlphaBlendModeTest/AlphaBlendModeTest.glb";
+
+std::string gl() {
+    const char* env = std::getenv("DERMIS_TEST_GL");
+    return std::string(" --gl ") + (env && *env ? env : "auto");
+}
+
+/// The frame of `model` rendered with `options` at 128² (no anti-aliasing: exact pixels).
+Image8 render(const TempDir& dir, const std::string& model, const std::string& options,
+              const json& render = json::object()) {
+    json scene = {{"format", "dermis.scene/1"}, {"model", model}, {"render", render}};
+    writeText(dir / "s.json", scene.dump());
+    CliRun r = runServer(dir, "render --scene " + (dir / "s.json") + " --out " + (dir / "f.png") +
+                                  " --size 128x128 --aa none " + options + gl());
+    EXPECT_EQ(r.code, 0) << options << ": " << r.err;
+    auto img = decodeFrame(readBytes(dir / "f.png"));
+    EXPECT_TRUE(img) << options;
+    return img ? *img : Image8{};
+}
+
+/// Pixels that differ from the top-left pixel (the background) by more than 8 in a channel.
+std::size_t foreground(const Image8& img) {
+    std::size_t n = 0;
+    for (std::size_t p = 0; p + 3 < img.rgba.size(); p += 4)
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(int(img.rgba[p + c]) - int(img.rgba[c])) > 8) {
+                ++n;
+                break;
+            }
+    return n;
+}
+
+double meanLuma(const Image8& img) {
+    double sum = 0.0;
+    for (std::size_t p = 0; p + 3 < img.rgba.size(); p += 4)
+        sum += 0.2126 * img.rgba[p] + 0.7152 * img.rgba[p + 1] + 0.0722 * img.rgba[p + 2];
+    return img.rgba.empty() ? 0.0 : sum / (img.rgba.size() / 4);
+}
+
+} // namespace
+
+TEST(PbrShadingGLTest, TheHelmetIsShadedByItsMaterialAndLegacyStaysTheDefault) {
+    TempDir dir;
+    const Image8 legacy = render(dir, kHelmet, "");
+    const Image8 legacyNamed = render(dir, kHelmet, "--shading legacy");
+    EXPECT_EQ(legacy.rgba, legacyNamed.rgba) << "legacy is the default shading";
+    const Image8 pbr = render(dir, kHelmet, "--shading pbr");
+    ASSERT_EQ(pbr.rgba.size(), legacy.rgba.size());
+    EXPECT_GT(foreground(pbr), 128u * 128u / 8) << "the helmet fills its frame";
+    std::size_t differ = 0;
+    for (std::size_t p = 0; p < pbr.rgba.size(); ++p)
+        if (std::abs(int(pbr.rgba[p]) - int(legacy.rgba[p])) > 16) ++differ;
+    EXPECT_GT(differ, pbr.rgba.size() / 20) << "pbr looks like legacy";
+    // The scene member says the same as the option.
+    const Image8 fromScene = render(dir, kHelmet, "", {{"shading", "pbr"}});
+    EXPECT_EQ(fromScene.rgba, pbr.rgba);
+}
+
+TEST(PbrShadingGLTest, ExposureZeroLeavesABlackSilhouette) {
+    TempDir dir;
+    // Exposure scales all light before tone mapping (the environment's and the emissive one, as
+    // three.js's toneMappingExposure does): at 0 the helmet is a black shape on the background.
+    const Image8 dark = render(dir, kHelmet, "--shading pbr --exposure 0");
+    const Image8 lit = render(dir, kHelmet, "--shading pbr");
+    EXPECT_GT(foreground(dark), foreground(lit) * 9 / 10) << "the silhouette is drawn";
+    std::size_t black = 0;
+    for (std::size_t p = 0; p + 3 < dark.rgba.size(); p += 4)
+        if (dark.rgba[p] < 3 && dark.rgba[p + 1] < 3 && dark.rgba[p + 2] < 3) ++black;
+    EXPECT_GT(black, foreground(lit) * 9 / 10);
+}
+
+TEST(PbrShadingGLTest, ExposureAndToneMappingChangeTheFrame) {
+    TempDir dir;
+    const Image8 neutral = render(dir, kHelmet, "--shading pbr");
+    const Image8 aces = render(dir, kHelmet, "--shading pbr --tone-mapping aces");
+    const Image8 bright = render(dir, kHelmet, "--shading pbr --exposure 4");
+    EXPECT_NE(neutral.rgba, aces.rgba);
+    EXPECT_GT(meanLuma(bright), meanLuma(neutral) + 5.0);
+}
+
+/// A square of side 2 in the XY plane facing +Z, textured with an 8×1 image whose left half is
+/// transparent and right half opaque (alpha ramps across the middle and, the sampler wrapping,
+/// across the left edge), in material `alphaMode` (with baseColorFactor alpha `alpha`).
+std::string alphaQuad(const TempDir& dir, const std::string& alphaMode, double alpha) {
+    namespace g = dermis::test::gltf;
+    g::Builder b;
+    const int pos =
+        b.add(std::vector<float>{-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, g::kFloat, "VEC3");
+    const int nrm =
+        b.add(std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, g::kFloat, "VEC3");
+    const int uv = b.add(std::vector<float>{0, 1, 1, 1, 1, 0, 0, 0}, g::kFloat, "VEC2");
+    const int idx = b.add(std::vector<std::uint16_t>{0, 1, 2, 0, 2, 3}, g::kUShort, "SCALAR");
+    std::vector<std::uint8_t> texels;
+    for (int i = 0; i < 8; ++i)
+        texels.insert(texels.end(), {230, 230, 230, std::uint8_t(i < 4 ? 0 : 255)});
+    writeImage(dir / "a.png", 8, 1, 4, texels, OIIO::TypeDesc::UINT8);
+    const int img = b.view(readBytes(dir / "a.png"));
+    b.doc["images"] = json::array({{{"bufferView", img}, {"mimeType", "image/png"}}});
+    b.doc["textures"] = json::array({{{"source", 0}}});
+    json pbr = json::object();
+    pbr["baseColorFactor"] = {1, 1, 1, alpha};
+    pbr["metallicFactor"] = 0;
+    pbr["baseColorTexture"] = {{"index", 0}};
+    json material = json::object();
+    material["alphaMode"] = alphaMode;
+    material["doubleSided"] = true;
+    material["pbrMetallicRoughness"] = pbr;
+    b.doc["materials"] = json::array({material});
+    json prim = json::object();
+    prim["attributes"] = {{"POSITION", pos}, {"NORMAL", nrm}, {"TEXCOORD_0", uv}};
+    prim["indices"] = idx;
+    prim["material"] = 0;
+    json mesh = json::object();
+    mesh["primitives"] = json::array({prim});
+    b.doc["meshes"] = json::array({mesh});
+    b.doc["nodes"] = json::array({{{"mesh", 0}}});
+    b.doc["scenes"] = json::array({{{"nodes", {0}}}});
+    b.doc["scene"] = 0;
+    const std::vector<std::uint8_t> glb = b.glb();
+    const std::string path = dir / (alphaMode + ".glb");
+    writeText(path, std::string(glb.begin(), glb.end()));
+    return path;
+}
+
+TEST(PbrShadingGLTest, AlphaMaskCutsHolesAndBlendLetsTheBackgroundThrough) {
+    TempDir dir;
+    const json front = {{"camera", {{"yaw", 0}, {"pitch", 0}}}};
+    // Legacy ignores alpha: the whole square is drawn. MASK (cutoff 0.5) keeps the opaque half.
+    const std::string mask = alphaQuad(dir, "MASK", 1.0);
+    const std::size_t whole = foreground(render(dir, mask, "--shading legacy", front));
+    const std::size_t half = foreground(render(dir, mask, "--shading pbr", front));
+    EXPECT_GT(whole, 128u * 128u / 4);
+    EXPECT_NEAR(static_cast<double>(half) / static_cast<double>(whole), 0.5, 0.08);
+    // BLEND with factor alpha 1: the transparent half shows the background through, a ramp
+    // between; OPAQUE ignores alpha.
+    const std::size_t opaque =
+        foreground(render(dir, alphaQuad(dir, "OPAQUE", 1.0), "--shading pbr", front));
+    EXPECT_EQ(opaque, whole);
+    const Image8 blended = render(dir, alphaQuad(dir, "BLEND", 1.0), "--shading pbr", front);
+    const std::size_t seen = foreground(blended);
+    EXPECT_LT(seen, whole * 3 / 4);
+    EXPECT_GT(seen, whole / 3);
+    // A uniform alpha of 0.5 mixes the lit square halfway with the background: darker than the
+    // opaque square's pixel at the centre of its right half, brighter than the background.
+    const Image8 solid = render(dir, alphaQuad(dir, "OPAQUE", 1.0), "--shading pbr", front);
+    const Image8 glass = render(dir, alphaQuad(dir, "BLEND", 0.5), "--shading pbr", front);
+    const std::size_t centre = (64u * 128u + 80u) * 4u;
+    EXPECT_LT(glass.rgba[centre], solid.rgba[centre] - 10);
+    EXPECT_GT(glass.rgba[centre], glass.rgba[0] + 10);
+}
+
+TEST(PbrShadingGLTest, TheCharactersRenderWithPbrOnEveryShape) {
+    TempDir dir;
+    // Skinned characters through the pbr programs: CesiumMan (textured), RiggedFigure (no UVs,
+    // no material), the Barbarian (palette texture, props), and the tessellated variant.
+    for (const char* model : {"CesiumMan/CesiumMan.glb", "RiggedFigure/RiggedFigure.glb",
+                              "KayKitBarbarian/Barbarian.glb"}) {
+        const Image8 img = render(dir, kTestModels + "/" + model, "--shading pbr");
+        EXPECT_GT(foreground(img), 128u * 128u / 50) << model;
+        const Image8 tess = render(dir, kTestModels + "/" + model, "--shading pbr",
+                                   {{"displacement", "tessellated"}});
+        EXPECT_GT(foreground(tess), 128u * 128u / 50) << model << " tessellated";
+    }
+}
