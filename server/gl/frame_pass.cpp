@@ -319,6 +319,7 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
     glBindVertexArray(0);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
+    glActiveTexture(GL_TEXTURE0);
     GLuint readFbo = frame.fbo;
     if (samples > 1) {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, frame.fbo);
