@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 
 using namespace dermis;
@@ -185,4 +187,43 @@ TEST(PbrShadingGLTest, TheCharactersRenderWithPbrOnEveryShape) {
                                    {{"displacement", "tessellated"}});
         EXPECT_GT(foreground(tess), 128u * 128u / 50) << model << " tessellated";
     }
+}
+
+/// A Radiance .hdr of w × h texels of one radiance `rgb` (flat RGBE scanlines).
+void writeUniformHdr(const std::string& path, int w, int h, glm::vec3 rgb) {
+    std::string text = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " +
+                       std::to_string(w) + "\n";
+    const float v = std::max({rgb.r, rgb.g, rgb.b});
+    int e = 0;
+    const float scale = std::frexp(v, &e) * 256.0f / v;
+    const char texel[4] = {static_cast<char>(rgb.r * scale), static_cast<char>(rgb.g * scale),
+                           static_cast<char>(rgb.b * scale), static_cast<char>(e + 128)};
+    for (int k = 0; k < w * h; ++k)
+        text.append(texel, 4);
+    writeText(path, text);
+}
+
+TEST(PbrShadingGLTest, AnEnvironmentFileLightsTheFrame) {
+    TempDir dir;
+    // Under a uniformly red sky the grey-white parts of the helmet turn red; under the default
+    // studio (neutral grey) they do not.
+    writeUniformHdr(dir / "red.hdr", 64, 32, glm::vec3(1.5f, 0.0f, 0.0f));
+    const Image8 studio = render(dir, kHelmet, "--shading pbr");
+    const Image8 red = render(dir, kHelmet, "--shading pbr --environment " + (dir / "red.hdr"));
+    auto redness = [](const Image8& img) {
+        double r = 0.0, g = 0.0;
+        for (std::size_t p = 0; p + 3 < img.rgba.size(); p += 4) {
+            r += img.rgba[p];
+            g += img.rgba[p + 1];
+        }
+        return r / std::max(g, 1.0);
+    };
+    EXPECT_GT(redness(red), 1.5 * redness(studio));
+    // A file that is not an image fails with a message naming it.
+    writeText(dir / "bad.hdr", "not an image");
+    writeText(dir / "s.json", json({{"format", "dermis.scene/1"}, {"model", kHelmet}}).dump());
+    CliRun r = runServer(dir, "render --scene " + (dir / "s.json") + " --out " + (dir / "f.png") +
+                                  " --shading pbr --environment " + (dir / "bad.hdr") + gl());
+    EXPECT_EQ(r.code, 1);
+    EXPECT_NE(r.err.find("bad.hdr"), std::string::npos) << r.err;
 }

@@ -341,6 +341,10 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--tone-mapping", render.toneMapping,
                           "pbr: neutral (Khronos PBR Neutral), aces or none (overrides render.tone_mapping)")
         ->check(CLI::IsMember({"neutral", "aces", "none"}));
+    renderCmd->add_option("--environment", render.environment,
+                          "pbr: light the frame with this equirectangular image (.hdr, .exr; linear radiance) "
+                          "instead of the default studio environment")
+        ->check(CLI::ExistingFile);
     renderCmd->add_option("--view", render.view,
                           "shaded (default), or unlit: bump / displacement height as grey, normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));

@@ -153,6 +153,12 @@ int runRender(const RenderArgs& a) {
     // Frames are encoded and written on a worker while the next one renders (at most two waiting:
     // bounded memory). Each file's bytes are those of the sequential path (deterministic encoders).
     FrameWriteQueue writer(1, 2);
+    std::shared_ptr<const EnvironmentImage> environment;
+    if (!a.environment.empty()) {
+        auto env = readEnvironmentImage(a.environment);
+        if (!env) return fail(env.error());
+        environment = std::make_shared<const EnvironmentImage>(std::move(*env));
+    }
     for (int k : todo) {
         const bool first = k == todo.front();
         const auto tFrame = std::chrono::steady_clock::now();
@@ -161,6 +167,7 @@ int runRender(const RenderArgs& a) {
         if (!plan) return fail(checkSize(plan.error()));
         FrameRequest request = frameRequest(*plan, model);
         request.readHeightMaps = a.heightmaps;
+        request.environment = environment;
         request.profile = a.timings && first; // a GL sync between stages: per-stage figures
         used = plan->render;
         auto result = (*renderer)->renderFrame(request);

@@ -26,6 +26,7 @@ struct RenderArgs {
     std::string shading;     ///< "": the scene's render.shading; legacy|pbr
     std::string toneMapping; ///< "": the scene's render.tone_mapping; neutral|aces|none
     double exposure = -1.0;  ///< < 0: the scene's render.exposure
+    std::string environment; ///< "": the default studio environment; else an .hdr / .exr file
     bool hasTime = false, heightmaps = false, resume = false;
     /// Print where the time went as one JSON line on stderr: start-up (context, programs, scene
     /// load, the wait for the renderer), the first frame's stages (with a GL sync between them)

@@ -153,8 +153,9 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     uploadOutlineBlock(req.outlines);
     const bool pbr = rs.shading == Shading::Pbr && req.view == FrameView::Shaded;
     if (pbr) {
-        ensureEnvironment();
-        uploadEnvironmentBlock(rs);
+        auto light = environmentLight(req.environment);
+        if (!light) return light.error();
+        uploadEnvironmentBlock(**light, rs);
     }
     const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view, pbr);
     const GLuint program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr);

@@ -58,17 +58,41 @@ GLuint imageTexture(const std::vector<GLuint>& textures, int image) {
 
 } // namespace
 
-void Renderer::Impl::ensureEnvironment() {
-    if (envSpecularTexture) return;
-    const EnvironmentImage env = studioEnvironment();
-    const PrefilteredEnvironment pre = prefilterEnvironment(env);
-    for (std::size_t k = 0; k < 9; ++k)
-        environment.irradianceSh[k] = glm::vec4(pre.irradianceSh[k], 0.0f);
+Result<const Renderer::Impl::EnvironmentLight*>
+Renderer::Impl::environmentLight(const std::shared_ptr<const EnvironmentImage>& env) {
+    if (!brdfLutTexture) {
+        const int lutSize = 32;
+        const std::vector<glm::vec2> lut = brdfLut(lutSize);
+        glGenTextures(1, &brdfLutTexture);
+        glBindTexture(GL_TEXTURE_2D, brdfLutTexture);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG16F, lutSize, lutSize);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, lutSize, lutSize, GL_RG, GL_FLOAT, lut.data());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glGenBuffers(1, &environmentUbo);
+        glBindBuffer(GL_UNIFORM_BUFFER, environmentUbo);
+        glBufferData(GL_UNIFORM_BUFFER, sizeof(EnvironmentBlock), nullptr, GL_DYNAMIC_DRAW);
+    }
+    EnvironmentLight* light = &studioLight;
+    if (env) {
+        if (customKey == env.get() && !customOwner.expired() && customLight.specular) return &customLight;
+        if (auto s = validateEnvironment(*env); !s)
+            return makeError(ErrorCode::InvalidArgument, kWhere, "environment", s.error().message);
+        customLight.destroy();
+        customOwner = env;
+        customKey = env.get();
+        light = &customLight;
+    } else if (studioLight.specular) {
+        return &studioLight;
+    }
+    const PrefilteredEnvironment pre = prefilterEnvironment(env ? *env : studioEnvironment());
+    for (std::size_t k = 0; k < 9; ++k) light->block.irradianceSh[k] = glm::vec4(pre.irradianceSh[k], 0.0f);
     const int levels = static_cast<int>(pre.specular.size());
-    environment.params = glm::vec4(1.0f, 1.0f, 0.0f, static_cast<float>(std::max(levels - 1, 0)));
-
-    glGenTextures(1, &envSpecularTexture);
-    glBindTexture(GL_TEXTURE_2D, envSpecularTexture);
+    light->block.params = glm::vec4(1.0f, 1.0f, 0.0f, static_cast<float>(std::max(levels - 1, 0)));
+    glGenTextures(1, &light->specular);
+    glBindTexture(GL_TEXTURE_2D, light->specular);
     const int w0 = pre.specular.empty() ? 1 : pre.specular[0].width;
     const int h0 = pre.specular.empty() ? 1 : pre.specular[0].height;
     glTexStorage2D(GL_TEXTURE_2D, std::max(levels, 1), GL_RGB16F, w0, h0);
@@ -84,25 +108,12 @@ void Renderer::Impl::ensureEnvironment() {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-
-    const int lutSize = 32;
-    const std::vector<glm::vec2> lut = brdfLut(lutSize);
-    glGenTextures(1, &brdfLutTexture);
-    glBindTexture(GL_TEXTURE_2D, brdfLutTexture);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG16F, lutSize, lutSize);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, lutSize, lutSize, GL_RG, GL_FLOAT, lut.data());
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-
-    glGenBuffers(1, &environmentUbo);
-    glBindBuffer(GL_UNIFORM_BUFFER, environmentUbo);
-    glBufferData(GL_UNIFORM_BUFFER, sizeof(EnvironmentBlock), nullptr, GL_DYNAMIC_DRAW);
+    if (auto s = checkGl("uploading an environment"); !s) return s.error();
+    return light;
 }
 
-void Renderer::Impl::uploadEnvironmentBlock(const RenderSettings& rs) {
-    EnvironmentBlock eb = environment;
+void Renderer::Impl::uploadEnvironmentBlock(const EnvironmentLight& light, const RenderSettings& rs) {
+    EnvironmentBlock eb = light.block;
     const double a = rs.environmentRotation * 3.14159265358979323846 / 180.0;
     eb.params.x = static_cast<float>(rs.exposure);
     eb.params.y = static_cast<float>(std::cos(a));
@@ -115,7 +126,7 @@ void Renderer::Impl::uploadEnvironmentBlock(const RenderSettings& rs) {
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof eb, &eb);
     glBindBufferBase(GL_UNIFORM_BUFFER, kEnvironmentBinding, environmentUbo);
     glActiveTexture(kUnitEnvSpecular);
-    glBindTexture(GL_TEXTURE_2D, envSpecularTexture);
+    glBindTexture(GL_TEXTURE_2D, light.specular);
     glActiveTexture(kUnitBrdfLut);
     glBindTexture(GL_TEXTURE_2D, brdfLutTexture);
 }

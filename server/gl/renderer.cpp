@@ -112,12 +112,12 @@ Status Renderer::Impl::buildPrograms() {
         ProgramDesc desc;
     };
     std::vector<Build> builds = {
-        {&heightProgram, {{{GL_VERTEX_SHADER, "heightpass.vert"}, {GL_FRAGMENT_SHADER, "heightpass.frag"}}, {}, {}}},
+        {&heightProgram, {{{GL_VERTEX_SHADER, "heightpass.vert"}, {GL_FRAGMENT_SHADER, "heightpass.frag"}}, {}, {}, {}}},
         {&heightSurfaceProgram,
-         {{{GL_VERTEX_SHADER, "heightpass.vert"}, {GL_FRAGMENT_SHADER, "heightpass.frag"}}, {"DERMIS_SURFACE"}, {}}},
-        {&heightBaseProgram, {{{GL_VERTEX_SHADER, "fullscreen.vert"}, {GL_FRAGMENT_SHADER, "heightbase.frag"}}, {}, {}}},
+         {{{GL_VERTEX_SHADER, "heightpass.vert"}, {GL_FRAGMENT_SHADER, "heightpass.frag"}}, {"DERMIS_SURFACE"}, {}, {}}},
+        {&heightBaseProgram, {{{GL_VERTEX_SHADER, "fullscreen.vert"}, {GL_FRAGMENT_SHADER, "heightbase.frag"}}, {}, {}, {}}},
         {&captureProgram,
-         {{{GL_VERTEX_SHADER, "skin.vert"}}, {"DERMIS_CAPTURE"}, {"v_position", "v_normal"}}},
+         {{{GL_VERTEX_SHADER, "skin.vert"}}, {"DERMIS_CAPTURE"}, {"v_position", "v_normal"}, {}}},
     };
     for (Build& b : builds) {
         auto p = buildProgram(b.desc);
@@ -199,10 +199,12 @@ void Renderer::Impl::shutdown() {
         glDeleteProgram(p);
         p = 0;
     }
-    glDeleteTextures(1, &envSpecularTexture);
+    studioLight.destroy();
+    customLight.destroy();
+    customKey = nullptr;
     glDeleteTextures(1, &brdfLutTexture);
     glDeleteBuffers(1, &environmentUbo);
-    envSpecularTexture = brdfLutTexture = environmentUbo = 0;
+    brdfLutTexture = environmentUbo = 0;
     GLuint bufs[6] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer, outlineUbo};
     glDeleteBuffers(6, bufs);
     glDeleteVertexArrays(1, &emptyVao);

@@ -36,6 +36,7 @@
 // The renderer draws models and maps, never scene documents: it includes the render settings
 // (core/render_settings.hpp), not core/scene.hpp (LayersTest checks this).
 #include "core/camera.hpp"
+#include "core/environment.hpp"
 #include "core/heightmap.hpp"
 #include "core/model.hpp"
 #include "core/render_settings.hpp"
@@ -152,6 +153,9 @@ struct FrameRequest {
     /// the part's vertices; triangles with an index out of range are dropped). Buffers for a
     /// layout are uploaded once per (model, layout object) and freed with either.
     std::shared_ptr<const TextureLayout> layout;
+    /// The light of a `pbr` frame (core/environment.hpp); null: the default studio environment.
+    /// Prefiltered once per image object and kept while it lives (one custom image at a time).
+    std::shared_ptr<const EnvironmentImage> environment;
 };
 
 struct FrameResult {

@@ -134,6 +134,26 @@ Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes) {
     return img;
 }
 
+Result<EnvironmentImage> readEnvironmentImage(const std::string& path) {
+    const char* where = "dermis::readEnvironmentImage";
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec))
+        return makeError(ErrorCode::NotFound, where, path, "no such file");
+    auto api = oiio::oiioApi();
+    if (!api) return api.error();
+    EnvironmentImage env;
+    std::vector<float> rgb;
+    oiio::OiioFailure f;
+    if (!(*api)->readRgbFloat(path, kMaxEnvironmentSide, env.width, env.height, rgb, f))
+        return moduleError(where, f);
+    env.texels.resize(rgb.size() / 3);
+    for (std::size_t k = 0; k < env.texels.size(); ++k)
+        env.texels[k] = glm::vec3(rgb[3 * k], rgb[3 * k + 1], rgb[3 * k + 2]);
+    if (auto s = validateEnvironment(env); !s)
+        return makeError(ErrorCode::InvalidArgument, where, path, s.error().message);
+    return env;
+}
+
 namespace {
 
 Status checkHeightImage(const char* where, const HeightImage& image) {

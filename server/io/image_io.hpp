@@ -14,6 +14,7 @@
 // Failure: missing, truncated or undecodable files, zero or huge (> limits) sizes → Error.
 #pragma once
 
+#include "core/environment.hpp"
 #include "core/heightmap.hpp"
 #include "core/model.hpp"
 #include "core/result.hpp"
@@ -53,6 +54,17 @@ Result<std::vector<std::uint8_t>> encodeF32(const HeightImage& image);
 Status writeFloatImage(const std::string& path, const HeightImage& image);
 /// encodeHeight16Png to a file, replaced whole.
 Status writeHeight16Png(const std::string& path, const HeightImage& image);
+
+/// Largest side of an environment image (`--environment`).
+constexpr int kMaxEnvironmentSide = 8192;
+
+/// Reads an environment for image-based light (core/environment.hpp: equirectangular, linear RGB
+/// radiance, row 0 at the top): a Radiance .hdr or OpenEXR file as stored, any other format
+/// OpenImageIO reads (8-bit ones as their values / 255, not decoded from sRGB), through the
+/// module. NotFound for a missing file; TooLarge past kMaxEnvironmentSide; Parse for unreadable
+/// data; InvalidArgument (validateEnvironment's field) for a size under 2 or negative or
+/// non-finite values; Unavailable without the module.
+Result<EnvironmentImage> readEnvironmentImage(const std::string& path);
 
 /// Decodes an encoded image (PNG, JPEG, …) to RGBA8 (grey → RGB, missing alpha → 255, alpha
 /// unassociated, 16-bit samples rounded to 8 bits), PNG and JPEG without the module.

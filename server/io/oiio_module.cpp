@@ -218,7 +218,31 @@ bool encodeExr(int width, int height, int channels, const char* const* names,
     }
 }
 
-const OiioApi kApi = {kAbiVersion, &readHeight, &decodeRgba8, &encodeExr};
+bool readRgbFloat(const std::string& path, int maxSide, int& width, int& height,
+                  std::vector<float>& rgb, OiioFailure& f) {
+    try {
+        auto in = ImageInput::open(path);
+        if (!in) return failParse(f, path, "cannot open image: " + OIIO::geterror());
+        const ImageSpec& spec = in->spec();
+        if (!checkSpec(path, spec, maxSide, f)) return false;
+        const int nc = std::min(spec.nchannels, 3);
+        std::vector<float> px(static_cast<std::size_t>(spec.width) * spec.height * nc);
+        if (!in->read_image(0, 0, 0, nc, TypeDesc::FLOAT, px.data()))
+            return failParse(f, path, "cannot decode pixels: " + in->geterror());
+        width = spec.width;
+        height = spec.height;
+        rgb.resize(static_cast<std::size_t>(width) * height * 3);
+        for (std::size_t k = 0, n = px.size() / nc; k < n; ++k)
+            for (int c = 0; c < 3; ++c) rgb[k * 3 + c] = px[k * nc + (nc == 3 ? c : 0)];
+        return true;
+    } catch (const std::bad_alloc&) {
+        return failWith(f, ErrorCode::TooLarge, path, "not enough memory to decode the image");
+    } catch (const std::exception& e) {
+        return failParse(f, path, std::string("corrupt image data (") + e.what() + ")");
+    }
+}
+
+const OiioApi kApi = {kAbiVersion, &readHeight, &decodeRgba8, &encodeExr, &readRgbFloat};
 
 } // namespace
 } // namespace dermis::oiio

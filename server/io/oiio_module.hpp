@@ -23,7 +23,7 @@
 namespace dermis::oiio {
 
 /// Bumped whenever OiioApi or the meaning of its functions changes.
-constexpr int kAbiVersion = 1;
+constexpr int kAbiVersion = 2;
 
 /// The file name the module is built as, looked up beside the executable.
 constexpr const char* kModuleFileName = "libdermis_oiio.so";
@@ -55,6 +55,12 @@ struct OiioApi {
     bool (*encodeExr)(int width, int height, int channels, const char* const* names,
                       const float* pixels, bool half, std::vector<std::uint8_t>& out,
                       OiioFailure& failure);
+    /// The first three channels of the image file `path` as linear float RGB (grey → RGB),
+    /// width·height·3 values, row 0 first, as stored (an HDR's or EXR's radiance; 8-bit formats
+    /// as OpenImageIO converts them). Sides over `maxSide` → TooLarge from the spec; unreadable →
+    /// Parse.
+    bool (*readRgbFloat)(const std::string& path, int maxSide, int& width, int& height,
+                         std::vector<float>& rgb, OiioFailure& failure);
 };
 
 } // namespace dermis::oiio

@@ -17,6 +17,7 @@
 #pragma once
 
 #include "core/camera.hpp"
+#include "core/environment.hpp"
 #include "core/render_settings.hpp"
 #include "core/rig.hpp"
 #include "core/texture_layout.hpp"
@@ -240,11 +241,22 @@ struct Renderer::Impl {
     /// The shaded view with `render.shading` pbr by [tessellated]: skin.frag + pbr.glsl with
     /// DERMIS_PBR (built at start with the others).
     GLuint pbrPrograms[2] = {};
-    /// The image-based light of the pbr programs, made by the first PBR frame from the default
-    /// studio environment (core/environment.hpp; ensureEnvironment): GGX-prefiltered radiance with one
-    /// mip level per roughness step, the split-sum table, and the block with its irradiance.
-    GLuint envSpecularTexture = 0, brdfLutTexture = 0, environmentUbo = 0;
-    gl::EnvironmentBlock environment{};
+    /// The image-based light of the pbr programs (pbr_pass.cpp): for the default studio
+    /// environment and for the last environment a frame brought (FrameRequest::environment, kept
+    /// while its owner lives), the GGX-prefiltered radiance with one mip level per roughness step
+    /// and the block with its irradiance; the split-sum table and the block's buffer are shared.
+    struct EnvironmentLight {
+        GLuint specular = 0;
+        gl::EnvironmentBlock block{};
+        void destroy() {
+            glDeleteTextures(1, &specular);
+            specular = 0;
+        }
+    };
+    EnvironmentLight studioLight, customLight;
+    std::weak_ptr<const EnvironmentImage> customOwner;
+    const EnvironmentImage* customKey = nullptr; ///< the image customLight was made from
+    GLuint brdfLutTexture = 0, environmentUbo = 0;
     GLuint emptyVao = 0, heightUbo = 0, frameUbo = 0, partUbo = 0, paletteSsbo = 0,
            feedbackBuffer = 0, outlineUbo = 0;
     GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
@@ -286,13 +298,14 @@ struct Renderer::Impl {
         if (pbr && view == FrameView::Shaded) return pbrPrograms[tess ? 1 : 0];
         return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
     }
-    /// The default environment's textures and block (envSpecularTexture, brdfLutTexture,
-    /// environment, environmentUbo), computed on the CPU by the first PBR frame (legacy frames
-    /// never pay for it) and kept; later calls do nothing.
-    void ensureEnvironment();
-    /// The frame's exposure, environment rotation and tone mapping into the environment block,
-    /// bound with the environment's textures (units 7, 8).
-    void uploadEnvironmentBlock(const RenderSettings& rs);
+    /// The light of `env` (null: the default studio environment), prefiltered on the CPU the
+    /// first time a frame asks for it (legacy frames never pay for it) and kept: the studio's for
+    /// the renderer's life, a custom one until another replaces it or its owner is gone. Fails
+    /// (InvalidArgument, field "environment") for an image validateEnvironment refuses.
+    Result<const EnvironmentLight*> environmentLight(const std::shared_ptr<const EnvironmentImage>& env);
+    /// The frame's exposure, environment rotation and tone mapping into `light`'s block, bound
+    /// with its textures (units 7, 8).
+    void uploadEnvironmentBlock(const EnvironmentLight& light, const RenderSettings& rs);
     void createSharedObjects();
     void shutdown();
     void dropPatternTextures(); ///< pattern and base textures, and what the targets were from
