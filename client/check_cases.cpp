@@ -67,7 +67,7 @@ std::vector<CheckCase> parseChecks(const std::string& path) {
             k.camera = c["camera"];
         }
         if (c.contains("view")) {
-            if (!c["view"].is_string()) throw usageError("must be shaded, bump, displacement or normal", at + "/view");
+            if (!c["view"].is_string()) throw usageError("must be shaded, bump, displacement, normal, basecolor or lighting", at + "/view");
             k.view = c["view"];
         }
         if (c.contains("threshold")) k.threshold = number(c["threshold"], at + "/threshold", 0, 1);

@@ -54,7 +54,7 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
     frame->add_option("--shading", o->shading, "legacy or pbr (the model's glTF material under image-based light)")
         ->check(CLI::IsMember({"legacy", "pbr"}));
     frame->add_option("--view", o->view, "shaded, or bump / displacement / normal")
-        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
+        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal", "basecolor", "lighting"}));
     frame->add_option("--revision", o->revision, "The scene as it was at this revision")->check(CLI::PositiveNumber);
     addCameraOptions(frame, o);
     frame->callback([&ctx, o, frame] {
@@ -107,7 +107,7 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
     render->add_option("-o,--out", o->out, "File pattern with a %04d-style field, e.g. out/frame_%04d.png (.png or .jpg)")->required();
     render->add_option("--size", o->size, "WxH (overrides the scene's render.size)");
     render->add_option("--view", o->view, "shaded, or bump / displacement / normal")
-        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
+        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal", "basecolor", "lighting"}));
     render->add_flag("--resume", o->resume, "Skip frames whose file exists (files appear only complete)");
     render->add_option("--batch", o->batch, "Frames per request (default 100; the server allows limits.max_batch_frames)")
         ->check(CLI::Range(1, 100000));

@@ -150,9 +150,12 @@ void main() {
     if ((u_maps.z & 4) != 0) base *= v_color;
     if (hasMap(1)) base *= texture(u_baseColorTexture, materialUv(0, v_uv, v_uv1));
     if (u_maps.y == 1 && base.a < u_emissive.w) discard;
+    // Views of the material (FrameView; u_part.w): 4 base colour as it is, 5 the light alone on a
+    // white rough dielectric, 3 the world normal with the model's normal map and the bump.
+    const int view = u_part.w;
     vec3 color;
-    if ((u_maps.z & 1) != 0) {
-        color = base.rgb; // KHR_materials_unlit
+    if (view == 4 || ((u_maps.z & 1) != 0 && view != 5 && view != 3)) {
+        color = base.rgb; // the base colour view, or KHR_materials_unlit
     } else {
         vec3 gradient = u_part.z != 0 ? bumpGradient(ng) : vec3(0.0);
         if (hasMap(4)) {
@@ -160,8 +163,16 @@ void main() {
             gradient += back ? -g : g;
         }
         vec3 nn = normalize(ng - gradient);
+        if (view == 3) {
+            o_color = vec4(outlined(pictureValue(nn * 0.5 + 0.5)), 1.0);
+            return;
+        }
         float metallic = u_material.x, roughness = u_material.y;
-        if (hasMap(2)) {
+        if (view == 5) {
+            base = vec4(1.0);
+            metallic = 0.0;
+            roughness = 1.0;
+        } else if (hasMap(2)) {
             vec4 mr = texture(u_metallicRoughnessTexture, materialUv(1, v_uv, v_uv1));
             roughness *= mr.g;
             metallic *= mr.b;
@@ -169,12 +180,16 @@ void main() {
         metallic = clamp(metallic, 0.0, 1.0);
         roughness = clamp(roughness, 0.03, 1.0);
         float occlusion = 1.0;
-        if (hasMap(8))
+        if (hasMap(8) && view != 5)
             occlusion = 1.0 + u_material.w * (texture(u_occlusionTexture, materialUv(3, v_uv, v_uv1)).r - 1.0);
         color = shadePbr(base.rgb, metallic, roughness, occlusion, nn, toCamera);
         vec3 emissive = u_emissive.rgb;
         if (hasMap(16)) emissive *= texture(u_emissiveTexture, materialUv(4, v_uv, v_uv1)).rgb;
-        color += emissive;
+        if (view != 5) color += emissive;
+    }
+    if (view == 4) {
+        o_color = vec4(outlined(color), 1.0);
+        return;
     }
     o_color = vec4(outlined(toneMap(color)), u_maps.y == 2 ? clamp(base.a, 0.0, 1.0) : 1.0);
 #else

@@ -227,3 +227,25 @@ TEST(PbrShadingGLTest, AnEnvironmentFileLightsTheFrame) {
     EXPECT_EQ(r.code, 1);
     EXPECT_NE(r.err.find("bad.hdr"), std::string::npos) << r.err;
 }
+
+TEST(PbrShadingGLTest, MaterialViewsTakeTheMaterialApart) {
+    TempDir dir;
+    const Image8 shaded = render(dir, kHelmet, "--shading pbr");
+    const Image8 base = render(dir, kHelmet, "--shading pbr --view basecolor");
+    const Image8 light = render(dir, kHelmet, "--shading pbr --view lighting");
+    const Image8 normal = render(dir, kHelmet, "--shading pbr --view normal");
+    const Image8 legacyNormal = render(dir, kHelmet, "--view normal");
+    EXPECT_NE(base.rgba, shaded.rgba);
+    EXPECT_NE(light.rgba, shaded.rgba);
+    EXPECT_NE(normal.rgba, legacyNormal.rgba)
+        << "pbr's normal view includes the model's normal map";
+    // The lighting view is the light on white: grey wherever the helmet is.
+    std::size_t grey = 0, fg = 0;
+    for (std::size_t p = 0; p + 3 < light.rgba.size(); p += 4) {
+        if (light.rgba[p] == light.rgba[0] && light.rgba[p + 1] == light.rgba[1]) continue;
+        ++fg;
+        if (std::abs(int(light.rgba[p]) - int(light.rgba[p + 2])) <= 3) ++grey;
+    }
+    EXPECT_GT(fg, 1000u);
+    EXPECT_GT(grey, fg * 9 / 10);
+}

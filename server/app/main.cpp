@@ -347,7 +347,7 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     renderCmd->add_option("--view", render.view,
                           "shaded (default), or unlit: bump / displacement height as grey, normal")
-        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal"}));
+        ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal", "basecolor", "lighting"}));
     renderCmd->add_flag("--timings", render.timings,
                         "Print where the time went (start-up, the first frame's stages, encode) as JSON on stderr");
     renderCmd->add_flag("--heightmaps", render.heightmaps,

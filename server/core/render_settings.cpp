@@ -77,12 +77,15 @@ std::string_view toString(FrameView v) {
     case FrameView::Bump: return "bump";
     case FrameView::Displacement: return "displacement";
     case FrameView::Normal: return "normal";
+    case FrameView::BaseColor: return "basecolor";
+    case FrameView::Lighting: return "lighting";
     }
     return "shaded";
 }
 
 std::optional<FrameView> frameViewFromString(std::string_view s) {
-    for (FrameView v : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal})
+    for (FrameView v : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal,
+                        FrameView::BaseColor, FrameView::Lighting})
         if (toString(v) == s) return v;
     return std::nullopt;
 }

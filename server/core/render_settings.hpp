@@ -84,9 +84,14 @@ struct RenderSettings {
 /// pattern mapping: height 0 is 128, ±1 is 255 / 1); Normal the bump-mapped world normal as
 /// rgb, byte = 255·(n·0.5 + 0.5). Sizes, camera, MSAA and displacement are the same in every
 /// view; the background is the shaded view's.
-enum class FrameView { Shaded, Bump, Displacement, Normal };
+/// BaseColor and Lighting (issue #26) take the glTF material apart, lit or not by the pbr
+/// shading's light whatever `render.shading` says: BaseColor the base colour (factor × texture ×
+/// vertex colour, alpha-masked) as it is, unlit; Lighting the light alone on a white rough
+/// dielectric with the model's normal map and the bump. Normal with `render.shading` "pbr" includes
+/// the model's normal map.
+enum class FrameView { Shaded, Bump, Displacement, Normal, BaseColor, Lighting };
 
-/// "shaded", "bump", "displacement", "normal".
+/// "shaded", "bump", "displacement", "normal", "basecolor", "lighting".
 std::string_view toString(FrameView v);
 /// The view spelled `s` as toString writes it; nullopt for any other string (case-sensitive).
 std::optional<FrameView> frameViewFromString(std::string_view s);

@@ -93,7 +93,7 @@ Status Renderer::Impl::checkFrameRequest(const FrameRequest& req) const {
                              std::to_string(maxRenderbufferSize));
     if (!req.model) return makeError(ErrorCode::InvalidArgument, kWhere, "model", "no model");
     if (static_cast<int>(req.view) < static_cast<int>(FrameView::Shaded) ||
-        static_cast<int>(req.view) > static_cast<int>(FrameView::Normal))
+        static_cast<int>(req.view) > static_cast<int>(FrameView::Lighting))
         return makeError(ErrorCode::InvalidArgument, kWhere, "view", "not a FrameView");
     if (req.outlines.size() > kMaxFrameOutlines)
         return makeError(ErrorCode::InvalidArgument, kWhere, "outlines",
@@ -151,7 +151,10 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     out.cameraDistance = camera.distance;
     uploadFrameBlock(camera, dispScale, bumpScale, heightSource->size);
     uploadOutlineBlock(req.outlines);
-    const bool pbr = rs.shading == Shading::Pbr && req.view == FrameView::Shaded;
+    // The pbr program draws the pbr shading and its views (BaseColor and Lighting always; Normal
+    // with the model's normal map when the shading is pbr).
+    const bool pbr = req.view == FrameView::BaseColor || req.view == FrameView::Lighting ||
+                     (rs.shading == Shading::Pbr && (req.view == FrameView::Shaded || req.view == FrameView::Normal));
     if (pbr) {
         auto light = environmentLight(req.environment);
         if (!light) return light.error();

@@ -147,7 +147,8 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         const auto view = frameViewFromString(req.get_param_value("view"));
         if (!view) {
             sendError(res, 422, "invalid_argument",
-                      "dermis::Api: view: must be shaded, bump, displacement or normal", "view");
+                      "dermis::Api: view: must be shaded, bump, displacement, normal, basecolor or lighting",
+                      "view");
             return false;
         }
         p.view = *view;

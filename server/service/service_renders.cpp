@@ -381,7 +381,7 @@ Result<Service::BatchJob> Service::batch(const json& body,
     }
     if (auto v = body.find("view"); v != body.end()) {
         auto view = v->is_string() ? frameViewFromString(v->get<std::string>()) : std::nullopt;
-        if (!view) return bad("/view", "must be shaded, bump, displacement or normal");
+        if (!view) return bad("/view", "must be shaded, bump, displacement, normal, basecolor or lighting");
         params.view = *view;
     }
     struct Item {

@@ -292,10 +292,10 @@ struct Renderer::Impl {
     /// (+ DERMIS_PBR and pbr.glsl when `pbr`); fails with the GL's log. Only buildPrograms calls
     /// it (never during a frame).
     Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false);
-    /// The skin program of a frame (built at start by buildPrograms): the PBR one for a shaded
-    /// frame with `pbr`.
+    /// The skin program of a frame (built at start by buildPrograms): the PBR one (every view
+    /// it draws, chosen by PartBlock's u_part.w) with `pbr`.
     GLuint skinProgram(bool tess, FrameView view, bool pbr = false) const {
-        if (pbr && view == FrameView::Shaded) return pbrPrograms[tess ? 1 : 0];
+        if (pbr) return pbrPrograms[tess ? 1 : 0];
         return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
     }
     /// The light of `env` (null: the default studio environment), prefiltered on the CPU the
