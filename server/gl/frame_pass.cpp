@@ -242,8 +242,8 @@ void Renderer::Impl::uploadOutlineBlock(const std::vector<FrameOutline>& outline
 }
 
 /// One PartBlock per part in partUbo (bound by range per draw), each with the frame's view in
-/// part.w (informative: skin.frag's program variant, DERMIS_VIEW, draws the view); returns the
-/// stride.
+/// part.w (the legacy programs draw their DERMIS_VIEW variant; the pbr program chooses its view
+/// by it) and, with `pbr`, the material (fillMaterialBlock); returns the stride.
 std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel& gm,
                                              const std::vector<GpuModel::Part>& parts, FrameView view,
                                              bool pbr) {
