@@ -16,7 +16,7 @@ namespace {
 
 struct SceneOptions {
     std::string id, file, pid, out, model = "builtin:default", clip;
-    std::vector<std::string> ids, fields, joints;
+    std::vector<std::string> ids, fields, joints, morphs;
     bool defaultPatterns = false, replace = false, apply = false, dryRun = false, update = false;
     std::string from;
     std::vector<std::string> jointMap;
@@ -82,6 +82,21 @@ nlohmann::json jointsObject(const std::vector<std::string>& joints) {
         } else {
             throw usageError("joint " + name + ": expected x,y,z degrees or a quaternion x,y,z,w, got \"" + value + "\"", j);
         }
+    }
+    return obj;
+}
+
+/// NAME=W (a morph target's weight) or NAME=none (remove), each --morph once.
+nlohmann::json morphsObject(const std::vector<std::string>& morphs) {
+    nlohmann::json obj = nlohmann::json::object();
+    for (const auto& m : morphs) {
+        const auto eq = m.find('=');
+        if (eq == std::string::npos || eq == 0) throw usageError("expected NAME=WEIGHT, got \"" + m + "\"", "--morph");
+        const std::string name = m.substr(0, eq), value = m.substr(eq + 1);
+        nlohmann::json v;
+        if (value == "none" || value == "null") obj[name] = nullptr;
+        else if (numberList(value, v) && v.size() == 1) obj[name] = v[0];
+        else throw usageError("morph " + name + ": expected a number, got \"" + value + "\"", "--morph");
     }
     return obj;
 }
@@ -285,11 +300,12 @@ void addSceneCommands(CLI::App& app, Context& ctx) {
     // --- pose
     CLI::App* pose = app.add_subcommand("pose", "A scene's pose");
     pose->require_subcommand(1);
-    CLI::App* set = pose->add_subcommand("set", "Set the clip, time and joint rotations (merged into the pose)");
+    CLI::App* set = pose->add_subcommand("set", "Set the clip, time, joint rotations and morph weights (merged into the pose)");
     set->add_option("id", o->id, "Scene id")->required();
     set->add_option("joints", o->joints, "JOINT=x,y,z (axis angles, degrees), JOINT=x,y,z,w (quaternion), JOINT=none (remove)");
     set->add_option("--clip", o->clip, "Animation clip (none = no clip)");
     set->add_option("--time", o->time, "Seconds into the clip")->check(CLI::NonNegativeNumber);
+    set->add_option("--morph", o->morphs, "NAME=WEIGHT: a morph target's weight (NAME=none removes it; repeatable)");
     set->add_flag("--replace", o->replace, "Replace the whole pose instead of merging");
     set->add_option("--if-revision", o->ifRevision, "Only if the scene is at this revision (If-Match)")->check(CLI::PositiveNumber);
     set->callback([&ctx, o] {
@@ -298,13 +314,15 @@ void addSceneCommands(CLI::App& app, Context& ctx) {
             if (!o->clip.empty()) body["animation"] = o->clip == "none" ? nlohmann::json() : nlohmann::json(o->clip);
             if (o->time >= 0) body["time"] = o->time;
             if (!o->joints.empty()) body["joints"] = jointsObject(o->joints);
-            if (body.empty()) throw usageError("nothing to set: give joints, --clip or --time", "joints");
+            if (!o->morphs.empty()) body["morphs"] = morphsObject(o->morphs);
+            if (body.empty()) throw usageError("nothing to set: give joints, --clip, --time or --morph", "joints");
             if (o->replace) {
                 for (auto it = body.begin(); it != body.end();)
                     it = it->is_null() ? body.erase(it) : std::next(it);
-                if (body.contains("joints"))
-                    for (auto it = body["joints"].begin(); it != body["joints"].end();)
-                        it = it->is_null() ? body["joints"].erase(it) : std::next(it);
+                for (const char* member : {"joints", "morphs"})
+                    if (body.contains(member))
+                        for (auto it = body[member].begin(); it != body[member].end();)
+                            it = it->is_null() ? body[member].erase(it) : std::next(it);
             }
             printEdit(ctx, ctx.http().sendJson(o->replace ? "PUT" : "PATCH", scenePath(o->id) + "/pose", body, ifMatch(o->ifRevision)));
             return kExitOk;

@@ -59,6 +59,8 @@ layout(std140, binding = 2) uniform PartBlock {
                        // set: texture k of the order above reads TEXCOORD_1)
     vec4 u_uvTransform[10]; // per texture (same order) two rows of its KHR_texture_transform:
                             // uv' = (dot(row0.xyz, (uv, 1)), dot(row1.xyz, (uv, 1)))
+    ivec4 u_morph;     // morph targets of the part, its first weight in u_morphWeights, vertex
+                       // count, 0 (skin.vert)
 };
 
 // Image-based light of the DERMIS_PBR programs (core/environment.hpp): the environment's

@@ -1,6 +1,7 @@
-// Skin pass (paper §4 stage 2), vertex stage: linear blend skinning (the paper's SSD) with the
-// joint palette in a shader storage buffer (any joint count), then — in the "vertex"
-// displacement variant — displacement along the skinned normal by the displacement map.
+// Skin pass (paper §4 stage 2), vertex stage: the model's morph targets, then linear blend
+// skinning (the paper's SSD) with the joint palette in a shader storage buffer (any joint
+// count), then — in the "vertex" displacement variant — displacement along the skinned normal by
+// the displacement map.
 // Variants: DERMIS_TESSELLATED (displacement moves to skin.tese), DERMIS_CAPTURE (outputs the
 // undisplaced skinned vertex for transform feedback; no later stages).
 
@@ -21,6 +22,16 @@ layout(std430, binding = 0) readonly buffer Palette {
     mat4 u_palette[];
 };
 
+// glTF morph targets (core/model.hpp MorphTarget), applied in bind space before skinning: the
+// drawn part's deltas, per target k and vertex v three vec4 at ((k·nv + v)·3) — position,
+// normal, tangent — and the frame's weights, the part's starting at u_morph.y.
+layout(std430, binding = 1) readonly buffer MorphDeltas {
+    vec4 u_morphDeltas[];
+};
+layout(std430, binding = 2) readonly buffer MorphWeights {
+    float u_morphWeights[];
+};
+
 layout(binding = 0) uniform sampler2D u_heightMap; // RG32F in the layout's UV space: bump, displacement
 
 out vec3 v_position; // world space
@@ -36,20 +47,49 @@ out vec4 v_color;
 #endif
 
 void main() {
+    // Morph targets (dermis::morphPart): p + Σ w·Δp; normal and tangent renormalised, kept when
+    // the sum vanishes.
+    vec3 position = a_position;
+    vec3 normal = a_normal;
+#ifdef DERMIS_PBR
+    vec4 tangent = a_tangent;
+#endif
+    if (u_morph.x > 0) {
+        vec3 dn = vec3(0.0);
+#ifdef DERMIS_PBR
+        vec3 dt = vec3(0.0);
+#endif
+        for (int k = 0; k < u_morph.x; ++k) {
+            float w = u_morphWeights[u_morph.y + k];
+            if (w == 0.0) continue;
+            int i = (k * u_morph.z + gl_VertexID) * 3;
+            position += w * u_morphDeltas[i].xyz;
+            dn += w * u_morphDeltas[i + 1].xyz;
+#ifdef DERMIS_PBR
+            dt += w * u_morphDeltas[i + 2].xyz;
+#endif
+        }
+        vec3 nSum = normal + dn;
+        if (dot(nSum, nSum) > 0.0) normal = normalize(nSum);
+#ifdef DERMIS_PBR
+        vec3 tSum = tangent.xyz + dt;
+        if (dot(tSum, tSum) > 0.0) tangent.xyz = normalize(tSum);
+#endif
+    }
     int base = u_part.x;
     // Σ w_k · J_k, the blended matrix (same sum as dermis::skin on the CPU).
     mat4 m = a_weights.x * u_palette[base + int(a_joints.x)] +
              a_weights.y * u_palette[base + int(a_joints.y)] +
              a_weights.z * u_palette[base + int(a_joints.z)] +
              a_weights.w * u_palette[base + int(a_joints.w)];
-    vec3 p = (m * vec4(a_position, 1.0)).xyz;
-    vec3 n = normalize(transpose(inverse(mat3(m))) * a_normal);
+    vec3 p = (m * vec4(position, 1.0)).xyz;
+    vec3 n = normalize(transpose(inverse(mat3(m))) * normal);
     v_uv = a_uv;
     v_mapUv = a_mapUv;
     v_restPosition = a_position;
     v_restNormal = a_normal;
 #ifdef DERMIS_PBR
-    v_tangent = vec4(mat3(m) * a_tangent.xyz, a_tangent.w);
+    v_tangent = vec4(mat3(m) * tangent.xyz, tangent.w);
     v_uv1 = a_uv1;
     v_color = a_color;
 #endif

@@ -160,6 +160,8 @@ TEST_F(BadInputHttpTest, BadInputGetsAJsonErrorWithTheRightStatus) {
         {"unknown joint", "POST", "/scenes", J, withPlacementField("joint", "tail_07"), {404}, "/placements/0/joint"},
         {"unknown clip", "POST", "/scenes", J, doc([](json& d) { d["pose"]["animation"] = "moonwalk"; }), {404}, "/pose/animation"},
         {"unknown pose joint", "PATCH", scene + "/pose", J, R"({"joints": {"tail_07": {"axis_angles": {"x": 5}}}})", {404}, "/pose/joints/tail_07"},
+        {"unknown morph target", "PATCH", scene + "/pose", J, R"({"morphs": {"frown": 1}})", {404}, "/pose/morphs/frown"},
+        {"morph weight out of range", "PATCH", scene + "/pose", J, R"({"morphs": {"frown": 12}})", {422}, "/pose/morphs/frown"},
         {"unknown model id", "POST", "/scenes", J, withModel("m_0000000000000000"), {404}, "/model"},
         {"model ../../etc/passwd", "POST", "/scenes", J, withModel("../../etc/passwd"), {404, 422}, "/model"},
         {"model /etc/passwd", "POST", "/scenes", J, withModel("/etc/passwd"), {404, 422}, "/model"},

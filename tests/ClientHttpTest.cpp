@@ -2,7 +2,7 @@
 // dermis-server as a real process on 127.0.0.1 (a GL context through $DERMIS_TEST_GL). It checks:
 //   * every subcommand: health, info, model upload|list|show|rm (content-addressed: the same id
 //     twice), pattern upload|list|rm, scene create|list|get|put|export|apply|rm|history|revert,
-//     pose set, placement add|set|rm|mirror, frame, maps, lint, watch, render, check;
+//     pose set (joints, clip, time, --morph), placement add|set|rm|mirror, frame, maps, lint, watch, render, check;
 //   * exit codes and messages: bad arguments → 2, server errors → 1 with
 //     "dermis: error: <message> (<field>)", an unreachable server → 3;
 //   * render --resume after the client is killed (SIGKILL) mid-range writes exactly the remaining
@@ -284,6 +284,12 @@ TEST_F(ClientHttpTest, ScenesPosesPlacementsAndHistory) {
     EXPECT_DOUBLE_EQ(doc["pose"]["time"].get<double>(), 0.5);
     EXPECT_EQ(doc["pose"]["joints"]["forearm.l"]["axis_angles"]["z"], 30.0) << doc["pose"];
     EXPECT_EQ(doc["pose"]["joints"]["hand.l"]["rotation"], json({0.0, 0.0, 0.0, 1.0})) << doc["pose"];
+    // --morph reaches pose.morphs: the default character has no morph targets, so the server
+    // refuses the name (404) and the client reports it with the field; a bad weight is a usage error.
+    ClientRun morph = dermis({"pose", "set", sid, "--morph", "smile=0.5"});
+    EXPECT_EQ(morph.code, 1) << morph;
+    EXPECT_NE(morph.err.find("(/pose/morphs/smile)"), std::string::npos) << morph;
+    EXPECT_EQ(dermis({"pose", "set", sid, "--morph", "smile=lots"}).code, 2);
 
     EXPECT_EQ(dermis({"placement", "set", sid, "elbow_l", "h=1.5", "label=left elbow"}).out, sid + " r3\n");
     EXPECT_EQ(dermis({"placement", "add", sid, "id=extra", "pattern=crease", "center=0.289,0.70", "scale=0.05,0.05", "joint=forearm.l",

@@ -199,6 +199,32 @@ struct SkinnedTriangle {
     }
 };
 
+/// SkinnedTriangle with two morph targets on its mesh (glTF 2.0 §3.7.2.2) named by
+/// extras.targetNames: "smile" moves vertex 2 by (0, 0.5, 0) and tips its normal towards +x,
+/// "blink" moves vertex 1 by (0, 0, 1); mesh weights [0.25, 0]; a second clip "face" drives the
+/// weights LINEARly from [0, 0] at 0 s to [1, 0.5] at 1 s.
+struct MorphedTriangle : SkinnedTriangle {
+    int smilePosition, smileNormal, blinkPosition, faceTimes, faceWeights;
+
+    MorphedTriangle() {
+        smilePosition = b.add(std::vector<float>{0, 0, 0, 0, 0, 0, 0, 0.5f, 0}, kFloat, "VEC3");
+        smileNormal = b.add(std::vector<float>{0, 0, 0, 0, 0, 0, 1, 0, 0}, kFloat, "VEC3");
+        blinkPosition = b.add(std::vector<float>{0, 0, 0, 0, 0, 1, 0, 0, 0}, kFloat, "VEC3");
+        json& mesh = b.doc["meshes"][0];
+        mesh["primitives"][0]["targets"] =
+            json::array({{{"POSITION", smilePosition}, {"NORMAL", smileNormal}},
+                         {{"POSITION", blinkPosition}}});
+        mesh["weights"] = {0.25, 0.0};
+        mesh["extras"] = {{"targetNames", {"smile", "blink"}}};
+        faceTimes = b.add(std::vector<float>{0, 1}, kFloat, "SCALAR");
+        faceWeights = b.add(std::vector<float>{0, 0, 1, 0.5f}, kFloat, "SCALAR");
+        b.doc["animations"].push_back(
+            {{"name", "face"},
+             {"samplers", {{{"input", faceTimes}, {"output", faceWeights}, {"interpolation", "LINEAR"}}}},
+             {"channels", {{{"sampler", 0}, {"target", {{"node", 2}, {"path", "weights"}}}}}}});
+    }
+};
+
 // --- files that declare more than they hold ---------------------------------------------------
 
 /// A GLB of a few hundred bytes: one mesh whose POSITION accessor has no buffer view (so `count`
@@ -323,6 +349,15 @@ inline void expectConsistent(const Model& m) {
             ASSERT_NEAR(sum, 1.0f, 1e-5f);
         }
         ASSERT_TRUE(p.material >= -1 && p.material < static_cast<int>(m.materials.size()));
+        for (const MorphTarget& t : p.morphs) {
+            ASSERT_TRUE(t.weight >= 0 && static_cast<std::size_t>(t.weight) < m.morphWeights.size());
+            for (const auto* d : {&t.positions, &t.normals, &t.tangents})
+                ASSERT_TRUE(d->empty() || d->size() == nv);
+        }
+    }
+    for (const MorphWeight& w : m.morphWeights) {
+        ASSERT_FALSE(w.name.empty());
+        ASSERT_TRUE(w.node >= 0 && static_cast<std::size_t>(w.node) < nodes);
     }
     for (const Material& mat : m.materials)
         ASSERT_TRUE(mat.baseColorTexture >= -1 &&
@@ -333,7 +368,12 @@ inline void expectConsistent(const Model& m) {
             ASSERT_FALSE(ch.times.empty());
             for (std::size_t k = 1; k < ch.times.size(); ++k)
                 ASSERT_GT(ch.times[k], ch.times[k - 1]);
-            const std::size_t comps = ch.path == ChannelPath::Rotation ? 4 : 3;
+            const std::size_t comps = ch.path == ChannelPath::Rotation  ? 4
+                                      : ch.path == ChannelPath::Weights ? static_cast<std::size_t>(ch.morphCount)
+                                                                        : 3;
+            if (ch.path == ChannelPath::Weights)
+                ASSERT_TRUE(ch.morphFirst >= 0 && ch.morphCount > 0 &&
+                            static_cast<std::size_t>(ch.morphFirst + ch.morphCount) <= m.morphWeights.size());
             const std::size_t per = ch.interpolation == Interpolation::CubicSpline ? 3 : 1;
             ASSERT_EQ(ch.values.size(), ch.times.size() * comps * per);
             ASSERT_LE(ch.times.back(), c.duration);

@@ -1,6 +1,7 @@
 // The one image-comparison helper of the tests: compares a rendered RGBA8 frame with a reference
-// PNG under a tolerance, and on failure (or a missing reference) saves the actual image and a
-// difference image beside the build's test output, naming them in the failure message.
+// PNG (compareWithReference) or with another rendered frame (compareImages) under a tolerance,
+// and on failure (or a missing reference) saves the actual image and a difference image beside
+// the build's test output, naming them in the failure message.
 //
 // Set DERMIS_UPDATE_REFERENCES=1 to (re)write the reference from the actual image instead; the
 // comparison then passes only if the write succeeds. References live in tests/reference/.
@@ -35,6 +36,9 @@ inline std::filesystem::path testOutputDir() {
     return dir;
 }
 
+inline ::testing::AssertionResult compareImages(const Image8& actual, const Image8& expected,
+                                                const std::string& name, const ImageTolerance& tol);
+
 inline ::testing::AssertionResult compareWithReference(const Image8& actual,
                                                        const std::string& referencePath,
                                                        const ImageTolerance& tol = {}) {
@@ -58,6 +62,16 @@ inline ::testing::AssertionResult compareWithReference(const Image8& actual,
                << "); actual image saved as " << actualPath
                << " — run with DERMIS_UPDATE_REFERENCES=1 to create it";
     }
+    return compareImages(actual, *ref, name, tol);
+}
+
+/// `actual` against `expected` (both rendered) under `tol`; on failure both and their difference
+/// are saved as <name>.actual.png, <name>.expected.png and <name>.diff.png in testOutputDir().
+inline ::testing::AssertionResult compareImages(const Image8& actual, const Image8& expected,
+                                                const std::string& name, const ImageTolerance& tol = {}) {
+    const std::string actualPath = (testOutputDir() / (name + ".actual.png")).string();
+    auto saveActual = [&] { (void)writeFrame(actualPath, actual); };
+    const Image8* ref = &expected;
     if (ref->width != actual.width || ref->height != actual.height) {
         saveActual();
         return ::testing::AssertionFailure()
@@ -87,6 +101,7 @@ inline ::testing::AssertionResult compareWithReference(const Image8& actual,
     if (fraction <= tol.maxDifferingFraction && mean <= tol.maxMeanAbsDiff)
         return ::testing::AssertionSuccess();
     saveActual();
+    (void)writeFrame((testOutputDir() / (name + ".expected.png")).string(), expected);
     const std::string diffPath = (testOutputDir() / (name + ".diff.png")).string();
     (void)writeFrame(diffPath, diff);
     std::ostringstream msg;

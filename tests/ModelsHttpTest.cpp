@@ -3,6 +3,8 @@
 // over loopback). It checks:
 //   * models: built-in details, .glb uploads of the shared models (CesiumMan, KayKit Barbarian,
 //     RiggedFigure without UVs), UV layouts as JSON and PNG, deletion (409 while a scene uses it);
+//   * morph targets listed by name in a model's details and posed through the scene's
+//     pose.morphs (merged like the joints; an unknown name 404 naming it);
 //   * the UV diagnosis in a model's details (`uv`, SPEC §8): the default character and CesiumMan
 //     usable without overlap, the Barbarian's palette atlas overlapping with its regions named
 //     (the hat shares texels with the body; left and right forearm mirrored), RiggedFigure
@@ -35,6 +37,43 @@ class ModelsHttpTest : public SharedServerTest {};
 // ================================================================================================
 // Models
 // ================================================================================================
+
+TEST_F(ModelsHttpTest, MorphTargetsAreListedAndPosedByName) {
+    Http h = http();
+    gltf::MorphedTriangle t;
+    Reply up = h.upload("/models", t.b.glb(), "model/gltf-binary");
+    ASSERT_EQ(up.status, 201) << up;
+    const std::string model = up.js()["id"];
+    const json details = h.get("/models/" + model).js();
+    ASSERT_EQ(details["morphs"].size(), 2u) << details.dump();
+    EXPECT_EQ(details["morphs"][0], json({{"name", "smile"}, {"rest", 0.25}}));
+    EXPECT_EQ(details["morphs"][1], json({{"name", "blink"}, {"rest", 0.0}}));
+    EXPECT_EQ(h.get("/models/builtin:default").js()["morphs"], json::array());
+
+    Reply created = h.post("/scenes", {{"format", "dermis.scene/1"}, {"model", model},
+                                       {"pose", {{"animation", "bend"}, {"time", 0}}}});
+    ASSERT_EQ(created.status, 201) << created;
+    const std::string scene = "/scenes/" + created.js()["id"].get<std::string>();
+    const std::string frame = scene + "/frame?width=96&height=96&aa=none";
+    const auto rest = decodeFrame(h.get(frame).bytes());
+    ASSERT_TRUE(rest);
+    // Merged member by member like the joints; null removes one.
+    ASSERT_EQ(h.patch(scene + "/pose", {{"morphs", {{"smile", 1.0}, {"blink", 1.0}}}}).status, 200);
+    ASSERT_EQ(h.patch(scene + "/pose", {{"morphs", {{"blink", nullptr}}}}).status, 200);
+    const json pose = h.get(scene).js()["scene"]["pose"];
+    EXPECT_EQ(pose["morphs"], json({{"smile", 1.0}})) << pose.dump();
+    const auto smiling = decodeFrame(h.get(frame).bytes());
+    ASSERT_TRUE(smiling);
+    EXPECT_NE(smiling->rgba, rest->rgba) << "the weight moved a vertex";
+    // Back to the rest weight: the first frame again.
+    ASSERT_EQ(h.patch(scene + "/pose", {{"morphs", {{"smile", 0.25}}}}).status, 200);
+    const auto again = decodeFrame(h.get(frame).bytes());
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->rgba, rest->rgba);
+    expectError(h.patch(scene + "/pose", {{"morphs", {{"frown", 1.0}}}}), 404, "/pose/morphs/frown");
+    EXPECT_EQ(h.del(scene).status, 204);
+    EXPECT_EQ(h.del("/models/" + model).status, 204);
+}
 
 TEST_F(ModelsHttpTest, BuiltinModelIsListedWithItsDetails) {
     Http h = http();

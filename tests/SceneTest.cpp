@@ -320,7 +320,7 @@ TEST(SceneTest, RoundTripIsStable) {
         {"pattern":"biceps","joint":"c","center":[1e-7, 0.9999999],"scale":[16, 1e-9]}],
         "pose":{"time":3.25,"joints":{"a/b~c":{"rotation":[0.1, 0.2, 0.3, 0.4]},
                                       "q":{"rotation":[0.5, 0.5, 0.5, 0.5]},
-                                      "e":{"axis_angles":{}}}},
+                                      "e":{"axis_angles":{}}},"morphs":{"smile":0.75,"a/b":-10}},
         "render":{"size":[640, 480],"camera":{"yaw":-725.5,"pitch":-90,"distance":3.5},
                   "displacement_scale":0,"bump_strength":0,"msaa":1})"));
 }
@@ -619,6 +619,10 @@ const BadCase kBadCases[] = {
     {"JointNameEscaped", doc(R"("pose":{"joints":{"a/b~c":{"rotation":[0,0,0,0]}}})"),
      "/pose/joints/a~1b~0c/rotation"},
     {"JointNameEmpty", doc(R"("pose":{"joints":{"":{"rotation":[0,0,0,1]}}})"), "/pose/joints/"},
+    {"PoseMorphsArray", doc(R"("pose":{"morphs":[]})"), "/pose/morphs"},
+    {"PoseMorphString", doc(R"("pose":{"morphs":{"smile":"1"}})"), "/pose/morphs/smile"},
+    {"PoseMorphTooLarge", doc(R"("pose":{"morphs":{"smile":11}})"), "/pose/morphs/smile"},
+    {"PoseMorphNameEmpty", doc(R"("pose":{"morphs":{"":1}})"), "/pose/morphs/"},
     // render.
     {"RenderNumber", doc(R"("render":1)"), "/render"},
     {"RenderSizeZero", doc(R"("render":{"size":[0, 1]})"), "/render/size/0"},

@@ -48,6 +48,17 @@ Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
             local.rotation[n] = axisAnglesRotation(model.nodes[n].rotation, a[0], a[1], a[2]);
         }
     }
+    for (const auto& [name, w] : pose.morphs) {
+        bool found = false;
+        for (std::size_t k = 0; k < model.morphWeights.size() && k < local.morphWeights.size(); ++k)
+            if (model.morphWeights[k].name == name) {
+                local.morphWeights[k] = static_cast<float>(w);
+                found = true;
+            }
+        if (!found)
+            return makeError(ErrorCode::NotFound, where, "/pose/morphs/" + jsonPointerEscape(name),
+                             "the model has no morph target named '" + name + "'");
+    }
     return local;
 }
 

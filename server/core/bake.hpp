@@ -23,8 +23,10 @@ int findPosable(const Model& model, const std::string& name);
 
 /// The local pose a scene asks for: the clip (`pose.animation`, else the model's first clip, else
 /// rest) sampled at `timeOverride` or `pose.time` (clamped to the clip), then the `pose.joints`
-/// overrides (`rotation` replaces the local rotation; `axis_angles` sets q_rest·Rx·Ry·Rz).
-/// Fails (NotFound) on an unknown clip "/pose/animation" or joint "/pose/joints/<name>".
+/// overrides (`rotation` replaces the local rotation; `axis_angles` sets q_rest·Rx·Ry·Rz), then
+/// `pose.morphs` (each sets every Model::morphWeights entry of that name).
+/// Fails (NotFound) on an unknown clip "/pose/animation", joint "/pose/joints/<name>" or morph
+/// target "/pose/morphs/<name>".
 Result<LocalPose> evaluatePose(const Model& model, const Pose& pose,
                                std::optional<double> timeOverride = std::nullopt);
 

@@ -31,6 +31,25 @@ struct Influence {
     glm::mat4 inverseBind{1.0f};
 };
 
+/// One morph target of a mesh part (glTF 2.0 §3.7.2.2): displacements added to the part's
+/// bind-space attributes, scaled by the weight of Model::morphWeights[weight]:
+///   p = p₀ + Σ w_k·Δp_k,  n = normalize(n₀ + Σ w_k·Δn_k),  t = normalize(t₀ + Σ w_k·Δt_k)
+/// (core/rig.hpp morphPart; skin.vert on the GPU). Each array is empty or has one entry per vertex
+/// of the part; a rigid part's deltas are in its rest world space like its positions.
+struct MorphTarget {
+    int weight = -1; ///< index into Model::morphWeights
+    std::vector<glm::vec3> positions, normals, tangents;
+};
+
+/// One morph weight of the model: target k of the mesh a node instances (glTF keeps the weights
+/// per node, `node.weights` else `mesh.weights`; animations drive them by node). Parts of the
+/// same node instance share their weights.
+struct MorphWeight {
+    std::string name; ///< mesh.extras.targetNames[k], else "<mesh name>#<k>"
+    int node = -1;    ///< the node that instances the mesh
+    float rest = 0.0f; ///< the default weight
+};
+
 /// One triangle list (a glTF primitive). Skinned primitives keep glTF's bind space; a rigid mesh
 /// attached to node N is stored as a one-influence skin: positions in rest world space and
 /// inverseBind = inverse(restWorld(N)), so skinning with the posed world matrix moves it rigidly.
@@ -50,6 +69,8 @@ struct MeshPart {
     std::vector<std::uint32_t> indices;   ///< triangle list, 3 per triangle
     std::vector<Influence> influences;
     int material = -1;                    ///< index into Model::materials, −1 for none
+    /// glTF morph targets of the primitive (§3.7.2.2), applied in bind space before skinning.
+    std::vector<MorphTarget> morphs;
 };
 
 /// An RGBA8 image, row 0 first.
@@ -104,13 +125,16 @@ struct Material {
 };
 
 enum class Interpolation { Linear, Step, CubicSpline };
-enum class ChannelPath { Translation, Rotation, Scale };
+enum class ChannelPath { Translation, Rotation, Scale, Weights };
 
-/// One animation channel. `values` holds, per key, 3 (T, S) or 4 (R, x y z w) floats; for
-/// CubicSpline each key holds in-tangent, value, out-tangent (3 groups), as in glTF.
+/// One animation channel. `values` holds, per key, 3 (T, S), 4 (R, x y z w) or `morphCount`
+/// (Weights) floats; for CubicSpline each key holds in-tangent, value, out-tangent (3 groups), as
+/// in glTF.
 struct Channel {
     int node = -1;
     ChannelPath path = ChannelPath::Rotation;
+    /// Weights: the node's morph weights are Model::morphWeights[morphFirst, morphFirst + morphCount)
+    int morphFirst = -1, morphCount = 0;
     Interpolation interpolation = Interpolation::Linear;
     std::vector<float> times; ///< strictly increasing seconds
     std::vector<float> values;
@@ -129,6 +153,7 @@ struct Model {
     std::vector<Material> materials;
     std::vector<Image8> images;
     std::vector<Clip> clips;
+    std::vector<MorphWeight> morphWeights; ///< every morph weight (MorphTarget::weight)
 
     bool hasUVs() const;        ///< every part has TEXCOORD_0 (false for a model without parts)
     std::size_t triangleCount() const;

@@ -12,9 +12,11 @@
 namespace dermis {
 namespace {
 
-/// Components of one key value for a channel path: 4 for rotations (x y z w), else 3.
-std::size_t componentsOf(ChannelPath path) {
-    return path == ChannelPath::Rotation ? 4 : 3;
+/// Components of one key value of a channel: 4 for rotations (x y z w), the node's morph weight
+/// count for weights, else 3.
+std::size_t componentsOf(const Channel& channel) {
+    if (channel.path == ChannelPath::Weights) return static_cast<std::size_t>(std::max(channel.morphCount, 0));
+    return channel.path == ChannelPath::Rotation ? 4 : 3;
 }
 
 /// The glm quaternion of glTF's [x, y, z, w] at `v`.
@@ -42,13 +44,13 @@ glm::quat slerpShortest(const glm::quat& a, glm::quat b, float t) {
 /// first key and after the last one the nearest key's value holds. Returns false (and leaves
 /// `out` alone) when the channel's arrays are inconsistent.
 bool sampleChannel(const Channel& channel, float time, float* out) {
-    const std::size_t comps = componentsOf(channel.path);
+    const std::size_t comps = componentsOf(channel);
     const std::size_t n = channel.times.size();
     const bool cubic = channel.interpolation == Interpolation::CubicSpline;
     // Per key: the value, or (CUBICSPLINE) in-tangent a_k, value v_k, out-tangent b_k.
     const std::size_t keyStride = cubic ? 3 * comps : comps;
     const std::size_t valueOffset = cubic ? comps : 0;
-    if (n == 0 || channel.values.size() < n * keyStride) return false;
+    if (n == 0 || comps == 0 || channel.values.size() < n * keyStride) return false;
     const float* values = channel.values.data();
     auto value = [&](std::size_t k) { return values + k * keyStride + valueOffset; };
 
@@ -132,6 +134,9 @@ LocalPose restPose(const Model& model) {
         pose.rotation[i] = model.nodes[i].rotation;
         pose.scale[i] = model.nodes[i].scale;
     }
+    pose.morphWeights.resize(model.morphWeights.size());
+    for (std::size_t i = 0; i < model.morphWeights.size(); ++i)
+        pose.morphWeights[i] = model.morphWeights[i].rest;
     return pose;
 }
 
@@ -141,7 +146,19 @@ LocalPose sampleClip(const Model& model, int clip, float time) {
     const Clip& c = model.clips[static_cast<std::size_t>(clip)];
     // Clamp to [0, duration]; NaN becomes 0.
     const float t = time > 0.0f ? std::min(time, c.duration) : 0.0f;
+    std::vector<float> weights;
     for (const Channel& channel : c.channels) {
+        if (channel.path == ChannelPath::Weights) {
+            if (channel.morphFirst < 0 || channel.morphCount <= 0 ||
+                static_cast<std::size_t>(channel.morphFirst) + static_cast<std::size_t>(channel.morphCount) >
+                    pose.morphWeights.size())
+                continue;
+            weights.resize(static_cast<std::size_t>(channel.morphCount));
+            if (!sampleChannel(channel, t, weights.data())) continue;
+            std::copy(weights.begin(), weights.end(),
+                      pose.morphWeights.begin() + channel.morphFirst);
+            continue;
+        }
         if (channel.node < 0 || static_cast<std::size_t>(channel.node) >= model.nodes.size())
             continue;
         float v[4];
@@ -159,6 +176,8 @@ LocalPose sampleClip(const Model& model, int clip, float time) {
             // glm::normalize maps a zero quaternion to the identity.
             pose.rotation[node] = glm::normalize(quatAt(v));
             break;
+        case ChannelPath::Weights:
+            break; // handled above
         }
     }
     return pose;
@@ -200,13 +219,64 @@ std::vector<glm::mat4> worldMatrices(const Model& model, const LocalPose& pose) 
     return world;
 }
 
-std::vector<SkinnedPart> skin(const Model& model, const std::vector<glm::mat4>& world) {
+float morphWeightOf(const Model& model, const MorphTarget& target, const std::vector<float>& weights) {
+    if (target.weight < 0 || static_cast<std::size_t>(target.weight) >= model.morphWeights.size())
+        return 0.0f;
+    const auto k = static_cast<std::size_t>(target.weight);
+    return weights.size() == model.morphWeights.size() ? weights[k] : model.morphWeights[k].rest;
+}
+
+MorphedPart morphPart(const Model& model, const MeshPart& part, const std::vector<float>& weights) {
+    MorphedPart out;
+    const std::size_t nv = part.positions.size();
+    out.positions = part.positions;
+    if (part.normals.size() == nv) out.normals = part.normals;
+    if (part.tangents.size() == nv) out.tangents = part.tangents;
+    if (part.morphs.empty()) return out;
+    std::vector<glm::vec3> tangents(out.tangents.size());
+    for (std::size_t v = 0; v < tangents.size(); ++v)
+        tangents[v] = glm::vec3(out.tangents[v]);
+    bool any = false;
+    for (const MorphTarget& target : part.morphs) {
+        const float w = morphWeightOf(model, target, weights);
+        if (w == 0.0f) continue;
+        any = true;
+        auto add = [&](std::vector<glm::vec3>& dst, const std::vector<glm::vec3>& delta) {
+            if (delta.size() != nv || dst.size() != nv) return;
+            for (std::size_t v = 0; v < nv; ++v)
+                dst[v] += w * delta[v];
+        };
+        add(out.positions, target.positions);
+        add(out.normals, target.normals);
+        add(tangents, target.tangents);
+    }
+    if (!any) return out;
+    for (std::size_t v = 0; v < out.normals.size(); ++v) {
+        const float len = glm::length(out.normals[v]);
+        out.normals[v] = len > 0.0f && std::isfinite(len) ? out.normals[v] / len : part.normals[v];
+    }
+    for (std::size_t v = 0; v < tangents.size(); ++v) {
+        const float len = glm::length(tangents[v]);
+        if (len > 0.0f && std::isfinite(len))
+            out.tangents[v] = glm::vec4(tangents[v] / len, part.tangents[v].w);
+    }
+    return out;
+}
+
+std::vector<SkinnedPart> skin(const Model& model, const std::vector<glm::mat4>& world,
+                              const std::vector<float>& morphWeights) {
     std::vector<SkinnedPart> out(model.parts.size());
     std::vector<glm::mat4> jointMatrix;
+    MorphedPart morphed;
     for (std::size_t pi = 0; pi < model.parts.size(); ++pi) {
         const MeshPart& part = model.parts[pi];
         SkinnedPart& sp = out[pi];
         const std::size_t nv = part.positions.size();
+        // Morph targets first (bind space), then skinning, in glTF 2.0's order.
+        const bool morphs = !part.morphs.empty();
+        if (morphs) morphed = morphPart(model, part, morphWeights);
+        const std::vector<glm::vec3>& positions = morphs ? morphed.positions : part.positions;
+        const std::vector<glm::vec3>& normals = morphs ? morphed.normals : part.normals;
 
         // Joint matrix of each influence: world(node_k) · inverseBind_k.
         jointMatrix.assign(part.influences.size(), glm::mat4(1.0f));
@@ -217,7 +287,7 @@ std::vector<SkinnedPart> skin(const Model& model, const std::vector<glm::mat4>& 
                              inf.inverseBind;
         }
 
-        const bool hasNormals = part.normals.size() == nv;
+        const bool hasNormals = normals.size() == nv;
         const bool hasWeights = part.joints.size() == nv && part.weights.size() == nv;
         sp.positions.resize(nv);
         sp.normals.resize(nv);
@@ -233,11 +303,11 @@ std::vector<SkinnedPart> skin(const Model& model, const std::vector<glm::mat4>& 
             } else {
                 m = jointMatrix.empty() ? glm::mat4(1.0f) : jointMatrix[0];
             }
-            sp.positions[v] = glm::vec3(m * glm::vec4(part.positions[v], 1.0f));
+            sp.positions[v] = glm::vec3(m * glm::vec4(positions[v], 1.0f));
             if (hasNormals) {
-                const glm::vec3 nrm = normalMatrix(glm::mat3(m)) * part.normals[v];
+                const glm::vec3 nrm = normalMatrix(glm::mat3(m)) * normals[v];
                 const float len = glm::length(nrm);
-                sp.normals[v] = len > 0.0f && std::isfinite(len) ? nrm / len : part.normals[v];
+                sp.normals[v] = len > 0.0f && std::isfinite(len) ? nrm / len : normals[v];
             }
         }
         // A hand-built part without normals gets the posed surface's own.

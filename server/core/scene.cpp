@@ -97,6 +97,7 @@ json toJson(const Scene& scene) {
         joints[name] = std::move(j);
     }
     pose["joints"] = std::move(joints);
+    if (!scene.pose.morphs.empty()) pose["morphs"] = scene.pose.morphs; // written only when set
     doc["pose"] = std::move(pose);
 
     const RenderSettings& r = scene.render;

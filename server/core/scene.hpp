@@ -105,6 +105,7 @@ constexpr double kMaxAngle = 360.0;      ///< degrees: theta_min/max, pose axis_
 constexpr double kMaxTurnAngle = 3600.0; ///< degrees: footprint rotation, camera yaw ∈ [−3600, 3600]
                                          ///< (ten turns: editors may accumulate, they are periodic)
 constexpr double kMaxPoseTime = 86400.0;        ///< pose time ∈ [0, 86400] s
+constexpr double kMaxMorphWeight = 10.0;        ///< pose morph weights ∈ [−10, 10]
 constexpr double kMaxCameraDistance = 10000.0;  ///< camera distance ∈ (0, 10000] model units
 constexpr double kMaxCameraTarget = 1.0e6;      ///< each camera target coordinate ∈ [−1e6, 1e6]
 constexpr double kMaxDisplacementScale = 1000.0; ///< displacement_scale ∈ [0, 1000]
@@ -122,6 +123,9 @@ struct Pose {
     std::optional<std::string> animation; ///< clip name; absent = the model's first clip
     double time = 0.0;                    ///< seconds, ≥ 0 (clamped to the clip when evaluated)
     std::map<std::string, JointPose> joints;
+    /// Morph weights by name (Model::morphWeights' names, glTF mesh.extras.targetNames): each
+    /// sets every weight of that name, over the clip's.
+    std::map<std::string, double> morphs;
 };
 
 struct Scene {

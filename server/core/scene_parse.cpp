@@ -476,6 +476,17 @@ Status parsePose(const Reader& rd, const json& v, Pose& pose) {
             pose.joints.emplace(name, jp);
         }
     }
+    if (const json* morphs = Reader::find(v, "morphs")) {
+        if (auto s = rd.object(*morphs, ptr + "/morphs"); !s) return s;
+        for (const auto& [name, mv] : morphs->items()) {
+            const std::string p = member(ptr + "/morphs", name);
+            if (name.empty()) return rd.bad(p, "morph target name must not be empty");
+            if (!validUtf8(name)) return rd.bad(p, "morph target name must be valid UTF-8");
+            auto w = rd.numberIn(mv, p, -kMaxMorphWeight, kMaxMorphWeight);
+            if (!w) return w.error();
+            pose.morphs.emplace(name, *w);
+        }
+    }
     return Ok{};
 }
 

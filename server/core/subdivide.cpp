@@ -84,6 +84,9 @@ Result<MeshPart> subdivideMidpoint(const MeshPart& part) {
             out.tangents.push_back(len > 0.0f ? glm::vec4(t / len, out.tangents[a].w)
                                               : out.tangents[a]);
         }
+        for (MorphTarget& t : out.morphs) // deltas of a midpoint: the mean (a linear blend)
+            for (std::vector<glm::vec3>* d : {&t.positions, &t.normals, &t.tangents})
+                if (d->size() == m) d->push_back(0.5f * ((*d)[a] + (*d)[b]));
         if (hasSkin) {
             auto [j, w] = blendSkin(out.joints[a], out.weights[a], out.joints[b], out.weights[b]);
             out.joints.push_back(j);

@@ -67,6 +67,11 @@ Model modelThroughLayout(const Model& model, const TextureLayout& layout) {
         part.uvs1 = gather(src.uvs1);
         part.tangents = gather(src.tangents);
         part.colors = gather(src.colors);
+        for (MorphTarget& t : part.morphs) {
+            t.positions = gather(t.positions);
+            t.normals = gather(t.normals);
+            t.tangents = gather(t.tangents);
+        }
         part.uvs = pl.uvs;
         part.indices = pl.indices;
     }

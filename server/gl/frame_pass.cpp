@@ -138,11 +138,11 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     const int samples = aa.samples;
     out.antiAliasing = aa.label();
     if (auto s = ensureFrameTargets(W, H, samples); !s) return s.error();
-    uploadPalette(model, **gm, req.world);
+    uploadPalette(model, **gm, req.world, req.morphWeights);
     const double dispScale = rs.displacementScale ? *rs.displacementScale : (*gm)->autoDisplacement;
     const double bumpScale = 0.25 * (*gm)->autoDisplacement * rs.bumpStrength;
     // Framed on the posed bounds (CPU skinning of the same pose: cheap at these sizes).
-    const std::vector<SkinnedPart> posed = skin(model, req.world);
+    const std::vector<SkinnedPart> posed = skin(model, req.world, req.morphWeights);
     const Bounds bounds = framingBounds(posed);
     out.boundsMin = bounds.min;
     out.boundsMax = bounds.max;
@@ -258,6 +258,7 @@ std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel&
         const bool textured = gm.baseColorTexture(model, gp) != 0 && gp.hasUVs;
         pb.part = glm::ivec4(gp.paletteOffset, textured ? 1 : 0, gp.hasMapUVs ? 1 : 0,
                              static_cast<int>(view));
+        pb.morph = glm::ivec4(gp.morphTargets, gp.morphWeightOffset, gp.vertexCount, 0);
         if (pbr) fillMaterialBlock(pb, model, gm, gp);
         std::memcpy(partBlocks.data() + stride * pi, &pb, sizeof pb);
     }
@@ -317,6 +318,7 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
             const GLuint colorTex = gm.baseColorTexture(model, gp);
             glBindTexture(GL_TEXTURE_2D, colorTex ? colorTex : whiteTexture);
         }
+        bindMorphDeltas(gp);
         glBindVertexArray(gp.vao);
         glDrawElements(tess ? GL_PATCHES : GL_TRIANGLES, gp.indexCount, GL_UNSIGNED_INT, nullptr);
     }
@@ -360,10 +362,16 @@ Status Renderer::Impl::readFrame(GLuint readFbo, Image8& image) {
 // --- transform-feedback skinning ------------------------------------------------------------------
 
 Result<std::vector<SkinnedPart>> Renderer::Impl::skinOnGpu(const std::shared_ptr<const Model>& model,
-                                                           const std::vector<glm::mat4>& world) {
+                                                           const std::vector<glm::mat4>& world,
+                                                           const std::vector<float>& morphWeights) {
     auto gm = modelFor(model);
     if (!gm) return gm.error();
-    uploadPalette(*model, **gm, world);
+    uploadPalette(*model, **gm, world, morphWeights);
+    // A draw needs a complete framebuffer even with rasterization discarded; a surfaceless
+    // context has no default one (GL_INVALID_FRAMEBUFFER_OPERATION when no frame came first).
+    if (frame.fbo == 0)
+        if (auto s = ensureFrameTargets(16, 16, 1); !s) return s.error();
+    glBindFramebuffer(GL_FRAMEBUFFER, frame.fbo);
     glUseProgram(captureProgram);
     glEnable(GL_RASTERIZER_DISCARD);
     std::vector<SkinnedPart> out((*gm)->parts.size());
@@ -374,6 +382,8 @@ Result<std::vector<SkinnedPart>> Renderer::Impl::skinOnGpu(const std::shared_ptr
         const std::size_t nv = static_cast<std::size_t>(gp.vertexCount);
         if (nv == 0) continue;
         pb.part = glm::ivec4(gp.paletteOffset, 0, 0, 0);
+        pb.morph = glm::ivec4(gp.morphTargets, gp.morphWeightOffset, gp.vertexCount, 0);
+        bindMorphDeltas(gp);
         glBindBuffer(GL_UNIFORM_BUFFER, partUbo);
         glBufferData(GL_UNIFORM_BUFFER, sizeof pb, &pb, GL_STREAM_DRAW);
         glBindBufferBase(GL_UNIFORM_BUFFER, kPartBinding, partUbo);

@@ -27,7 +27,7 @@ namespace {
 void destroyParts(std::vector<GpuModel::Part>& parts) {
     for (GpuModel::Part& p : parts) {
         glDeleteVertexArrays(1, &p.vao);
-        glDeleteBuffers(10, p.buffers);
+        glDeleteBuffers(static_cast<GLsizei>(std::size(p.buffers)), p.buffers);
     }
     parts.clear();
 }
@@ -138,7 +138,8 @@ std::size_t uploadBytes(const Model& m) {
     std::size_t bytes = 0;
     for (const MeshPart& part : m.parts)
         bytes += part.positions.size() * 56 + part.indices.size() * 4 +
-                 (part.tangents.size() + part.colors.size()) * 16 + part.uvs1.size() * 8;
+                 (part.tangents.size() + part.colors.size()) * 16 + part.uvs1.size() * 8 +
+                 part.morphs.size() * part.positions.size() * 48;
     for (const Image8& img : m.images)
         bytes += static_cast<std::size_t>(std::max(img.width, 1)) * std::max(img.height, 1) * 4 * 4 / 3;
     for (const Material& mat : m.materials) // the linear copies (counted per use: an upper bound)
@@ -248,10 +249,39 @@ void uploadArrays(GpuModel::Part& gp, const std::vector<glm::vec3>& positions,
     glBindVertexArray(0);
 }
 
+/// The morph deltas of `part` into buffers[10] (skin.vert's MorphDeltas): per target k and
+/// vertex v three vec4 at ((k·nv + v)·3), the position, normal and tangent deltas (zero where the
+/// target has none). Vertex v reads source vertex (*source)[v] (null: v itself; layout parts).
+/// Returns the bytes uploaded (0 without targets).
+std::size_t uploadMorphs(const MeshPart& part, const std::vector<std::uint32_t>* source, GpuModel::Part& gp) {
+    const std::size_t np = part.positions.size();
+    const std::size_t nv = source ? source->size() : np;
+    const std::size_t targets = part.morphs.size();
+    if (targets == 0 || nv == 0) return 0;
+    std::vector<glm::vec4> deltas(targets * nv * 3, glm::vec4(0.0f));
+    for (std::size_t k = 0; k < targets; ++k) {
+        const MorphTarget& t = part.morphs[k];
+        const std::vector<glm::vec3>* arrays[3] = {&t.positions, &t.normals, &t.tangents};
+        for (std::size_t v = 0; v < nv; ++v) {
+            const std::size_t s = source ? (*source)[v] : v;
+            for (int a = 0; a < 3; ++a)
+                if (arrays[a]->size() == np && s < np)
+                    deltas[(k * nv + v) * 3 + static_cast<std::size_t>(a)] = glm::vec4((*arrays[a])[s], 0.0f);
+        }
+    }
+    glGenBuffers(1, &gp.buffers[10]);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, gp.buffers[10]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(deltas.size() * sizeof(glm::vec4)),
+                 deltas.data(), GL_STATIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    return deltas.size() * sizeof(glm::vec4);
+}
+
 /// The vertex array and buffers of one part with the model's own UVs as the maps' UVs.
 void uploadPart(const MeshPart& part, GpuModel::Part& gp) {
     gp.hasMapUVs = gp.hasUVs;
     uploadArrays(gp, part.positions, partAttributes(part, gp.hasUVs), nullptr);
+    uploadMorphs(part, nullptr, gp);
 }
 
 /// Whether `pl` is part `part`'s own UVs (what modelTextureLayout makes of it): identity source,
@@ -305,7 +335,8 @@ std::size_t uploadLayoutPart(const MeshPart& part, const PartLayout& pl, GpuMode
                              pl.indices.begin() + static_cast<long>(i) + 3);
     gp.hasMapUVs = !a.indices.empty();
     uploadArrays(gp, positions, a, &mapUvs);
-    return lv * 64 + a.indices.size() * 4;
+    const std::size_t morphBytes = uploadMorphs(part, &source, gp);
+    return lv * 64 + a.indices.size() * 4 + morphBytes;
 }
 
 } // namespace
@@ -352,6 +383,9 @@ Result<GpuModel*> Renderer::Impl::modelFor(const std::shared_ptr<const Model>& m
         gp.vertexCount = static_cast<GLsizei>(nv);
         gp.paletteOffset = gm.paletteSize;
         gm.paletteSize += std::max<int>(1, static_cast<int>(part.influences.size()));
+        gp.morphTargets = static_cast<int>(part.morphs.size());
+        gp.morphWeightOffset = gm.morphWeightCount;
+        gm.morphWeightCount += gp.morphTargets;
         gp.material = part.material;
         gp.hasUVs = part.uvs.size() == nv && nv > 0;
         uploadPart(part, gp);
@@ -411,7 +445,8 @@ Result<const std::vector<GpuModel::Part>*> Renderer::Impl::partsFor(
 }
 
 void Renderer::Impl::uploadPalette(const Model& model, const GpuModel& gm,
-                                   const std::vector<glm::mat4>& world) {
+                                   const std::vector<glm::mat4>& world,
+                                   const std::vector<float>& morphWeights) {
     std::vector<glm::mat4> palette(static_cast<std::size_t>(std::max(gm.paletteSize, 1)),
                                    glm::mat4(1.0f));
     for (std::size_t pi = 0; pi < model.parts.size() && pi < gm.parts.size(); ++pi) {
@@ -429,6 +464,25 @@ void Renderer::Impl::uploadPalette(const Model& model, const GpuModel& gm,
                  static_cast<GLsizeiptr>(palette.size() * sizeof(glm::mat4)), palette.data(),
                  GL_STREAM_DRAW);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPaletteBinding, paletteSsbo);
+
+    // Each part's target weights from its MorphWeight entries (core morphWeightOf).
+    std::vector<float> weights(static_cast<std::size_t>(std::max(gm.morphWeightCount, 1)), 0.0f);
+    for (std::size_t pi = 0; pi < model.parts.size() && pi < gm.parts.size(); ++pi) {
+        const MeshPart& part = model.parts[pi];
+        const auto base = static_cast<std::size_t>(gm.parts[pi].morphWeightOffset);
+        for (std::size_t k = 0; k < part.morphs.size() && base + k < weights.size(); ++k)
+            weights[base + k] = morphWeightOf(model, part.morphs[k], morphWeights);
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, morphWeightSsbo);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, static_cast<GLsizeiptr>(weights.size() * sizeof(float)),
+                 weights.data(), GL_STREAM_DRAW);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kMorphWeightBinding, morphWeightSsbo);
+}
+
+void Renderer::Impl::bindMorphDeltas(const GpuModel::Part& gp) const {
+    // A part without targets never reads the buffer; any buffer keeps the binding valid.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kMorphDeltaBinding,
+                     gp.buffers[10] ? gp.buffers[10] : morphWeightSsbo);
 }
 
 } // namespace dermis

@@ -154,14 +154,15 @@ Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool 
 /// The vertex array, buffers and 1×1 textures every job shares.
 void Renderer::Impl::createSharedObjects() {
     glGenVertexArrays(1, &emptyVao);
-    GLuint bufs[6];
-    glGenBuffers(6, bufs);
+    GLuint bufs[7];
+    glGenBuffers(7, bufs);
     heightUbo = bufs[0];
     frameUbo = bufs[1];
     partUbo = bufs[2];
     paletteSsbo = bufs[3];
     feedbackBuffer = bufs[4];
     outlineUbo = bufs[5];
+    morphWeightSsbo = bufs[6];
     glBindBuffer(GL_UNIFORM_BUFFER, frameUbo);
     glBufferData(GL_UNIFORM_BUFFER, sizeof(FrameBlock), nullptr, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_UNIFORM_BUFFER, outlineUbo);
@@ -205,8 +206,8 @@ void Renderer::Impl::shutdown() {
     glDeleteTextures(1, &brdfLutTexture);
     glDeleteBuffers(1, &environmentUbo);
     brdfLutTexture = environmentUbo = 0;
-    GLuint bufs[6] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer, outlineUbo};
-    glDeleteBuffers(6, bufs);
+    GLuint bufs[7] = {heightUbo, frameUbo, partUbo, paletteSsbo, feedbackBuffer, outlineUbo, morphWeightSsbo};
+    glDeleteBuffers(7, bufs);
     glDeleteVertexArrays(1, &emptyVao);
     glDeleteTextures(1, &flatTexture);
     glDeleteTextures(1, &whiteTexture);
@@ -242,6 +243,7 @@ FrameRequest frameRequest(const FramePlan& plan, std::shared_ptr<const Model> mo
     FrameRequest req;
     req.model = std::move(model);
     req.world = plan.world;
+    req.morphWeights = plan.pose.morphWeights;
     req.render = plan.render;
     req.view = plan.view;
     req.heights = plan.heights;
@@ -300,8 +302,9 @@ Result<FrameResult> Renderer::renderFrame(const FrameRequest& request) {
 }
 
 Result<std::vector<SkinnedPart>> Renderer::skinOnGpu(const std::shared_ptr<const Model>& model,
-                                                     const std::vector<glm::mat4>& world) {
-    return impl_->run([&] { return impl_->skinOnGpu(model, world); });
+                                                     const std::vector<glm::mat4>& world,
+                                                     const std::vector<float>& morphWeights) {
+    return impl_->run([&] { return impl_->skinOnGpu(model, world, morphWeights); });
 }
 
 void Renderer::forgetPatterns() {

@@ -138,6 +138,8 @@ inline constexpr std::size_t kMaxFrameOutlines = 8;
 struct FrameRequest {
     std::shared_ptr<const Model> model;
     std::vector<glm::mat4> world; ///< worldMatrices(model, pose): one per node
+    /// LocalPose::morphWeights: one per Model::morphWeights; empty: their rest values.
+    std::vector<float> morphWeights;
     RenderSettings render;        ///< size, camera, displacement scale/mode, bump strength, MSAA
     FrameView view = FrameView::Shaded; ///< shaded, or an unlit view of the maps (render_settings.hpp)
     /// Height maps from the GPU height pass when set; else `cpuMaps` (uploaded); else flat.
@@ -212,10 +214,12 @@ public:
     void forgetModel(const std::shared_ptr<const Model>& model) override;
     std::optional<GpuCacheStats> cacheStats() const override;
 
-    /// Stage 2's skinning alone, captured with transform feedback: per part, the skinned
-    /// positions and unit normals without displacement — the GPU twin of dermis::skin.
+    /// Stage 2's morphing and skinning alone, captured with transform feedback: per part, the
+    /// skinned positions and unit normals without displacement — the GPU twin of dermis::skin
+    /// (same `morphWeights`: one per Model::morphWeights, empty for the rest values).
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
-                                               const std::vector<glm::mat4>& world);
+                                               const std::vector<glm::mat4>& world,
+                                               const std::vector<float>& morphWeights = {});
 
     /// Counters since creation: height passes run, and skipped because the targets already held
     /// the same inputs (same placements, t values, patterns, base and size).

@@ -1,6 +1,7 @@
 // glTF → Model for the loader of gltf_loader.hpp: the Converter reads the tinygltf model (nodes
 // with rest TRS and parents, skins, metallic-roughness materials, the triangle primitives
-// of the default scene's meshes, skin weights or rigid influences, animations), validating
+// of the default scene's meshes, skin weights or rigid influences; animations and morph
+// targets through gltf_animations.cpp and gltf_morph.cpp), validating
 // everything it reads; accessors go through readAccessor (gltf_accessors.cpp).
 #include "gltf_internal.hpp"
 
@@ -57,7 +58,7 @@ class Converter {
         if (auto s = skins(); !s) return s.error();
         if (auto s = materials(); !s) return s.error();
         if (auto s = meshes(); !s) return s.error();
-        if (auto s = animations(); !s) return s.error();
+        if (auto s = convertAnimations(g_, m_, morphSlots_); !s) return s.error();
         ParsedGltf out;
         out.model = std::move(m_);
         out.images = std::move(pending_);
@@ -71,6 +72,7 @@ class Converter {
     PendingImages pending_;
     std::vector<std::vector<Influence>> skinInfluences_;
     std::vector<glm::mat4> restWorld_;
+    MorphSlots morphSlots_;
 
     // --- nodes: names, rest TRS, parents -----------------------------------------------------
     Status nodes() {
@@ -388,11 +390,14 @@ class Converter {
         if (node.skin >= 0 && static_cast<std::size_t>(node.skin) >= g_.skins.size())
             return parseError(nodeField + "/skin", "skin " + str(node.skin) + " does not exist");
         const tg::Mesh& mesh = g_.meshes[static_cast<std::size_t>(node.mesh)];
+        if (auto s = addMorphWeights(g_, nodeIndex, m_, morphSlots_); !s) return s.error();
+        const auto slots = morphSlots_.find(nodeIndex);
+        const int firstWeight = slots != morphSlots_.end() ? slots->second.first : -1;
         for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
             const std::string field = "/meshes/" + str(node.mesh) + "/primitives/" + str(p);
             std::string name = !mesh.name.empty() ? mesh.name : node.name;
             if (mesh.primitives.size() > 1) name += "#" + str(p);
-            if (auto s = primitive(nodeIndex, mesh.primitives[p], field, name); !s)
+            if (auto s = primitive(nodeIndex, mesh.primitives[p], field, name, firstWeight); !s)
                 return s.error();
         }
         return Ok{};
@@ -417,7 +422,7 @@ class Converter {
     }
 
     Status primitive(int nodeIndex, const tg::Primitive& prim, const std::string& field,
-                     const std::string& name) {
+                     const std::string& name, int firstWeight) {
         // Topology (glTF 2.0 §3.7.2.1): lists, strips and fans become lists; points and lines
         // are not surfaces and are skipped.
         const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
@@ -569,6 +574,9 @@ class Converter {
                                                       rgb ? 1.0 : (*col)->at(v, 3)));
         }
 
+        if (!prim.targets.empty())
+            if (auto s = readMorphTargets(g_, prim, field, firstWeight, part); !s) return s.error();
+
         // Skinned (node has a skin and the primitive has JOINTS_0), else rigid on the node.
         const tg::Node& node = g_.nodes[static_cast<std::size_t>(nodeIndex)];
         const bool skinned = node.skin >= 0 && prim.attributes.count("JOINTS_0") != 0;
@@ -676,6 +684,9 @@ class Converter {
             if (ok) {
                 inf.inverseBind = glm::mat4(inverse);
                 const glm::dmat3 nm = glm::transpose(glm::inverse(glm::dmat3(dworld)));
+                // Per vertex 1/|M·v₀| of the normal and tangent, for their morph deltas.
+                std::vector<double> normalScale(part.morphs.empty() ? 0 : part.positions.size(), 1.0);
+                std::vector<double> tangentScale(normalScale.size(), 1.0);
                 for (std::size_t v = 0; v < part.positions.size(); ++v) {
                     const glm::dvec3 p(dworld * glm::dvec4(glm::dvec3(part.positions[v]), 1.0));
                     if (!fitsFloat(p.x) || !fitsFloat(p.y) || !fitsFloat(p.z))
@@ -684,104 +695,29 @@ class Converter {
                     part.positions[v] = glm::vec3(p);
                     const glm::dvec3 n = nm * glm::dvec3(part.normals[v]);
                     const double len = glm::length(n);
-                    if (len > 0.0 && std::isfinite(len)) part.normals[v] = glm::vec3(n / len);
+                    if (len > 0.0 && std::isfinite(len)) {
+                        part.normals[v] = glm::vec3(n / len);
+                        if (!normalScale.empty()) normalScale[v] = 1.0 / len;
+                    }
                     if (!part.tangents.empty()) {
                         // Tangents move with the surface (the matrix, not its inverse
                         // transpose); a mirroring transform flips the bitangent's sign.
                         const glm::dvec3 t = glm::dmat3(dworld) * glm::dvec3(part.tangents[v]);
                         const double tl = glm::length(t);
-                        if (tl > 0.0 && std::isfinite(tl))
+                        if (tl > 0.0 && std::isfinite(tl)) {
                             part.tangents[v] = glm::vec4(glm::vec3(t / tl),
                                                          det < 0.0 ? -part.tangents[v].w
                                                                    : part.tangents[v].w);
+                            if (!tangentScale.empty()) tangentScale[v] = 1.0 / tl;
+                        }
                     }
                 }
+                if (!part.morphs.empty()) transformMorphs(part, dworld, normalScale, tangentScale);
             }
         }
         part.influences = {inf};
         part.joints.assign(part.positions.size(), glm::u16vec4(0));
         part.weights.assign(part.positions.size(), glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
-        return Ok{};
-    }
-
-    // --- animations -------------------------------------------------------------------------
-    Status animations() {
-        for (std::size_t a = 0; a < g_.animations.size(); ++a) {
-            const tg::Animation& anim = g_.animations[a];
-            const std::string field = "/animations/" + str(a);
-            Clip clip;
-            clip.name = anim.name.empty() ? "animation" + str(a) : anim.name;
-            for (std::size_t c = 0; c < anim.channels.size(); ++c) {
-                const tg::AnimationChannel& ch = anim.channels[c];
-                const std::string cfield = field + "/channels/" + str(c);
-                ChannelPath path;
-                if (ch.target_path == "translation")
-                    path = ChannelPath::Translation;
-                else if (ch.target_path == "rotation")
-                    path = ChannelPath::Rotation;
-                else if (ch.target_path == "scale")
-                    path = ChannelPath::Scale;
-                else
-                    continue; // "weights" (morph targets) and extension paths: not loaded
-                if (ch.target_node < 0) continue; // targeted by an extension only
-                if (static_cast<std::size_t>(ch.target_node) >= m_.nodes.size())
-                    return parseError(cfield + "/target/node",
-                                      "node " + str(ch.target_node) + " does not exist");
-                if (ch.sampler < 0 || static_cast<std::size_t>(ch.sampler) >= anim.samplers.size())
-                    return parseError(cfield + "/sampler",
-                                      "sampler " + str(ch.sampler) + " does not exist");
-                const tg::AnimationSampler& smp =
-                    anim.samplers[static_cast<std::size_t>(ch.sampler)];
-                const std::string sfield = field + "/samplers/" + str(ch.sampler);
-                Channel out;
-                out.node = ch.target_node;
-                out.path = path;
-                if (smp.interpolation == "LINEAR" || smp.interpolation.empty())
-                    out.interpolation = Interpolation::Linear;
-                else if (smp.interpolation == "STEP")
-                    out.interpolation = Interpolation::Step;
-                else if (smp.interpolation == "CUBICSPLINE")
-                    out.interpolation = Interpolation::CubicSpline;
-                else
-                    return makeError(ErrorCode::Unsupported, kWhere, sfield + "/interpolation",
-                                     "unknown interpolation '" + smp.interpolation + "'");
-
-                auto in = readAccessor(g_, smp.input, TINYGLTF_TYPE_SCALAR, Want::Float,
-                                       {TINYGLTF_COMPONENT_TYPE_FLOAT}, sfield + "/input");
-                if (!in) return in.error();
-                if (in->count == 0) return parseError(sfield + "/input", "no keys");
-                out.times.resize(in->count);
-                for (std::size_t k = 0; k < in->count; ++k) {
-                    const double t = in->values[k];
-                    if (!std::isfinite(t) || !std::isfinite(static_cast<float>(t)))
-                        return parseError(sfield + "/input", "non-finite key time");
-                    out.times[k] = static_cast<float>(t);
-                    if (k > 0 && !(out.times[k] > out.times[k - 1]))
-                        return parseError(sfield + "/input",
-                                          "key times must be strictly increasing (key " + str(k) +
-                                              ")");
-                }
-                const int type =
-                    path == ChannelPath::Rotation ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3;
-                auto values =
-                    readAccessor(g_, smp.output, type, Want::Float, {}, sfield + "/output");
-                if (!values) return values.error();
-                const std::size_t perKey = out.interpolation == Interpolation::CubicSpline ? 3 : 1;
-                if (values->count != in->count * perKey)
-                    return parseError(sfield + "/output", str(values->count) + " values for " +
-                                                              str(in->count) + " keys (" +
-                                                              smp.interpolation + ")");
-                out.values.resize(values->values.size());
-                for (std::size_t k = 0; k < values->values.size(); ++k) {
-                    out.values[k] = static_cast<float>(values->values[k]);
-                    if (!std::isfinite(out.values[k]))
-                        return parseError(sfield + "/output", "non-finite value");
-                }
-                clip.duration = std::max(clip.duration, out.times.back());
-                clip.channels.push_back(std::move(out));
-            }
-            m_.clips.push_back(std::move(clip));
-        }
         return Ok{};
     }
 };

@@ -175,12 +175,22 @@ class DeclaredSizes {
                 // What each instance reads (gltf_convert.cpp: primitive, skinWeights).
                 for (const auto& [name, index] : prim.attributes) {
                     const bool read = name == "POSITION" || name == "NORMAL" ||
-                                      name == "TEXCOORD_0" || name.rfind("JOINTS_", 0) == 0 ||
+                                      name == "TEXCOORD_0" || name == "TEXCOORD_1" ||
+                                      name == "TANGENT" || name == "COLOR_0" ||
+                                      name.rfind("JOINTS_", 0) == 0 ||
                                       name.rfind("WEIGHTS_", 0) == 0;
                     if (read)
                         if (auto s = use(index, field + "/attributes/" + name, Big(inst)); !s)
                             return s;
                 }
+                // Morph targets (gltf_morph.cpp): their POSITION, NORMAL and TANGENT deltas.
+                for (std::size_t t = 0; t < prim.targets.size(); ++t)
+                    for (const auto& [name, index] : prim.targets[t])
+                        if (name == "POSITION" || name == "NORMAL" || name == "TANGENT")
+                            if (auto s = use(index, field + "/targets/" + str(t) + "/" + name,
+                                             Big(inst));
+                                !s)
+                                return s;
                 if (auto s = use(prim.indices, field + "/indices", Big(inst)); !s) return s;
                 // A skinned part copies its skin's influences (node + inverse bind: 17 values).
                 if (prim.attributes.count("JOINTS_0"))

@@ -68,6 +68,10 @@ std::size_t ContentCache::approxBytes(const Model& m) {
              (p.tangents.size() + p.colors.size()) * sizeof(glm::vec4) + p.joints.size() * sizeof(glm::u16vec4) +
              p.weights.size() * sizeof(glm::vec4) + p.indices.size() * sizeof(std::uint32_t) +
              p.influences.size() * sizeof(Influence);
+    for (const MeshPart& p : m.parts)
+        for (const MorphTarget& t : p.morphs)
+            n += sizeof(MorphTarget) + (t.positions.size() + t.normals.size() + t.tangents.size()) * sizeof(glm::vec3);
+    n += m.morphWeights.size() * sizeof(MorphWeight);
     for (const Image8& img : m.images) n += img.rgba.size() + img.rgba.size() / 3; // + CPU mip chain
     for (const Clip& c : m.clips)
         for (const Channel& ch : c.channels) n += (ch.times.size() + ch.values.size()) * sizeof(float);

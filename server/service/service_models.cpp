@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <set>
 
 namespace dermis {
 
@@ -264,6 +265,11 @@ Result<json> Service::getModel(const std::string& id) const {
         vertices += p.positions.size();
     out["joints"] = std::move(joints);
     out["clips"] = std::move(clips);
+    json morphs = json::array(); // by name, each once (pose.morphs sets every weight of a name)
+    std::set<std::string> named;
+    for (const MorphWeight& w : m.morphWeights)
+        if (named.insert(w.name).second) morphs.push_back({{"name", w.name}, {"rest", w.rest}});
+    out["morphs"] = std::move(morphs);
     out["vertices"] = vertices;
     // Built once per model entry (ids are content addresses: cached by content), then shared
     // with lint and the picks.

@@ -405,11 +405,13 @@ Result<json> Service::patchPose(const std::string& id, const json& patch, const 
         json& pose = doc["pose"];
         if (!pose.is_object()) pose = json::object();
         for (auto e = patch.begin(); e != patch.end(); ++e) {
-            if (e.key() == "joints" && e->is_object()) {
-                if (!pose["joints"].is_object()) pose["joints"] = json::object();
+            if ((e.key() == "joints" || e.key() == "morphs") && e->is_object()) {
+                // Member by member (null removes one), like the joints the morph weights.
+                json& members = pose[e.key()];
+                if (!members.is_object()) members = json::object();
                 for (auto j = e->begin(); j != e->end(); ++j) {
-                    if (j->is_null()) pose["joints"].erase(j.key());
-                    else pose["joints"][j.key()] = *j;
+                    if (j->is_null()) members.erase(j.key());
+                    else members[j.key()] = *j;
                 }
             } else if (e->is_null()) {
                 pose.erase(e.key());

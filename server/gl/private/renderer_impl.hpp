@@ -61,14 +61,18 @@ struct GpuModel {
         GLuint vao = 0;
         /// position, normal, uv, joints, weights, indices, map uv (attribute slots 0–4 and 5;
         /// the model's own parts read slot 5 from the uv buffer and leave buffers[6] at 0),
-        /// then tangent, uv1, colour (slots 6–8, 0 when the part has none)
-        GLuint buffers[10] = {};
+        /// then tangent, uv1, colour (slots 6–8, 0 when the part has none), then the morph
+        /// deltas (skin.vert's MorphDeltas storage buffer; 0 without morph targets)
+        GLuint buffers[11] = {};
         GLsizei indexCount = 0, vertexCount = 0;
         int paletteOffset = 0;
         int material = -1;
         bool hasUVs = false;    ///< the model's TEXCOORD_0 (base colour)
         bool hasMapUVs = false; ///< height-map UVs (the layout covers the part)
         bool hasTangents = false, hasUVs1 = false, hasColors = false; ///< slots 6, 7, 8
+        /// Morph targets (MeshPart::morphs) and where their weights start in the frame's
+        /// MorphWeights buffer (uploadPalette).
+        int morphTargets = 0, morphWeightOffset = 0;
     };
     std::vector<Part> parts; ///< with the model's own UVs as the maps' layout
     /// The parts drawn with another height-map layout (SPEC §8): vertices split as the layout's
@@ -88,6 +92,7 @@ struct GpuModel {
     /// (metallic-roughness, normal, occlusion), 0 for the others.
     std::vector<GLuint> dataTextures;
     int paletteSize = 0;
+    int morphWeightCount = 0; ///< Σ morph targets over the parts
     double autoDisplacement = 0.01;
     std::size_t bytes = 0;     ///< estimated GPU bytes of the buffers and textures
     std::uint64_t lastUse = 0; ///< job counter of its last use, for evicting the least recent
@@ -258,7 +263,7 @@ struct Renderer::Impl {
     const EnvironmentImage* customKey = nullptr; ///< the image customLight was made from
     GLuint brdfLutTexture = 0, environmentUbo = 0;
     GLuint emptyVao = 0, heightUbo = 0, frameUbo = 0, partUbo = 0, paletteSsbo = 0,
-           feedbackBuffer = 0, outlineUbo = 0;
+           feedbackBuffer = 0, outlineUbo = 0, morphWeightSsbo = 0;
     GLuint flatTexture = 0;  ///< 1×1 zero heights (RG32F), for frames without height maps
     GLuint whiteTexture = 0; ///< 1×1 white, for parts without a base-colour texture
     GLint uboAlignment = 256;
@@ -334,7 +339,13 @@ struct Renderer::Impl {
     Result<const std::vector<gl::GpuModel::Part>*> partsFor(const Model& model, gl::GpuModel& gm,
                                                             const std::shared_ptr<const TextureLayout>& layout);
     void dropOrphanedModels();
-    void uploadPalette(const Model& model, const gl::GpuModel& gm, const std::vector<glm::mat4>& world);
+    /// The joint palette of `world` (binding kPaletteBinding) and the morph weights of every
+    /// part's targets at `morphWeights` (one per Model::morphWeights; empty: rest values;
+    /// binding kMorphWeightBinding).
+    void uploadPalette(const Model& model, const gl::GpuModel& gm, const std::vector<glm::mat4>& world,
+                       const std::vector<float>& morphWeights);
+    /// Binds part `gp`'s morph deltas (kMorphDeltaBinding) for its draw.
+    void bindMorphDeltas(const gl::GpuModel::Part& gp) const;
 
     // height_pass.cpp: stage 1.
     Status bakeHeightMaps(const HeightPassInput& in, HeightMaps& maps); ///< pass + readback
@@ -371,7 +382,8 @@ struct Renderer::Impl {
                         const std::vector<std::size_t>* pbrOrder);
     Status readFrame(GLuint readFbo, Image8& image);
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
-                                               const std::vector<glm::mat4>& world);
+                                               const std::vector<glm::mat4>& world,
+                                               const std::vector<float>& morphWeights);
 };
 
 } // namespace dermis

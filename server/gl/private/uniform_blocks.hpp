@@ -50,6 +50,8 @@ struct PartBlock {
     /// bits), UV set per texture (bit k: texture k reads TEXCOORD_1)
     glm::ivec4 maps;
     glm::vec4 uvTransform[10]; ///< per texture two rows of its KHR_texture_transform matrix
+    /// morph targets of the part, first weight in the MorphWeights buffer, vertex count, 0
+    glm::ivec4 morph;
 };
 
 /// PartBlock::maps.x bits, in the texture order of uvTransform and maps.w.
@@ -88,13 +90,15 @@ enum BlockBinding : unsigned {
     kPartBinding = 2,
     kOutlineBinding = 3,
     kEnvironmentBinding = 4,
-    kPaletteBinding = 0, // shader storage buffer binding
+    kPaletteBinding = 0,      // shader storage buffer bindings: the joint palette,
+    kMorphDeltaBinding = 1,   // the drawn part's morph deltas,
+    kMorphWeightBinding = 2,  // the frame's morph weights
 };
 
 static_assert(sizeof(glm::vec4) == 16 && sizeof(glm::mat4) == 64);
 static_assert(sizeof(HeightPassBlock) == 144);
 static_assert(sizeof(FrameBlock) == 144);
-static_assert(sizeof(PartBlock) == 32 + 3 * 16 + 10 * 16);
+static_assert(sizeof(PartBlock) == 32 + 3 * 16 + 10 * 16 + 16);
 static_assert(sizeof(EnvironmentBlock) == 9 * 16 + 2 * 16);
 static_assert(sizeof(OutlineBlock) == 16 + 5 * 8 * 16);
 

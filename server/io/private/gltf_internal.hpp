@@ -25,12 +25,16 @@
 #include "io/gltf_loader.hpp"
 #include "io/image_header.hpp"
 
+#include "core/model.hpp"
 #include "core/result.hpp"
+
+#include <glm/glm.hpp>
 
 #include <cstddef>
 #include <initializer_list>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace dermis::gltf_detail {
@@ -111,5 +115,36 @@ Status checkDeclaredTextures(const PendingImages& images, const GltfLimits& limi
 /// everything it reads. The base-colour images it uses are taken out of `captured` into
 /// ParsedGltf::images, still encoded.
 Result<ParsedGltf> convertGltf(const tg::Model& g, Captured& captured);
+
+/// Per node that instances a mesh with morph targets: its first index into Model::morphWeights
+/// and the mesh's target count.
+using MorphSlots = std::map<int, std::pair<int, int>>;
+
+/// Animations → m.clips (gltf_animations.cpp): translation, rotation, scale and weights channels
+/// (weights through `morphSlots`; a node without slots moves nothing), keys checked (strictly
+/// increasing finite times, one value per key — per target for weights —, finite values).
+Status convertAnimations(const tg::Model& g, Model& m, const MorphSlots& morphSlots);
+
+// ------------------------------------------------------------------------------------------------
+// Morph targets (gltf_morph.cpp; glTF 2.0 §3.7.2.2)
+
+/// Adds the morph weights of node `nodeIndex` (whose mesh has targets) to m.morphWeights: named
+/// by the mesh's extras.targetNames (else "<mesh>#<k>"), rest values from node.weights, else
+/// mesh.weights, else 0. Fails when the primitives disagree on the target count or a weights
+/// array has another length. `slots` gets the node's entry; no-op for a mesh without targets.
+Status addMorphWeights(const tg::Model& g, int nodeIndex, Model& m, MorphSlots& slots);
+
+/// Reads the POSITION, NORMAL and TANGENT deltas of `prim`'s targets into part.morphs (weights
+/// firstWeight + k), each checked for the part's vertex count and finite values. Other target
+/// attributes (TEXCOORD_n, COLOR_n) are ignored.
+Status readMorphTargets(const tg::Model& g, const tg::Primitive& prim, const std::string& field,
+                        int firstWeight, MeshPart& part);
+
+/// A rigid part's morph deltas into its rest world space (MeshPart: rigid parts are stored
+/// there): positions and tangents by the linear part of `world`, normals by its inverse
+/// transpose; normal and tangent deltas scaled like the part's own were when normalised
+/// (`normalScale`, `tangentScale`: per vertex, 1 / |M·v₀| before normalisation).
+void transformMorphs(MeshPart& part, const glm::dmat4& world, const std::vector<double>& normalScale,
+                     const std::vector<double>& tangentScale);
 
 } // namespace dermis::gltf_detail
