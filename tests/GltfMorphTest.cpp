@@ -27,20 +27,6 @@ void expectNear(glm::vec3 a, glm::vec3 b, float tol = 1e-6f) {
     EXPECT_NEAR(a.z, b.z, tol);
 }
 
-/// `m` with every part's morph targets baked in at `weights` and then dropped: what skinning
-/// after morphing must equal.
-Model baked(const Model& m, const std::vector<float>& weights) {
-    Model out = m;
-    for (MeshPart& p : out.parts) {
-        const MorphedPart mp = morphPart(m, p, weights);
-        p.positions = mp.positions;
-        p.normals = mp.normals;
-        p.tangents = mp.tangents;
-        p.morphs.clear();
-    }
-    return out;
-}
-
 } // namespace
 
 TEST(GltfMorphTest, LoadsTargetsWeightsAndNames) {
@@ -129,7 +115,7 @@ TEST(GltfMorphTest, SkinningMorphsFirstInBindSpace) {
     // Posed by the "bend" clip: morph, then skin — the same as skinning the baked vertices.
     const std::vector<glm::mat4> world = worldMatrices(m, sampleClip(m, m.findClip("bend"), 0.7f));
     const auto a = skin(m, world, w);
-    const auto b = skin(baked(m, w), world);
+    const auto b = skin(bakedMorphs(m, w), world);
     ASSERT_EQ(a.size(), 1u);
     EXPECT_LT(maxDistance(a, b), 1e-6f);
     for (std::size_t v = 0; v < 3; ++v)

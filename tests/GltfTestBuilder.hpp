@@ -225,6 +225,21 @@ struct MorphedTriangle : SkinnedTriangle {
     }
 };
 
+/// `m` with every part's morph targets baked in at `weights` (morphPart) and then dropped: what
+/// morphing and skinning together must equal (GltfMorphTest, MorphGLTest).
+inline Model bakedMorphs(const Model& m, const std::vector<float>& weights) {
+    Model out = m;
+    for (MeshPart& p : out.parts) {
+        const MorphedPart mp = morphPart(m, p, weights);
+        p.positions = mp.positions;
+        p.normals = mp.normals;
+        p.tangents = mp.tangents;
+        p.morphs.clear();
+    }
+    out.morphWeights.clear();
+    return out;
+}
+
 // --- files that declare more than they hold ---------------------------------------------------
 
 /// A GLB of a few hundred bytes: one mesh whose POSITION accessor has no buffer view (so `count`

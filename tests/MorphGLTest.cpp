@@ -55,16 +55,7 @@ std::shared_ptr<const Model> morphedTriangle() {
 
 /// `m` with its targets baked in at `weights` and dropped.
 std::shared_ptr<const Model> baked(const Model& m, const std::vector<float>& weights) {
-    Model out = m;
-    for (MeshPart& p : out.parts) {
-        const MorphedPart mp = morphPart(m, p, weights);
-        p.positions = mp.positions;
-        p.normals = mp.normals;
-        p.tangents = mp.tangents;
-        p.morphs.clear();
-    }
-    out.morphWeights.clear();
-    return std::make_shared<const Model>(std::move(out));
+    return std::make_shared<const Model>(gltf::bakedMorphs(m, weights));
 }
 
 void expectGpuEqualsCpu(Renderer& gl, const std::shared_ptr<const Model>& model,
