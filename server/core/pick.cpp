@@ -65,7 +65,7 @@ static FrameCamera cameraOf(const FramePlan& plan, const Model& model, const std
 }
 
 FrameCamera planCamera(const FramePlan& plan, const Model& model) {
-    return cameraOf(plan, model, skin(model, plan.world));
+    return cameraOf(plan, model, skin(model, plan.world, plan.pose.morphWeights));
 }
 
 std::optional<PickHit> pickUv(const Model& model, const UvLookup& lookup, glm::dvec2 uv) {
@@ -89,7 +89,7 @@ Result<std::optional<PickHit>> pickFrame(const FramePlan& plan, const Model& mod
         return makeError(ErrorCode::InvalidArgument, where, "x", "must be in [0, " + std::to_string(W) + ")");
     if (!std::isfinite(y) || y < 0.0 || y >= H)
         return makeError(ErrorCode::InvalidArgument, where, "y", "must be in [0, " + std::to_string(H) + ")");
-    const std::vector<SkinnedPart> posed = skin(model, plan.world);
+    const std::vector<SkinnedPart> posed = skin(model, plan.world, plan.pose.morphWeights);
     const FrameCamera cam = cameraOf(plan, model, posed);
     const Ray ray = pixelRay(cam, {x, y});
     std::optional<PickHit> best;

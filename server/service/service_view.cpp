@@ -58,7 +58,7 @@ Result<json> Service::focus(const std::string& id, const std::string& pid, const
                 }
             }
         if (!std::isfinite(best)) return bad("placement", "the model has no vertices");
-        const std::vector<SkinnedPart> posed = skin(m, plan->world);
+        const std::vector<SkinnedPart> posed = skin(m, plan->world, plan->pose.morphWeights);
         const glm::vec3 target = posed[bp].positions[bv];
         const double radius = std::max(0.5 * std::hypot(p.size[0], p.size[1]), 1e-3);
         return json{{"scene", id},
@@ -73,7 +73,7 @@ Result<json> Service::focus(const std::string& id, const std::string& pid, const
     if (!derived->model().hasUVs()) return bad("placement", "the model has no UVs: a footprint lies nowhere");
     auto plan = state_->plan(*snap, params);
     if (!plan) return asParamError(plan.error(), params);
-    const auto region = footprintRegion(derived->model(), derived->uvLookup(), skin(derived->model(), plan->world),
+    const auto region = footprintRegion(derived->model(), derived->uvLookup(), skin(derived->model(), plan->world, plan->pose.morphWeights),
                                         {p.center[0], p.center[1]}, {p.scale[0], p.scale[1]}, p.rotation);
     if (!region) return bad("placement", "no skin lies inside the footprint of \"" + pid + "\"");
     return json{{"scene", id},
