@@ -1,5 +1,6 @@
 // Test helper: a GL suite's one renderer — created once per suite on the backend the suite asks
-// for ($DERMIS_TEST_GL, GlTestBackend.hpp), shared by its tests, destroyed after the last. A
+// for ($DERMIS_TEST_GL, GlTestBackend.hpp), shared by its tests, destroyed after the last; it checks
+// every draw's buffer bindings (RendererOptions::checkBindings). A
 // backend that cannot start fails every test of the suite with the reason (nothing is skipped).
 #pragma once
 
@@ -17,7 +18,9 @@ namespace dermis::test {
 class RendererSuite : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
-        auto r = Renderer::create(requestedBackend());
+        RendererOptions options;
+        options.checkBindings = true; // every draw of every GL suite (DrawBindingsGLTest)
+        auto r = Renderer::create(requestedBackend(), options);
         if (!r) {
             createError_ = r.error().message;
             return;

@@ -265,6 +265,9 @@ std::size_t Renderer::Impl::uploadPartBlocks(const Model& model, const GpuModel&
     glBindBuffer(GL_UNIFORM_BUFFER, partUbo);
     glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(partBlocks.size()), partBlocks.data(),
                  GL_STREAM_DRAW);
+    // The last draw's range may lie past the new, smaller store; every program declares PartBlock
+    // (std140: always active) and Mesa reads each bound range on every draw.
+    glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo, 0, sizeof(PartBlock));
     return stride;
 }
 
@@ -320,6 +323,7 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
         }
         bindMorphDeltas(gp);
         glBindVertexArray(gp.vao);
+        checkDrawBindings("skin pass");
         glDrawElements(tess ? GL_PATCHES : GL_TRIANGLES, gp.indexCount, GL_UNSIGNED_INT, nullptr);
     }
     glBindVertexArray(0);
@@ -393,6 +397,7 @@ Result<std::vector<SkinnedPart>> Renderer::Impl::skinOnGpu(const std::shared_ptr
         glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, feedbackBuffer);
         glBindVertexArray(gp.vao);
         glBeginTransformFeedback(GL_POINTS);
+        checkDrawBindings("transform feedback skinning");
         glDrawArrays(GL_POINTS, 0, gp.vertexCount);
         glEndTransformFeedback();
         glBindVertexArray(0);

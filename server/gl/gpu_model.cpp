@@ -466,7 +466,8 @@ void Renderer::Impl::uploadPalette(const Model& model, const GpuModel& gm,
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPaletteBinding, paletteSsbo);
 
     // Each part's target weights from its MorphWeight entries (core morphWeightOf).
-    std::vector<float> weights(static_cast<std::size_t>(std::max(gm.morphWeightCount, 1)), 0.0f);
+    // At least one vec4: the buffer also stands in for the MorphDeltas of parts without targets.
+    std::vector<float> weights(static_cast<std::size_t>(std::max(gm.morphWeightCount, 4)), 0.0f);
     for (std::size_t pi = 0; pi < model.parts.size() && pi < gm.parts.size(); ++pi) {
         const MeshPart& part = model.parts[pi];
         const auto base = static_cast<std::size_t>(gm.parts[pi].morphWeightOffset);

@@ -348,6 +348,9 @@ std::size_t Renderer::Impl::uploadHeightBlocks(const HeightPassInput& in, const 
     glBindBuffer(GL_UNIFORM_BUFFER, heightUbo);
     glBufferData(GL_UNIFORM_BUFFER, static_cast<GLsizeiptr>(blocks.size()), blocks.data(),
                  GL_STREAM_DRAW);
+    // The last placement's range may lie past the new, smaller store; every program declares
+    // HeightPassBlock (std140: always active) and Mesa reads each bound range on every draw.
+    glBindBufferRange(GL_UNIFORM_BUFFER, kHeightPassBinding, heightUbo, 0, sizeof(HeightPassBlock));
     return stride;
 }
 
@@ -370,6 +373,7 @@ void Renderer::Impl::drawHeightPass(const HeightPassInput& in, const ResolvedPat
         glBindBufferRange(GL_UNIFORM_BUFFER, kHeightPassBinding, heightUbo, 0, sizeof(HeightPassBlock));
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, baseTexture);
+        checkDrawBindings("height pass base map");
         glDrawArrays(GL_TRIANGLES, 0, 3);
     } else {
         glClearBufferfv(GL_COLOR, 0, zero);
@@ -392,6 +396,7 @@ void Renderer::Impl::drawHeightPass(const HeightPassInput& in, const ResolvedPat
         glBindBufferRange(GL_UNIFORM_BUFFER, kHeightPassBinding, heightUbo,
                           static_cast<GLintptr>(stride * (k + 1)), sizeof(HeightPassBlock));
         glBindTexture(GL_TEXTURE_2D, textures[k]);
+        checkDrawBindings("height pass");
         glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     }
     glDisable(GL_BLEND);

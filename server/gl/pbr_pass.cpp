@@ -71,9 +71,6 @@ Renderer::Impl::environmentLight(const std::shared_ptr<const EnvironmentImage>& 
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        glGenBuffers(1, &environmentUbo);
-        glBindBuffer(GL_UNIFORM_BUFFER, environmentUbo);
-        glBufferData(GL_UNIFORM_BUFFER, sizeof(EnvironmentBlock), nullptr, GL_DYNAMIC_DRAW);
     }
     EnvironmentLight* light = &studioLight;
     if (env) {

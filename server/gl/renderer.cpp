@@ -50,13 +50,72 @@ void Renderer::Impl::loop() {
     }
 }
 
+void Renderer::Impl::checkDrawBindings(const char* draw) {
+    if (!checkBindings || !bindingProblem.empty()) return;
+    GLint current = 0;
+    glGetIntegerv(GL_CURRENT_PROGRAM, &current);
+    if (current == 0) {
+        bindingProblem = std::string(draw) + ": no program in use";
+        return;
+    }
+    const auto program = static_cast<GLuint>(current);
+    GLint readBefore = 0;
+    glGetIntegerv(GL_COPY_READ_BUFFER_BINDING, &readBefore);
+    struct Kind {
+        GLenum iface, binding, start, size;
+        const char* name;
+    };
+    const Kind kinds[2] = {
+        {GL_UNIFORM_BLOCK, GL_UNIFORM_BUFFER_BINDING, GL_UNIFORM_BUFFER_START,
+         GL_UNIFORM_BUFFER_SIZE, "uniform block"},
+        {GL_SHADER_STORAGE_BLOCK, GL_SHADER_STORAGE_BUFFER_BINDING, GL_SHADER_STORAGE_BUFFER_START,
+         GL_SHADER_STORAGE_BUFFER_SIZE, "storage block"}};
+    for (const Kind& kind : kinds) {
+        GLint count = 0;
+        glGetProgramInterfaceiv(program, kind.iface, GL_ACTIVE_RESOURCES, &count);
+        for (GLint i = 0; i < count && bindingProblem.empty(); ++i) {
+            const GLenum props[2] = {GL_BUFFER_BINDING, GL_BUFFER_DATA_SIZE};
+            GLint value[2] = {0, 0};
+            glGetProgramResourceiv(program, kind.iface, static_cast<GLuint>(i), 2, props, 2, nullptr,
+                                   value);
+            char name[64] = {};
+            glGetProgramResourceName(program, kind.iface, static_cast<GLuint>(i), sizeof name,
+                                     nullptr, name);
+            const auto index = static_cast<GLuint>(value[0]);
+            GLint buffer = 0;
+            GLint64 start = 0, size = 0, store = 0;
+            glGetIntegeri_v(kind.binding, index, &buffer);
+            glGetInteger64i_v(kind.start, index, &start);
+            glGetInteger64i_v(kind.size, index, &size);
+            if (buffer != 0) {
+                glBindBuffer(GL_COPY_READ_BUFFER, static_cast<GLuint>(buffer));
+                glGetBufferParameteri64v(GL_COPY_READ_BUFFER, GL_BUFFER_SIZE, &store);
+            }
+            const GLint64 range = size != 0 ? size : store - start; // base binding: the whole store
+            if (buffer == 0 || range < value[1] || start + range > store)
+                bindingProblem = std::string(draw) + ": " + kind.name + " " + name + " (binding " +
+                                 std::to_string(value[0]) + ", " + std::to_string(value[1]) +
+                                 " bytes) has buffer " + std::to_string(buffer) + " range [" +
+                                 std::to_string(start) + ", " + std::to_string(start + range) +
+                                 ") of a " + std::to_string(store) + "-byte store";
+        }
+    }
+    glBindBuffer(GL_COPY_READ_BUFFER, static_cast<GLuint>(readBefore));
+}
+
 // --- life cycle (render thread) ----------------------------------------------------------------
 
 Status Renderer::Impl::checkGl(const char* what) {
     GLenum err = glGetError();
-    if (err == GL_NO_ERROR) return Ok{};
-    while (glGetError() != GL_NO_ERROR) {
+    if (err != GL_NO_ERROR)
+        while (glGetError() != GL_NO_ERROR) {
+        }
+    if (!bindingProblem.empty()) {
+        std::string problem = std::move(bindingProblem);
+        bindingProblem.clear();
+        return makeError(ErrorCode::Internal, kWhere, "", problem); // names the draw
     }
+    if (err == GL_NO_ERROR) return Ok{};
     char buf[16];
     std::snprintf(buf, sizeof buf, "0x%04X", err);
     return makeError(ErrorCode::Internal, kWhere, "", std::string(what) + ": GL error " + buf);
@@ -163,10 +222,33 @@ void Renderer::Impl::createSharedObjects() {
     feedbackBuffer = bufs[4];
     outlineUbo = bufs[5];
     morphWeightSsbo = bufs[6];
-    glBindBuffer(GL_UNIFORM_BUFFER, frameUbo);
-    glBufferData(GL_UNIFORM_BUFFER, sizeof(FrameBlock), nullptr, GL_DYNAMIC_DRAW);
-    glBindBuffer(GL_UNIFORM_BUFFER, outlineUbo);
-    glBufferData(GL_UNIFORM_BUFFER, sizeof(OutlineBlock), nullptr, GL_DYNAMIC_DRAW);
+    glGenBuffers(1, &environmentUbo);
+    // Every block common.glsl and skin.vert declare is active in every program (std140 / std430),
+    // so each binding holds a zeroed buffer of at least the block's size from the start; the
+    // passes re-bind a buffer at offset 0 whenever they re-allocate it (checkDrawBindings).
+    const std::vector<std::uint8_t> zeros(sizeof(EnvironmentBlock) + sizeof(OutlineBlock) +
+                                              sizeof(PartBlock) + sizeof(HeightPassBlock) +
+                                              sizeof(FrameBlock),
+                                          0);
+    const struct {
+        GLenum target;
+        GLuint binding, buffer;
+        std::size_t bytes;
+    } initial[] = {
+        {GL_UNIFORM_BUFFER, kHeightPassBinding, heightUbo, sizeof(HeightPassBlock)},
+        {GL_UNIFORM_BUFFER, kFrameBinding, frameUbo, sizeof(FrameBlock)},
+        {GL_UNIFORM_BUFFER, kPartBinding, partUbo, sizeof(PartBlock)},
+        {GL_UNIFORM_BUFFER, kOutlineBinding, outlineUbo, sizeof(OutlineBlock)},
+        {GL_UNIFORM_BUFFER, kEnvironmentBinding, environmentUbo, sizeof(EnvironmentBlock)},
+        {GL_SHADER_STORAGE_BUFFER, kPaletteBinding, paletteSsbo, sizeof(glm::mat4)},
+        {GL_SHADER_STORAGE_BUFFER, kMorphDeltaBinding, morphWeightSsbo, sizeof(glm::vec4)},
+        {GL_SHADER_STORAGE_BUFFER, kMorphWeightBinding, morphWeightSsbo, sizeof(glm::vec4)},
+    };
+    for (const auto& b : initial) {
+        glBindBuffer(b.target, b.buffer);
+        glBufferData(b.target, static_cast<GLsizeiptr>(b.bytes), zeros.data(), GL_DYNAMIC_DRAW);
+        glBindBufferBase(b.target, b.binding, b.buffer);
+    }
     const float zero[2] = {0.0f, 0.0f};
     flatTexture = makeFloatTexture(1, 1, zero, GL_NEAREST, 2);
     glGenTextures(1, &whiteTexture);
@@ -259,6 +341,7 @@ Result<std::unique_ptr<Renderer>> Renderer::create(GlBackend backend, const Rend
     auto impl = std::make_unique<Impl>();
     impl->cacheBudget = options.cacheBudgetBytes;
     impl->softwareCpuBakeCoverage = options.softwareCpuBakeCoverage;
+    impl->checkBindings = options.checkBindings;
     impl->publishCacheStats();
     std::promise<Status> started;
     std::future<Status> startedFuture = started.get_future();

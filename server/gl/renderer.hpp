@@ -86,6 +86,13 @@ struct RendererOptions {
     /// would make the frame time jump. Same maps up to float rounding; Stats::heightPassesOnCpu
     /// counts them. 0 = always the GL pass. Hardware GLs always run the GL pass.
     double softwareCpuBakeCoverage = 2.0;
+    /// Before every draw, checks that each uniform and storage block of the program in use has a
+    /// buffer bound, with a range inside the buffer's store and at least the block's size. GL
+    /// leaves such a draw undefined; Mesa's llvmpipe copies every bound uniform range on every
+    /// draw and so reads past a store that shrank under a stale range. The first violation fails
+    /// the job (ErrorCode::Internal, naming the draw, the block and the range). Costs a few GL
+    /// queries per draw: for tests (RendererGLTest), off by default.
+    bool checkBindings = false;
 };
 
 /// What the renderer's GPU cache holds, as of the last job that ended.

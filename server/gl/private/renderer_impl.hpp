@@ -238,10 +238,9 @@ struct Renderer::Impl {
     /// The skin pass by [tessellated][FrameView]: skin.frag with DERMIS_VIEW = the view, so that a
     /// software rasterizer, which runs every branch for every pixel, does not shade the unlit
     /// views' code in a shaded frame (1024² skin pass on llvmpipe: 19 → 12 ms). All eight are
-    /// built at start (buildPrograms), none during a frame: with Mesa 22.3's llvmpipe, a program
-    /// linked from Mesa's on-disk shader cache between a frame's uniform uploads and its draw made
-    /// the draw read out of bounds (ASan: SEGV / heap-buffer-overflow in swrast_dri under
-    /// glDrawElements, InspectHttpTest with the cache warm).
+    /// built at start (buildPrograms), none during a frame. (The out-of-bounds reads in swrast_dri
+    /// once blamed on a program linked mid-frame were a stale uniform range past a store that had
+    /// shrunk; see checkDrawBindings.)
     GLuint skinPrograms[2][4] = {};
     /// The shaded view with `render.shading` pbr by [tessellated]: skin.frag + pbr.glsl with
     /// DERMIS_PBR (built at start with the others).
@@ -281,6 +280,8 @@ struct Renderer::Impl {
     std::optional<gl::HeightKey> lastHeights; ///< what `heights` holds now, if from a height pass
     std::size_t heightPasses = 0, heightPassesSkipped = 0, heightPassesOnCpu = 0;
     double softwareCpuBakeCoverage = 2.0; ///< RendererOptions::softwareCpuBakeCoverage
+    bool checkBindings = false;           ///< RendererOptions::checkBindings
+    std::string bindingProblem;           ///< its first violation since the last checkGl
     HeightMaps cpuBake;                   ///< storage of height passes baked on the CPU
 
     /// Bytes between consecutive blocks of `size` in one uniform buffer bound by range.
@@ -314,7 +315,13 @@ struct Renderer::Impl {
     void createSharedObjects();
     void shutdown();
     void dropPatternTextures(); ///< pattern and base textures, and what the targets were from
+    /// The GL error state, and the first binding violation checkDrawBindings recorded (both
+    /// cleared): an Internal error naming `what`, else Ok.
     Status checkGl(const char* what);
+    /// With checkBindings: records in bindingProblem the first block of the current program
+    /// whose binding is missing, too small or past its buffer's store (RendererOptions::
+    /// checkBindings). Call right before a draw; `draw` names it. No-op otherwise.
+    void checkDrawBindings(const char* draw);
     Result<Renderer::BlockLayout> blockLayout(const std::string& block);
 
     // gpu_cache.cpp: the byte budget.

@@ -1,0 +1,156 @@
+// DrawBindingsGLTest — every draw's uniform and storage blocks are backed by a buffer range that
+// lies inside its store and holds the block (RendererOptions::checkBindings), across the sequences
+// that shrink the renderer's shared buffers, on the backend named by $DERMIS_TEST_GL. Each block
+// in shaders/common.glsl is active in every program (std140), and Mesa's llvmpipe reads every
+// bound uniform range on every draw: a range left at a placement's or a part's offset in a buffer
+// that a later job re-allocated smaller made the draw read past the store (AddressSanitizer: SEGV
+// in swrast_dri under glDrawElements in SweepHttpTest, RendersHttpTest and View3dHttpTest). It
+// checks:
+//   * frames with a 12-placement height pass, then with 1, then none (a pass that draws no
+//     placement), then flat maps after a bake without placements;
+//   * a frame of a many-part model (Barbarian), then of a one-part model (CesiumMan), then a
+//     height pass, then transform-feedback skinning;
+//   * pbr frames and tessellated displacement after both;
+//   * the images of the checked renderer equal those of an unchecked one (the check only reads).
+#include "BuildPaths.hpp"
+#include "GlTestBackend.hpp"
+#include "gl/renderer.hpp"
+#include "io/gltf_loader.hpp"
+
+#include "core/rig.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+using namespace dermis;
+using namespace dermis::test;
+
+namespace {
+
+const std::string kModels = dermis::build::testModelsDir();
+
+std::shared_ptr<const Model> load(const std::string& relative) {
+    auto m = loadGltfFile(kModels + relative);
+    EXPECT_TRUE(m) << relative << ": " << (m ? "" : m.error().message);
+    return m ? std::make_shared<const Model>(std::move(*m)) : nullptr;
+}
+
+std::unique_ptr<Renderer> checkedRenderer() {
+    RendererOptions options;
+    options.checkBindings = true;
+    options.softwareCpuBakeCoverage = 0.0; // always the GL height pass: its draws are checked
+    auto r = Renderer::create(requestedBackend(), options);
+    EXPECT_TRUE(r) << "no GL context for backend " << toString(requestedBackend()) << ": "
+                   << (r ? "" : r.error().message);
+    return r ? std::move(*r) : nullptr;
+}
+
+/// A 32² bump: a cosine dome.
+std::shared_ptr<const PatternImage> dome() {
+    HeightImage img(32, 32);
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+            const double r = std::hypot(x - 15.5, y - 15.5) / 16.0;
+            img.data[static_cast<std::size_t>(y) * 32 + x] =
+                r < 1.0 ? static_cast<float>(0.5 + 0.5 * std::cos(r * 3.14159265)) : 0.0f;
+        }
+    return makePatternImage(std::move(img));
+}
+
+/// `count` placements of `pattern` spread over the map, bump and displacement alternating.
+HeightPassInput heights(const PatternImage& pattern, int count) {
+    HeightPassInput in;
+    in.width = in.height = 256;
+    for (int k = 0; k < count; ++k) {
+        BakePlacement p;
+        p.pattern = &pattern.pixels;
+        p.patternId = pattern.contentId;
+        p.footprint.center = {0.1 + 0.07 * k, 0.2 + 0.05 * k};
+        p.footprint.scale = {0.2, 0.2};
+        p.h = 1.0;
+        p.t = 0.5;
+        p.target = k % 2 ? Target::Displacement : Target::Bump;
+        in.placements.push_back(p);
+    }
+    return in;
+}
+
+FrameRequest request(const std::shared_ptr<const Model>& m, std::optional<HeightPassInput> maps) {
+    FrameRequest req;
+    req.model = m;
+    req.world = worldMatrices(*m, m->clips.empty() ? restPose(*m) : sampleClip(*m, 0, 0.3f));
+    req.render.size = {96, 96};
+    req.render.aa = AntiAliasing::None;
+    req.heights = std::move(maps);
+    return req;
+}
+
+Image8 frame(Renderer& gl, const FrameRequest& req, const char* what) {
+    auto f = gl.renderFrame(req);
+    EXPECT_TRUE(f) << what << ": " << (f ? "" : f.error().message);
+    return f ? f->image : Image8{};
+}
+
+} // namespace
+
+TEST(DrawBindingsGLTest, AHeightPassWithFewerPlacementsThenFrames) {
+    auto gl = checkedRenderer();
+    ASSERT_TRUE(gl);
+    const auto cesium = load("/CesiumMan/CesiumMan.glb");
+    ASSERT_TRUE(cesium);
+    const auto pattern = dome();
+    frame(*gl, request(cesium, heights(*pattern, 12)), "12 placements");
+    frame(*gl, request(cesium, heights(*pattern, 1)), "1 placement after 12");
+    frame(*gl, request(cesium, heights(*pattern, 12)), "12 placements after 1");
+    // A height pass without placements draws nothing that would re-bind the block's range.
+    frame(*gl, request(cesium, heights(*pattern, 0)), "no placements after 12");
+    frame(*gl, request(cesium, heights(*pattern, 12)), "12 placements after none");
+    auto none = gl->bakeHeightMaps(heights(*pattern, 0));
+    EXPECT_TRUE(none) << "a height pass without placements: " << (none ? "" : none.error().message);
+    frame(*gl, request(cesium, std::nullopt), "flat after a pass without placements");
+    FrameRequest pbr = request(cesium, heights(*pattern, 12));
+    pbr.render.shading = Shading::Pbr;
+    frame(*gl, pbr, "pbr, 12 placements");
+    pbr.heights = heights(*pattern, 2);
+    pbr.render.displacement = DisplacementMode::Tessellated;
+    frame(*gl, pbr, "pbr tessellated, 2 placements after 12");
+}
+
+TEST(DrawBindingsGLTest, AManyPartModelThenAOnePartModelThenAHeightPass) {
+    auto gl = checkedRenderer();
+    ASSERT_TRUE(gl);
+    const auto barbarian = load("/KayKitBarbarian/Barbarian.glb");
+    const auto cesium = load("/CesiumMan/CesiumMan.glb");
+    ASSERT_TRUE(barbarian && cesium);
+    ASSERT_GT(barbarian->parts.size(), cesium->parts.size() + 2);
+    const auto pattern = dome();
+    frame(*gl, request(barbarian, std::nullopt), "Barbarian");
+    frame(*gl, request(cesium, std::nullopt), "CesiumMan after Barbarian");
+    frame(*gl, request(barbarian, std::nullopt), "Barbarian after CesiumMan");
+    auto maps = gl->bakeHeightMaps(heights(*pattern, 3));
+    EXPECT_TRUE(maps) << "height pass after Barbarian: " << (maps ? "" : maps.error().message);
+    auto skinned = gl->skinOnGpu(cesium, worldMatrices(*cesium, restPose(*cesium)));
+    EXPECT_TRUE(skinned) << "transform feedback after Barbarian: "
+                         << (skinned ? "" : skinned.error().message);
+    frame(*gl, request(barbarian, std::nullopt), "Barbarian after transform feedback");
+}
+
+TEST(DrawBindingsGLTest, TheCheckOnlyReads) {
+    auto checked = checkedRenderer();
+    RendererOptions plainOptions;
+    plainOptions.softwareCpuBakeCoverage = 0.0;
+    auto plain = Renderer::create(requestedBackend(), plainOptions);
+    ASSERT_TRUE(checked && plain);
+    const auto cesium = load("/CesiumMan/CesiumMan.glb");
+    ASSERT_TRUE(cesium);
+    const auto pattern = dome();
+    for (int count : {12, 1}) {
+        const FrameRequest req = request(cesium, heights(*pattern, count));
+        const Image8 a = frame(*checked, req, "checked"), b = frame(**plain, req, "plain");
+        ASSERT_FALSE(a.rgba.empty());
+        EXPECT_EQ(a.rgba, b.rgba) << count << " placements";
+    }
+}
