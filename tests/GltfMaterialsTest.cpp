@@ -39,9 +39,12 @@ TEST(GltfMaterialsTest, DamagedHelmetHasEveryTextureOfItsMaterial) {
     EXPECT_EQ(mat.roughnessFactor, 1.0f);
     EXPECT_EQ(mat.alphaMode, AlphaMode::Opaque);
     EXPECT_FALSE(mat.unlit);
-    // No TANGENT in the file: the shading builds the frame per pixel.
-    for (const MeshPart& p : m->parts)
-        EXPECT_TRUE(p.tangents.empty());
+    // No TANGENT in the file but a normal map: MikkTSpace tangents generated on load
+    // (TangentsTest checks their values).
+    for (const MeshPart& p : m->parts) {
+        EXPECT_TRUE(p.tangentsGenerated);
+        EXPECT_EQ(p.tangents.size(), p.positions.size());
+    }
 }
 
 TEST(GltfMaterialsTest, AlphaModesAndCutoffs) {

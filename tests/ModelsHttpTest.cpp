@@ -5,6 +5,7 @@
 //     RiggedFigure without UVs), UV layouts as JSON and PNG, deletion (409 while a scene uses it);
 //   * morph targets listed by name in a model's details and posed through the scene's
 //     pose.morphs (merged like the joints; an unknown name 404 naming it);
+//   * parts counted by where their tangents come from (the file, generated on load, none);
 //   * the UV diagnosis in a model's details (`uv`, SPEC §8): the default character and CesiumMan
 //     usable without overlap, the Barbarian's palette atlas overlapping with its regions named
 //     (the hat shares texels with the body; left and right forearm mirrored), RiggedFigure
@@ -73,6 +74,27 @@ TEST_F(ModelsHttpTest, MorphTargetsAreListedAndPosedByName) {
     expectError(h.patch(scene + "/pose", {{"morphs", {{"frown", 1.0}}}}), 404, "/pose/morphs/frown");
     EXPECT_EQ(h.del(scene).status, 204);
     EXPECT_EQ(h.del("/models/" + model).status, 204);
+}
+
+TEST_F(ModelsHttpTest, PartsAreCountedByWhereTheirTangentsComeFrom) {
+    Http h = http();
+    const std::string fidelity = kTestModels + "/fidelity/";
+    const std::pair<std::string, json> cases[] = {
+        // A normal map and no TANGENT: generated on load (core/tangents.hpp).
+        {"DamagedHelmet/DamagedHelmet.glb", {{"file", 0}, {"generated", 1}, {"none", 0}}},
+        {"NormalTangentMirrorTest/NormalTangentMirrorTest.glb", {{"file", 1}, {"generated", 0}, {"none", 0}}},
+    };
+    for (const auto& [file, tangents] : cases) {
+        Reply up = h.upload("/models", readBytes(fidelity + file), "model/gltf-binary");
+        ASSERT_TRUE(up.status == 201 || up.status == 200) << file << ": " << up;
+        const json details = h.get("/models/" + up.js()["id"].get<std::string>()).js();
+        EXPECT_EQ(details["tangents"], tangents) << file;
+    }
+    // No normal map: no tangents (CesiumMan's and the others' uploads are other tests').
+    const json builtin = h.get("/models/builtin:default").js()["tangents"];
+    EXPECT_EQ(builtin["file"], 0);
+    EXPECT_EQ(builtin["generated"], 0);
+    EXPECT_GE(builtin["none"], 1);
 }
 
 TEST_F(ModelsHttpTest, BuiltinModelIsListedWithItsDetails) {

@@ -60,9 +60,11 @@ struct MeshPart {
     std::vector<glm::vec3> normals;       ///< unit; computed (area-weighted) when the file has none
     std::vector<glm::vec2> uvs;           ///< TEXCOORD_0; empty when the file has none
     std::vector<glm::vec2> uvs1;          ///< TEXCOORD_1; empty when the file has none
-    /// TANGENT: unit xyz, w = ±1 the bitangent's sign (b = w·n × t); empty when the file has none
-    /// (the shading then builds the tangent frame per pixel from the UV derivatives).
+    /// TANGENT: unit xyz, w = ±1 the bitangent's sign (b = w·n × t). A normal-mapped part whose
+    /// file has none gets MikkTSpace tangents on load (core/tangents.hpp, tangentsGenerated);
+    /// empty otherwise (the shading then builds the frame per pixel from the UV derivatives).
     std::vector<glm::vec4> tangents;
+    bool tangentsGenerated = false; ///< `tangents` were generated on load, not read from the file
     std::vector<glm::vec4> colors;        ///< COLOR_0 as linear RGBA; empty when the file has none
     std::vector<glm::u16vec4> joints;     ///< indices into `influences`, one per vertex
     std::vector<glm::vec4> weights;       ///< normalised (sum 1), one per vertex

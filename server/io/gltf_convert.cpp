@@ -6,6 +6,7 @@
 #include "gltf_internal.hpp"
 
 #include "core/rig.hpp"
+#include "core/tangents.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -580,12 +581,23 @@ class Converter {
         // Skinned (node has a skin and the primitive has JOINTS_0), else rigid on the node.
         const tg::Node& node = g_.nodes[static_cast<std::size_t>(nodeIndex)];
         const bool skinned = node.skin >= 0 && prim.attributes.count("JOINTS_0") != 0;
-        if (skinned) {
+        if (skinned)
             if (auto s = skinWeights(prim, field, static_cast<std::size_t>(node.skin), part); !s)
                 return s.error();
-        } else if (auto s = rigid(nodeIndex, part); !s) {
-            return s.error();
+        // glTF §3.7.2.1: a normal-mapped primitive without TANGENT gets MikkTSpace tangents over
+        // the normal texture's UV set, in the mesh's own space (before a rigid part moves to rest
+        // world space, which turns them as it turns tangents read from the file).
+        if (part.tangents.empty() && part.material >= 0) {
+            const Material& mat = m_.materials[static_cast<std::size_t>(part.material)];
+            const int set = mat.normalUv.texCoord;
+            if (mat.normalTexture >= 0 && !(set == 1 ? part.uvs1 : part.uvs).empty()) {
+                if (auto s = generateTangents(part, set); !s)
+                    return parseError(field + "/attributes/TANGENT", s.error().message);
+                part.tangentsGenerated = true;
+            }
         }
+        if (!skinned)
+            if (auto s = rigid(nodeIndex, part); !s) return s.error();
         m_.parts.push_back(std::move(part));
         return Ok{};
     }

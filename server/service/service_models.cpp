@@ -270,6 +270,11 @@ Result<json> Service::getModel(const std::string& id) const {
     for (const MorphWeight& w : m.morphWeights)
         if (named.insert(w.name).second) morphs.push_back({{"name", w.name}, {"rest", w.rest}});
     out["morphs"] = std::move(morphs);
+    // Parts by where their normal-map tangents come from (core/tangents.hpp generates them).
+    std::size_t fromFile = 0, generated = 0, none = 0;
+    for (const MeshPart& p : m.parts)
+        (p.tangents.empty() ? none : p.tangentsGenerated ? generated : fromFile) += 1;
+    out["tangents"] = {{"file", fromFile}, {"generated", generated}, {"none", none}};
     out["vertices"] = vertices;
     // Built once per model entry (ids are content addresses: cached by content), then shared
     // with lint and the picks.
