@@ -244,7 +244,8 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       // The crowded middle of the default scene: each of them, selected, shows its label.
       for (const id of ["ribs_l", "stomach", "waist_l", "waist_r"]) {
         await page.click(`#placementList li[data-placement="${id}"] .name`);
-        l = await until(async () => { const x = await labels(page); return x.shown.some((b) => b.id === id) && x; }, `${id}'s label shows when selected`);
+        // The layout drawn for this selection (it is drawn on the next animation frame).
+        l = await until(async () => { const x = await labels(page); return x.selection === id && x.shown.some((b) => b.id === id) && x; }, `${id}'s label shows when selected`);
         assert.deepEqual(overlaps(l.shown), [], `no overlap with ${id} selected`);
         // No label covers the selection's handles (corners, the rotation handle).
         const g = await footprint(page, id);

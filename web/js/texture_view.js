@@ -345,7 +345,7 @@ function obstacles() {
 }
 
 function drawLabels(dims, w, h) {
-  labels = layoutLabels(w, h);
+  labels = { ...layoutLabels(w, h), selection: store.selection[0] ?? null };
   ctx.font = LABEL_FONT;
   ctx.textBaseline = "middle";
   for (const b of labels.shown) {
@@ -360,10 +360,13 @@ function drawLabels(dims, w, h) {
   ctx.textBaseline = "alphabetic";
 }
 
-/// The last drawn label layout, for tests: {shown: [{id, x, y, w, h}] in client px, hidden: [id]}.
+/// The last drawn label layout, for tests: {shown: [{id, x, y, w, h}] in client px, hidden: [id],
+/// selection: the placement selected when it was drawn (null for none)}. It is drawn on the next
+/// animation frame after a change, so a test waits for the selection it set.
 export function labelLayout() {
   const r = canvas.getBoundingClientRect();
-  return { shown: labels.shown.map(({ id, x, y, w, h }) => ({ id, x: r.left + x, y: r.top + y, w, h })), hidden: [...labels.hidden] };
+  return { shown: labels.shown.map(({ id, x, y, w, h }) => ({ id, x: r.left + x, y: r.top + y, w, h })), hidden: [...labels.hidden],
+           selection: labels.selection ?? null };
 }
 
 function handlePoints(p) {
