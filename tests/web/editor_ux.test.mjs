@@ -62,6 +62,13 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       await sleep(300);
       const bar = await box(page, ".toolbar");
       assert.ok(bar.height < 44, `the toolbar is one row (${bar.height} px)`);
+      // Whatever this window's random name and the revision: the longest name the editor makes,
+      // and a five-digit revision, still leave one row (a long name wrapped it in one CI run).
+      const [name, rev] = await page.evaluate(() => [document.getElementById("me").textContent, document.getElementById("revision").textContent]);
+      await page.evaluate(() => { document.getElementById("me").textContent = "nimble-marten-wwww"; document.getElementById("revision").textContent = "r88888"; });
+      const longBar = await box(page, ".toolbar");
+      assert.ok(longBar.height < 44, `the toolbar is one row with the longest name (${longBar.height} px)`);
+      await page.evaluate(([n, r]) => { document.getElementById("me").textContent = n; document.getElementById("revision").textContent = r; }, [name, rev]);
       const tbar = await box(page, "#textureView .viewbar"), fbar = await box(page, "#frameView .viewbar");
       assert.ok(tbar.height < 40, `the texture view bar is one row (${tbar.height} px)`);
       assert.ok(fbar.height < 40, `the 3D view bar is one row too (${fbar.height} px): Size and Reset fold into ⋯`);
