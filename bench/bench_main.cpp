@@ -89,11 +89,11 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
     const double duration = ds.clipDuration;
     HeightMaps cpuHeights; // reused: no per-frame allocation
     for (bool cpuMaps : {false, true})
-        for (const Shading shading : {Shading::Legacy, Shading::Pbr})
+        for (const Shading shading : {Shading::Legacy, Shading::Pbr, Shading::Skin})
         for (int size : {512, 1024})
             for (const AntiAliasing aa : {AntiAliasing::None, AntiAliasing::Post, AntiAliasing::Msaa}) {
-                // The pbr shading's cost is measured with GPU maps only.
-                if (cpuMaps && shading == Shading::Pbr) continue;
+                // The pbr and skin shadings' cost is measured with GPU maps only.
+                if (cpuMaps && shading != Shading::Legacy) continue;
                 // Off, the post-process edge pass (render.aa "post"), MSAA 4x.
                 const int msaa = aa == AntiAliasing::Msaa ? 4 : 1;
                 scene.render.shading = shading;

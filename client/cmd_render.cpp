@@ -51,8 +51,8 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
     frame->add_option("--msaa", o->msaa, "MSAA with 1, 2 or 4 samples")->check(CLI::IsMember({1, 2, 4}));
     frame->add_option("--aa", o->aa, "Anti-aliasing: auto (post on software rasterizers, else MSAA), msaa, post or none")
         ->check(CLI::IsMember({"auto", "msaa", "post", "none"}));
-    frame->add_option("--shading", o->shading, "legacy or pbr (the model's glTF material under image-based light)")
-        ->check(CLI::IsMember({"legacy", "pbr"}));
+    frame->add_option("--shading", o->shading, "legacy, pbr (the model's glTF material under image-based light) or skin (pbr with subsurface scattering)")
+        ->check(CLI::IsMember({"legacy", "pbr", "skin"}));
     frame->add_option("--view", o->view, "shaded, or bump / displacement / normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal", "basecolor", "lighting"}));
     frame->add_option("--revision", o->revision, "The scene as it was at this revision")->check(CLI::PositiveNumber);

@@ -37,18 +37,22 @@ vec2 equirectTexcoord(vec3 d) {
     return vec2(atan(d.z, d.x) * (0.5 / kPi) + 0.5, 0.5 - asin(clamp(d.y, -1.0, 1.0)) / kPi);
 }
 
-vec3 irradiance(vec3 n) {
+// The irradiance about `n` with SH band 1 scaled by `band1` and band 2 by `band2` per channel
+// (1 and 1: the environment's own; the skin shading blurs it by attenuating them).
+vec3 irradianceBands(vec3 n, vec3 band1, vec3 band2) {
     vec3 d = envDirection(n);
     // Real SH basis, order 2 (the constants of core/environment.cpp's projection).
     float x = d.x, y = d.y, z = d.z;
-    vec3 e = u_irradianceSh[0].rgb * 0.282095 + u_irradianceSh[1].rgb * 0.488603 * y +
-             u_irradianceSh[2].rgb * 0.488603 * z + u_irradianceSh[3].rgb * 0.488603 * x +
-             u_irradianceSh[4].rgb * 1.092548 * x * y + u_irradianceSh[5].rgb * 1.092548 * y * z +
-             u_irradianceSh[6].rgb * 0.315392 * (3.0 * z * z - 1.0) +
-             u_irradianceSh[7].rgb * 1.092548 * x * z +
-             u_irradianceSh[8].rgb * 0.546274 * (x * x - y * y);
-    return max(e, vec3(0.0));
+    vec3 e1 = u_irradianceSh[1].rgb * 0.488603 * y + u_irradianceSh[2].rgb * 0.488603 * z +
+              u_irradianceSh[3].rgb * 0.488603 * x;
+    vec3 e2 = u_irradianceSh[4].rgb * 1.092548 * x * y + u_irradianceSh[5].rgb * 1.092548 * y * z +
+              u_irradianceSh[6].rgb * 0.315392 * (3.0 * z * z - 1.0) +
+              u_irradianceSh[7].rgb * 1.092548 * x * z +
+              u_irradianceSh[8].rgb * 0.546274 * (x * x - y * y);
+    return max(u_irradianceSh[0].rgb * 0.282095 + band1 * e1 + band2 * e2, vec3(0.0));
 }
+
+vec3 irradiance(vec3 n) { return irradianceBands(n, vec3(1.0), vec3(1.0)); }
 
 vec3 prefilteredRadiance(vec3 r, float roughness) {
     return textureLod(u_envSpecular, equirectTexcoord(envDirection(r)), roughness * u_envParams.w).rgb;
@@ -139,3 +143,54 @@ vec3 shadePbr(vec3 baseColor, float metallic, float roughness, float occlusion, 
     vec3 diffuse = (FmsEms + kD) * irradiance(n);
     return (diffuse + specular) * occlusion;
 }
+
+#ifdef DERMIS_SKIN
+// Skin (`render.shading` "skin", Shading::Skin in core/render_settings.hpp, whose constants come in
+// as the DERMIS_SKIN_* defines): the metallic-roughness BRDF above with light scattered under the
+// surface and a second specular lobe.
+// * Scattering, for image-based light: a diffusion profile blurs the irradiance over the sphere
+//   of directions; a Gaussian of angular width σ attenuates SH band l by exp(−l(l+1)σ²/2), so
+//   band 1 by exp(−σ²) and band 2 by exp(−3σ²), σ per channel (red scatters furthest). Band 0,
+//   the mean, is kept: under a uniform environment the diffuse light is pbr's.
+// * The diffuse normal of each channel is the bumped normal `n` blended towards the unbumped
+//   `nSmooth` (red most): wrinkles and the normal map's detail soften in red, as on skin, and
+//   keep their edge in blue and in the specular.
+// * Two GGX lobes (roughness r and r·DERMIS_SKIN_LOBE_ROUGHNESS, the second weighted
+//   DERMIS_SKIN_LOBE_WEIGHT), as dual-lobe skin models do (Kelemen and Szirmay-Kalos).
+vec3 skinIrradiance(vec3 n, vec3 nSmooth) {
+    const vec3 sigma = DERMIS_SKIN_SCATTER;
+    const vec3 blend = DERMIS_SKIN_NORMAL_BLEND;
+    vec3 band1 = exp(-sigma * sigma), band2 = exp(-3.0 * sigma * sigma);
+    vec3 nr = normalize(mix(n, nSmooth, blend.r));
+    vec3 ng = normalize(mix(n, nSmooth, blend.g));
+    vec3 nb = normalize(mix(n, nSmooth, blend.b));
+    return vec3(irradianceBands(nr, band1, band2).r, irradianceBands(ng, band1, band2).g,
+                irradianceBands(nb, band1, band2).b);
+}
+
+vec3 shadeSkin(vec3 baseColor, float metallic, float roughness, float occlusion, vec3 n, vec3 nSmooth,
+               vec3 v) {
+    vec3 f0 = mix(vec3(0.04), baseColor, metallic);
+    vec3 diffuseColor = baseColor * (1.0 - metallic);
+    float NdotV = clamp(dot(n, v), 1e-4, 1.0);
+    vec2 dfg = texture(u_brdfLut, vec2(NdotV, roughness)).rg;
+    vec3 Fr = max(vec3(1.0 - roughness), f0) - f0;
+    vec3 kS = f0 + Fr * pow(1.0 - NdotV, 5.0);
+    vec3 FssEss = kS * dfg.x + dfg.y;
+    float Ems = 1.0 - (dfg.x + dfg.y);
+    vec3 Favg = f0 + (1.0 - f0) / 21.0;
+    vec3 FmsEms = Ems * FssEss * Favg / (1.0 - Favg * Ems);
+    vec3 kD = diffuseColor * (1.0 - FssEss - FmsEms);
+    // The second lobe's split-sum term at its own roughness.
+    float roughness2 = max(roughness * DERMIS_SKIN_LOBE_ROUGHNESS, 0.03);
+    vec2 dfg2 = texture(u_brdfLut, vec2(NdotV, roughness2)).rg;
+    vec3 Fr2 = max(vec3(1.0 - roughness2), f0) - f0;
+    vec3 FssEss2 = (f0 + Fr2 * pow(1.0 - NdotV, 5.0)) * dfg2.x + dfg2.y;
+    vec3 r = reflect(-v, n);
+    const float w = DERMIS_SKIN_LOBE_WEIGHT;
+    vec3 specular = (1.0 - w) * FssEss * prefilteredRadiance(r, roughness) +
+                    w * FssEss2 * prefilteredRadiance(r, roughness2);
+    vec3 diffuse = (FmsEms + kD) * skinIrradiance(n, nSmooth);
+    return (diffuse + specular) * occlusion;
+}
+#endif

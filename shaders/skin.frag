@@ -1,9 +1,10 @@
 // Skin pass, fragment stage: bump mapping from the height maps without precomputed tangents
 // (Mikkelsen, "Bump Mapping Unparametrized Surfaces on the GPU", 2010: the surface gradient from
-// screen-space derivatives), then one of two shadings: "legacy", the base colour under one
-// Blinn-Phong key light and a hemisphere fill, or — DERMIS_PBR, `render.shading` "pbr" — glTF
-// metallic-roughness under image-based light (pbr.glsl), exposure and tone mapping. Writes linear
-// colour; the sRGB render target encodes it.
+// screen-space derivatives), then one of three shadings: "legacy", the base colour under one
+// Blinn-Phong key light and a hemisphere fill; DERMIS_PBR, `render.shading` "pbr", glTF
+// metallic-roughness under image-based light (pbr.glsl), exposure and tone mapping; or
+// DERMIS_PBR with DERMIS_SKIN, "skin", that with subsurface scattering and a second specular lobe
+// (pbr.glsl shadeSkin). Writes linear colour; the sRGB render target encodes it.
 //
 // Views (DERMIS_VIEW, FrameView in server/core/render_settings.hpp; one program per view, so that a
 // software rasterizer, which runs every branch for every pixel, shades only its view's code):
@@ -182,7 +183,11 @@ void main() {
         float occlusion = 1.0;
         if (hasMap(8) && view != 5)
             occlusion = 1.0 + u_material.w * (texture(u_occlusionTexture, materialUv(3, v_uv, v_uv1)).r - 1.0);
+#ifdef DERMIS_SKIN
+        color = shadeSkin(base.rgb, metallic, roughness, occlusion, nn, ng, toCamera);
+#else
         color = shadePbr(base.rgb, metallic, roughness, occlusion, nn, toCamera);
+#endif
         vec3 emissive = u_emissive.rgb;
         if (hasMap(16)) emissive *= texture(u_emissiveTexture, materialUv(4, v_uv, v_uv1)).rgb;
         if (view != 5) color += emissive;

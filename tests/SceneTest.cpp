@@ -353,6 +353,19 @@ TEST(SceneTest, EnabledAndLabelRoundTrip) {
     expectStableRoundTrip(placement(R"("enabled":false,"label":")" + std::string(120, 'y') + R"(")"));
 }
 
+TEST(SceneTest, EveryShadingRoundTrips) {
+    for (const char* name : {"legacy", "pbr", "skin"}) {
+        const auto shading = dermis::shadingFromString(name);
+        ASSERT_TRUE(shading) << name;
+        EXPECT_EQ(dermis::toString(*shading), name);
+    }
+    EXPECT_FALSE(dermis::shadingFromString("Skin")) << "names are case-sensitive";
+    const Scene s = parseOk(doc(R"("render":{"shading":"skin"})"));
+    EXPECT_EQ(s.render.shading, dermis::Shading::Skin);
+    EXPECT_EQ(dermis::toJson(s)["render"]["shading"], "skin");
+    expectStableRoundTrip(doc(R"("render":{"shading":"skin"})"));
+}
+
 TEST(SceneTest, UvLayoutDefaultsToAutoAndRoundTrips) {
     EXPECT_EQ(parseOk(doc("")).uvLayout, dermis::UvLayoutMode::Auto);
     EXPECT_EQ(dermis::toJson(parseOk(doc("")))["uv_layout"], "auto");

@@ -46,12 +46,18 @@ std::optional<AntiAliasing> antiAliasingFromString(std::string_view s) {
 }
 
 std::string_view toString(Shading s) {
-    return s == Shading::Pbr ? "pbr" : "legacy";
+    switch (s) {
+    case Shading::Pbr: return "pbr";
+    case Shading::Skin: return "skin";
+    case Shading::Legacy: break;
+    }
+    return "legacy";
 }
 
 std::optional<Shading> shadingFromString(std::string_view s) {
     if (s == "legacy") return Shading::Legacy;
     if (s == "pbr") return Shading::Pbr;
+    if (s == "skin") return Shading::Skin;
     return std::nullopt;
 }
 

@@ -48,7 +48,24 @@ std::optional<AntiAliasing> antiAliasingFromString(std::string_view s);
 /// metallic-roughness material (base colour, metallic-roughness, normal, occlusion and emissive
 /// textures, alpha modes, vertex colours, KHR_texture_transform, unlit) under image-based light
 /// from the default studio environment (core/environment.hpp), with exposure and tone mapping.
-enum class Shading { Legacy, Pbr };
+/// Skin: pbr for previews of skin (issue #26), so that a wrinkle reads as it would on skin —
+/// light scattered under the surface, approximated for image-based light: the irradiance's
+/// spherical-harmonic bands 1 and 2 attenuated per channel as a Gaussian diffusion profile of
+/// angular width kSkinScatterWidth blurs them (red widest), the diffuse normal of each channel
+/// blended from the bumped normal towards the unbumped one by kSkinNormalBlend (red softest),
+/// and a second, sharper specular lobe (roughness × kSkinSecondLobeRoughness, weight
+/// kSkinSecondLobeWeight) for skin's oily sheen. The same inputs as pbr; a uniform environment
+/// shades it as pbr does but for the second lobe (the scattering moves light, it adds none).
+enum class Shading { Legacy, Pbr, Skin };
+
+/// The skin shading's constants (shaders/pbr.glsl mirrors them; SkinShadingGLTest): σ per
+/// channel (rgb, radians) of the Gaussian blur on the sphere of directions, whose SH band l is
+/// attenuated by exp(−l(l+1)σ²/2); how far each channel's diffuse normal goes from the bumped
+/// normal towards the unbumped one; the second lobe's roughness scale and weight.
+constexpr double kSkinScatterWidth[3] = {0.55, 0.25, 0.12};
+constexpr double kSkinNormalBlend[3] = {0.7, 0.35, 0.1};
+constexpr double kSkinSecondLobeRoughness = 0.5;
+constexpr double kSkinSecondLobeWeight = 0.15;
 std::string_view toString(Shading s);
 std::optional<Shading> shadingFromString(std::string_view s);
 

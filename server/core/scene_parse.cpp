@@ -564,7 +564,7 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
         render.displacement = *e;
     }
     if (const json* sh = Reader::find(v, "shading")) {
-        auto e = rd.enumeration(*sh, ptr + "/shading", shadingFromString, "\"legacy\" or \"pbr\"");
+        auto e = rd.enumeration(*sh, ptr + "/shading", shadingFromString, "\"legacy\", \"pbr\" or \"skin\"");
         if (!e) return e.error();
         render.shading = *e;
     }

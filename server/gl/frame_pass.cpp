@@ -153,19 +153,22 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     uploadOutlineBlock(req.outlines);
     // The pbr program draws the pbr shading and its views (BaseColor and Lighting always; Normal
     // with the model's normal map when the shading is pbr).
+    // Skin shading draws its shaded view with its own program, and every other view as pbr.
     const bool pbr = req.view == FrameView::BaseColor || req.view == FrameView::Lighting ||
-                     (rs.shading == Shading::Pbr && (req.view == FrameView::Shaded || req.view == FrameView::Normal));
+                     (rs.shading != Shading::Legacy && (req.view == FrameView::Shaded || req.view == FrameView::Normal));
+    const bool skinShading = rs.shading == Shading::Skin && req.view == FrameView::Shaded;
     if (pbr) {
         auto light = environmentLight(req.environment);
         if (!light) return light.error();
         uploadEnvironmentBlock(**light, rs);
     }
     const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view, pbr);
-    const GLuint program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr);
+    const auto program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr, skinShading);
+    if (!program) return program.error();
     std::vector<std::size_t> order(parts.value()->size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     if (pbr) order = pbrDrawOrder(model, **parts, posed, camera.eye);
-    const GLuint readFbo = drawSkinPass(model, **gm, **parts, rs, program, heightSource->texture,
+    const GLuint readFbo = drawSkinPass(model, **gm, **parts, rs, *program, heightSource->texture,
                                         partStride, samples, pbr ? &order : nullptr);
     if (auto s = checkGl("skin pass"); !s) return s.error();
     if (req.profile) glFinish();

@@ -193,7 +193,21 @@ Status Renderer::Impl::buildPrograms() {
     return Ok{};
 }
 
-Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool pbr) {
+Result<GLuint> Renderer::Impl::skinProgram(bool tess, FrameView view, bool pbr, bool skinShading) {
+    if (skinShading) {
+        GLuint& p = skinShadingPrograms[tess ? 1 : 0];
+        if (!p) {
+            auto built = buildSkinProgram(tess, FrameView::Shaded, true, true);
+            if (!built) return built.error();
+            p = *built;
+        }
+        return p;
+    }
+    if (pbr) return pbrPrograms[tess ? 1 : 0];
+    return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
+}
+
+Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool pbr, bool skinShading) {
     ProgramDesc desc;
     desc.stages = {{GL_VERTEX_SHADER, "skin.vert"}};
     if (tess) {
@@ -206,6 +220,16 @@ Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool 
     if (pbr) {
         desc.defines.push_back("DERMIS_PBR");
         desc.includes.push_back({GL_FRAGMENT_SHADER, "pbr.glsl"});
+    }
+    if (skinShading) {
+        auto vec3 = [](const double (&v)[3]) {
+            return "vec3(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+        };
+        desc.defines.push_back("DERMIS_SKIN");
+        desc.defines.push_back("DERMIS_SKIN_SCATTER " + vec3(kSkinScatterWidth));
+        desc.defines.push_back("DERMIS_SKIN_NORMAL_BLEND " + vec3(kSkinNormalBlend));
+        desc.defines.push_back("DERMIS_SKIN_LOBE_ROUGHNESS " + std::to_string(kSkinSecondLobeRoughness));
+        desc.defines.push_back("DERMIS_SKIN_LOBE_WEIGHT " + std::to_string(kSkinSecondLobeWeight));
     }
     return buildProgram(desc);
 }
@@ -279,6 +303,10 @@ void Renderer::Impl::shutdown() {
             p = 0;
         }
     for (GLuint& p : pbrPrograms) {
+        glDeleteProgram(p);
+        p = 0;
+    }
+    for (GLuint& p : skinShadingPrograms) {
         glDeleteProgram(p);
         p = 0;
     }

@@ -129,7 +129,7 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
     if (req.has_param("shading")) {
         const auto shading = shadingFromString(req.get_param_value("shading"));
         if (!shading) {
-            sendError(res, 422, "invalid_argument", "dermis::Api: shading: must be legacy or pbr", "shading");
+            sendError(res, 422, "invalid_argument", "dermis::Api: shading: must be legacy, pbr or skin", "shading");
             return false;
         }
         p.shading = *shading;

@@ -245,6 +245,11 @@ struct Renderer::Impl {
     /// The shaded view with `render.shading` pbr by [tessellated]: skin.frag + pbr.glsl with
     /// DERMIS_PBR (built at start with the others).
     GLuint pbrPrograms[2] = {};
+    /// The shaded view with `render.shading` skin by [tessellated]: the pbr program with
+    /// DERMIS_SKIN. Built on the first frame that asks for skin (a preview shading: a server
+    /// that never shows it does not pay its link at start), on the render thread before the
+    /// frame's draws, and kept.
+    GLuint skinShadingPrograms[2] = {};
     /// The image-based light of the pbr programs (pbr_pass.cpp): for the default studio
     /// environment and for the last environment a frame brought (FrameRequest::environment, kept
     /// while its owner lives), the GGX-prefiltered radiance with one mip level per roughness step
@@ -297,13 +302,13 @@ struct Renderer::Impl {
     /// Links skin.vert/.frag (+ the tessellation stages when `tess`) with DERMIS_VIEW = `view`
     /// (+ DERMIS_PBR and pbr.glsl when `pbr`); fails with the GL's log. Only buildPrograms calls
     /// it (never during a frame).
-    Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false);
+    /// With `skinShading` (and `pbr`), the skin shading's variant (DERMIS_SKIN, its constants
+    /// from core/render_settings.hpp as defines).
+    Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false);
     /// The skin program of a frame (built at start by buildPrograms): the PBR one (every view
-    /// it draws, chosen by PartBlock's u_part.w) with `pbr`.
-    GLuint skinProgram(bool tess, FrameView view, bool pbr = false) const {
-        if (pbr) return pbrPrograms[tess ? 1 : 0];
-        return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
-    }
+    /// it draws, chosen by PartBlock's u_part.w) with `pbr`; the skin shading's with
+    /// `skinShading`, linked here the first time (fails with the GL's log).
+    Result<GLuint> skinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false);
     /// The light of `env` (null: the default studio environment), prefiltered on the CPU the
     /// first time a frame asks for it (legacy frames never pay for it) and kept: the studio's for
     /// the renderer's life, a custom one until another replaces it or its owner is gone. Fails
