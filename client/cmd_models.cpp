@@ -208,6 +208,40 @@ void addModelCommands(CLI::App& app, Context& ctx) {
     CLI::App* prm = pattern->add_subcommand("rm", "Delete uploaded patterns (refused while a scene uses one)");
     prm->add_option("ids", p->ids, "Pattern ids")->required();
     prm->callback([&ctx, p] { ctx.action = [&ctx, p] { removeEach(ctx, "patterns", p->ids); return kExitOk; }; });
+
+    auto e = std::make_shared<ModelOptions>();
+    CLI::App* env = app.add_subcommand("environment", "Environments for image-based light (render.environment): upload, list, rm");
+    env->require_subcommand(1);
+    CLI::App* eup = env->add_subcommand("upload", "Upload an equirectangular Radiance .hdr or OpenEXR of linear radiance; prints the id");
+    eup->add_option("file", e->id, ".hdr or .exr file")->required()->check(CLI::ExistingFile);
+    eup->add_option("--name", e->name, "Display name (default: the file's)");
+    eup->callback([&ctx, e] {
+        ctx.action = [&ctx, e] {
+            const std::string name = e->name.empty() ? std::filesystem::path(e->id).stem().string() : e->name;
+            printUpload(ctx, ctx.http().send("POST", "/environments?" + queryString({{"name", name}}),
+                                             readFileOrThrow(e->id, "file"), "application/octet-stream", true));
+            return kExitOk;
+        };
+    });
+    CLI::App* elist = env->add_subcommand("list", "List environments (the built-in studio and uploads)");
+    elist->callback([&ctx] {
+        ctx.action = [&ctx] {
+            auto j = ctx.http().getJson("/environments");
+            if (ctx.global.json) {
+                printJson(j);
+                return kExitOk;
+            }
+            std::vector<std::vector<std::string>> rows;
+            for (const auto& x : j["environments"])
+                rows.push_back({cell(x["id"]), cell(x["name"]), x.value("builtin", false) ? "built-in" : "uploaded",
+                                x.contains("width") ? cell(x["width"]) + "x" + cell(x["height"]) : "-"});
+            printTable({"ID", "NAME", "SOURCE", "SIZE"}, rows);
+            return kExitOk;
+        };
+    });
+    CLI::App* erm = env->add_subcommand("rm", "Delete uploaded environments (refused while a scene names one)");
+    erm->add_option("ids", e->ids, "Environment ids")->required();
+    erm->callback([&ctx, e] { ctx.action = [&ctx, e] { removeEach(ctx, "environments", e->ids); return kExitOk; }; });
 }
 
 } // namespace dermis::cli

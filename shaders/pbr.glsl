@@ -126,18 +126,24 @@ vec3 normalMapGradient(vec3 n, vec2 uv, vec4 tangent, vec3 position) {
 
 // Outgoing radiance of the glTF metallic-roughness BRDF under the environment (linear, before
 // exposure and tone mapping). `n` the shading normal, `v` towards the camera.
+// The split-sum specular terms at (N·V, roughness) for reflectance f0: roughness-dependent
+// Fresnel (Fdez-Agüera 2019), single scattering (FssEss) and multiple scattering (FmsEms).
+void splitSumTerms(vec3 f0, float NdotV, float roughness, out vec3 FssEss, out vec3 FmsEms) {
+    vec2 dfg = texture(u_brdfLut, vec2(NdotV, roughness)).rg;
+    vec3 Fr = max(vec3(1.0 - roughness), f0) - f0;
+    vec3 kS = f0 + Fr * pow(1.0 - NdotV, 5.0);
+    FssEss = kS * dfg.x + dfg.y;
+    float Ems = 1.0 - (dfg.x + dfg.y);
+    vec3 Favg = f0 + (1.0 - f0) / 21.0;
+    FmsEms = Ems * FssEss * Favg / (1.0 - Favg * Ems);
+}
+
 vec3 shadePbr(vec3 baseColor, float metallic, float roughness, float occlusion, vec3 n, vec3 v) {
     vec3 f0 = mix(vec3(0.04), baseColor, metallic);
     vec3 diffuseColor = baseColor * (1.0 - metallic);
     float NdotV = clamp(dot(n, v), 1e-4, 1.0);
-    vec2 dfg = texture(u_brdfLut, vec2(NdotV, roughness)).rg;
-    // Roughness-dependent Fresnel (Fdez-Agüera 2019), single and multiple scattering.
-    vec3 Fr = max(vec3(1.0 - roughness), f0) - f0;
-    vec3 kS = f0 + Fr * pow(1.0 - NdotV, 5.0);
-    vec3 FssEss = kS * dfg.x + dfg.y;
-    float Ems = 1.0 - (dfg.x + dfg.y);
-    vec3 Favg = f0 + (1.0 - f0) / 21.0;
-    vec3 FmsEms = Ems * FssEss * Favg / (1.0 - Favg * Ems);
+    vec3 FssEss, FmsEms;
+    splitSumTerms(f0, NdotV, roughness, FssEss, FmsEms);
     vec3 kD = diffuseColor * (1.0 - FssEss - FmsEms);
     vec3 specular = FssEss * prefilteredRadiance(reflect(-v, n), roughness);
     vec3 diffuse = (FmsEms + kD) * irradiance(n);
@@ -173,19 +179,13 @@ vec3 shadeSkin(vec3 baseColor, float metallic, float roughness, float occlusion,
     vec3 f0 = mix(vec3(0.04), baseColor, metallic);
     vec3 diffuseColor = baseColor * (1.0 - metallic);
     float NdotV = clamp(dot(n, v), 1e-4, 1.0);
-    vec2 dfg = texture(u_brdfLut, vec2(NdotV, roughness)).rg;
-    vec3 Fr = max(vec3(1.0 - roughness), f0) - f0;
-    vec3 kS = f0 + Fr * pow(1.0 - NdotV, 5.0);
-    vec3 FssEss = kS * dfg.x + dfg.y;
-    float Ems = 1.0 - (dfg.x + dfg.y);
-    vec3 Favg = f0 + (1.0 - f0) / 21.0;
-    vec3 FmsEms = Ems * FssEss * Favg / (1.0 - Favg * Ems);
+    vec3 FssEss, FmsEms;
+    splitSumTerms(f0, NdotV, roughness, FssEss, FmsEms);
     vec3 kD = diffuseColor * (1.0 - FssEss - FmsEms);
-    // The second lobe's split-sum term at its own roughness.
+    // The second lobe's single-scattering term at its own roughness.
     float roughness2 = max(roughness * DERMIS_SKIN_LOBE_ROUGHNESS, 0.03);
-    vec2 dfg2 = texture(u_brdfLut, vec2(NdotV, roughness2)).rg;
-    vec3 Fr2 = max(vec3(1.0 - roughness2), f0) - f0;
-    vec3 FssEss2 = (f0 + Fr2 * pow(1.0 - NdotV, 5.0)) * dfg2.x + dfg2.y;
+    vec3 FssEss2, FmsEms2;
+    splitSumTerms(f0, NdotV, roughness2, FssEss2, FmsEms2);
     vec3 r = reflect(-v, n);
     const float w = DERMIS_SKIN_LOBE_WEIGHT;
     vec3 specular = (1.0 - w) * FssEss * prefilteredRadiance(r, roughness) +

@@ -1,7 +1,7 @@
 // ClientHttpTest — the `dermis` command-line client (client/, issue #14) as a child process against
 // dermis-server as a real process on 127.0.0.1 (a GL context through $DERMIS_TEST_GL). It checks:
 //   * every subcommand: health, info, model upload|list|show|rm (content-addressed: the same id
-//     twice), pattern upload|list|rm, scene create|list|get|put|export|apply|rm|history|revert,
+//     twice), pattern upload|list|rm, environment upload|list|rm, scene create|list|get|put|export|apply|rm|history|revert,
 //     pose set (joints, clip, time, --morph), placement add|set|rm|mirror, frame, maps, lint, watch, render, check;
 //   * exit codes and messages: bad arguments → 2, server errors → 1 with
 //     "dermis: error: <message> (<field>)", an unreachable server → 3;
@@ -233,6 +233,19 @@ TEST_F(ClientHttpTest, HealthInfoModelsAndPatterns) {
     EXPECT_NE(plist.out.find("my crease"), std::string::npos) << plist;
     EXPECT_EQ(dermis({"pattern", "rm", pid}).code, 0);
     EXPECT_EQ(dermis({"--json", "pattern", "list"}).js()["patterns"].dump().find(pid), std::string::npos);
+
+    const float sky[3] = {0.8f, 0.7f, 0.6f};
+    writeText(*dir_ / "dusk.hdr", radianceHdr(32, 16, sky, sky));
+    ClientRun eup = dermis({"environment", "upload", *dir_ / "dusk.hdr"});
+    ASSERT_EQ(eup.code, 0) << eup;
+    const std::string eid = eup.firstLine();
+    EXPECT_EQ(eid.rfind("e_", 0), 0u) << eup;
+    ClientRun elist = dermis({"environment", "list"});
+    EXPECT_NE(elist.out.find(eid), std::string::npos) << elist;
+    EXPECT_NE(elist.out.find("dusk"), std::string::npos) << elist;
+    EXPECT_NE(elist.out.find("builtin:studio"), std::string::npos) << elist;
+    EXPECT_EQ(dermis({"environment", "rm", eid}).code, 0);
+    EXPECT_EQ(dermis({"--json", "environment", "list"}).js()["environments"].dump().find(eid), std::string::npos);
 }
 
 TEST_F(ClientHttpTest, GltfWithItsFilesUploadsAsMultipart) {

@@ -366,6 +366,17 @@ TEST(SceneTest, EveryShadingRoundTrips) {
     expectStableRoundTrip(doc(R"("render":{"shading":"skin"})"));
 }
 
+TEST(SceneTest, EnvironmentIsWrittenOnlyWhenNamed) {
+    const Scene plain = parseOk(doc(""));
+    EXPECT_EQ(plain.render.environment, "");
+    EXPECT_FALSE(dermis::toJson(plain)["render"].contains("environment")) << "older documents keep their text";
+    const Scene named = parseOk(doc(R"("render":{"environment":"e_0123456789abcdef"})"));
+    EXPECT_EQ(named.render.environment, "e_0123456789abcdef");
+    EXPECT_EQ(dermis::toJson(named)["render"]["environment"], "e_0123456789abcdef");
+    expectStableRoundTrip(doc(R"("render":{"environment":"sky/studio.hdr"})"));
+    expectStableRoundTrip(doc(R"("render":{"environment":"builtin:studio"})"));
+}
+
 TEST(SceneTest, UvLayoutDefaultsToAutoAndRoundTrips) {
     EXPECT_EQ(parseOk(doc("")).uvLayout, dermis::UvLayoutMode::Auto);
     EXPECT_EQ(dermis::toJson(parseOk(doc("")))["uv_layout"], "auto");
@@ -671,6 +682,9 @@ const BadCase kBadCases[] = {
     {"ExposureNegative", doc(R"("render":{"exposure":-1})"), "/render/exposure"},
     {"ExposureTooLarge", doc(R"("render":{"exposure":65})"), "/render/exposure"},
     {"ToneMappingUnknown", doc(R"("render":{"tone_mapping":"filmic"})"), "/render/tone_mapping"},
+    {"EnvironmentNotAString", doc(R"("render":{"environment":7})"), "/render/environment"},
+    {"EnvironmentEmpty", doc(R"("render":{"environment":""})"), "/render/environment"},
+    {"EnvironmentUnknownBuiltin", doc(R"("render":{"environment":"builtin:sunset"})"), "/render/environment"},
     {"EnvironmentRotationTooLarge", doc(R"("render":{"environment_rotation":3601})"),
      "/render/environment_rotation"},
     {"EnvironmentRotationString", doc(R"("render":{"environment_rotation":"90"})"),

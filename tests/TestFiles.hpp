@@ -10,6 +10,8 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -87,6 +89,28 @@ inline CliRun runServer(const TempDir& dir, const std::string& args) {
     r.out.assign(out.begin(), out.end());
     r.err.assign(err.begin(), err.end());
     return r;
+}
+
+/// A Radiance .hdr of w × h texels (flat RGBE scanlines, the format's header): linear radiance
+/// `sky` (rgb) in the rows above the horizon (the upper half) and `ground` below it.
+inline std::string radianceHdr(int w, int h, const float (&sky)[3], const float (&ground)[3]) {
+    std::string text = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " +
+                       std::to_string(w) + "\n";
+    auto rgbe = [](const float (&rgb)[3]) {
+        std::string t(4, '\0');
+        const float v = std::max(rgb[0], std::max(rgb[1], rgb[2]));
+        if (v <= 0.0f) return t;
+        int e = 0;
+        const float scale = std::frexp(v, &e) * 256.0f / v;
+        t = {static_cast<char>(rgb[0] * scale), static_cast<char>(rgb[1] * scale),
+             static_cast<char>(rgb[2] * scale), static_cast<char>(e + 128)};
+        return t;
+    };
+    const std::string top = rgbe(sky), bottom = rgbe(ground);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            text += y < h / 2 ? top : bottom;
+    return text;
 }
 
 /// A one-triangle glTF 2.0 document whose only buffer is the external file `binName`, and that

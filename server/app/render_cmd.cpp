@@ -153,10 +153,20 @@ int runRender(const RenderArgs& a) {
     // Frames are encoded and written on a worker while the next one renders (at most two waiting:
     // bounded memory). Each file's bytes are those of the sequential path (deterministic encoders).
     FrameWriteQueue writer(1, 2);
+    // --environment, else the scene's `render.environment` (a path relative to the document;
+    // builtin:studio or none: the default studio).
     std::shared_ptr<const EnvironmentImage> environment;
-    if (!a.environment.empty()) {
-        auto env = readEnvironmentImage(a.environment);
-        if (!env) return fail(env.error());
+    std::string environmentFile = a.environment;
+    if (const std::string& named = loaded->scene.render.environment;
+        environmentFile.empty() && !named.empty() && named != kBuiltinStudioEnvironment)
+        environmentFile = (std::filesystem::path(loaded->baseDir) / named).lexically_normal().string();
+    if (!environmentFile.empty()) {
+        auto env = readEnvironmentImage(environmentFile);
+        if (!env) {
+            Error e = env.error();
+            if (a.environment.empty()) e.field = "/render/environment";
+            return fail(e);
+        }
         environment = std::make_shared<const EnvironmentImage>(std::move(*env));
     }
     for (int k : todo) {

@@ -92,7 +92,16 @@ struct RenderSettings {
     double exposure = 1.0;                        ///< pbr: light × exposure before tone mapping
     ToneMapping toneMapping = ToneMapping::Neutral; ///< pbr only
     double environmentRotation = 0.0; ///< pbr: degrees the environment turns about +Y
+    /// pbr and skin: the environment that lights the frame (`render.environment`). Empty or
+    /// kBuiltinStudioEnvironment: the default studio (core/environment.hpp). Anything else is a
+    /// name the shell resolves: an uploaded environment's id ("e_…") on a server, a file path
+    /// relative to the scene document on the command line. Not checked here (a path or an id
+    /// of ≤ kMaxPathLength bytes; the parser checks its form, the shell that it exists).
+    std::string environment;
 };
+
+/// The default studio environment's name in `render.environment`.
+inline constexpr const char* kBuiltinStudioEnvironment = "builtin:studio";
 
 /// What a frame shows of the posed, displaced character (a frame's choice, like its camera
 /// overrides: not part of scene documents). Shaded is the picture; the others are unlit

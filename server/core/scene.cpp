@@ -122,6 +122,7 @@ json toJson(const Scene& scene) {
         render["tone_mapping"] = std::string(toString(r.toneMapping));
     if (r.environmentRotation != defaults.environmentRotation)
         render["environment_rotation"] = r.environmentRotation;
+    if (!r.environment.empty()) render["environment"] = r.environment;
     doc["render"] = std::move(render);
     return doc;
 }

@@ -584,6 +584,14 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
         if (!d) return d.error();
         render.environmentRotation = *d;
     }
+    if (const json* en = Reader::find(v, "environment")) {
+        auto s = rd.path(*en, ptr + "/environment");
+        if (!s) return s.error();
+        if (s->rfind(kBuiltinPrefix, 0) == 0 && *s != kBuiltinStudioEnvironment)
+            return rd.bad(ptr + "/environment", "the built-in environment is \"" +
+                                                   std::string(kBuiltinStudioEnvironment) + "\", got '" + *s + "'");
+        render.environment = *s;
+    }
     return validateRenderSettings(render, {}, kSceneWhere);
 }
 

@@ -300,6 +300,7 @@ const RouteTable& routeTable() {
         installSessionRoutes(t);
         installModelRoutes(t);
         installPatternRoutes(t);
+        installEnvironmentRoutes(t);
         installSceneRoutes(t);
         installRenderRoutes(t);
         installInspectRoutes(t);

@@ -134,7 +134,7 @@ Result<Image8> decodeImage8(const std::vector<std::uint8_t>& bytes) {
     return img;
 }
 
-Result<EnvironmentImage> readEnvironmentImage(const std::string& path) {
+Result<EnvironmentImage> readEnvironmentImage(const std::string& path, int maxSide) {
     const char* where = "dermis::readEnvironmentImage";
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
@@ -144,7 +144,7 @@ Result<EnvironmentImage> readEnvironmentImage(const std::string& path) {
     EnvironmentImage env;
     std::vector<float> rgb;
     oiio::OiioFailure f;
-    if (!(*api)->readRgbFloat(path, kMaxEnvironmentSide, env.width, env.height, rgb, f))
+    if (!(*api)->readRgbFloat(path, std::min(std::max(maxSide, 2), kMaxEnvironmentSide), env.width, env.height, rgb, f))
         return moduleError(where, f);
     env.texels.resize(rgb.size() / 3);
     for (std::size_t k = 0; k < env.texels.size(); ++k)

@@ -63,8 +63,9 @@ constexpr int kMaxEnvironmentSide = 8192;
 /// OpenImageIO reads (8-bit ones as their values / 255, not decoded from sRGB), through the
 /// module. NotFound for a missing file; TooLarge past kMaxEnvironmentSide; Parse for unreadable
 /// data; InvalidArgument (validateEnvironment's field) for a size under 2 or negative or
-/// non-finite values; Unavailable without the module.
-Result<EnvironmentImage> readEnvironmentImage(const std::string& path);
+/// non-finite values; Unavailable without the module. `maxSide` (≤ kMaxEnvironmentSide) lowers
+/// the side limit (a server's maxImageSide for uploads).
+Result<EnvironmentImage> readEnvironmentImage(const std::string& path, int maxSide = kMaxEnvironmentSide);
 
 /// Decodes an encoded image (PNG, JPEG, …) to RGBA8 (grey → RGB, missing alpha → 255, alpha
 /// unassociated, 16-bit samples rounded to 8 bits), PNG and JPEG without the module.

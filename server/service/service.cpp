@@ -135,6 +135,10 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool
         }
     auto scene = parseScene(doc, manifest);
     if (!scene) return scene.error();
+    if (const std::string& env = scene->render.environment;
+        !env.empty() && env != kBuiltinStudioEnvironment && !environments.count(env))
+        return notFound("/render/environment", "no environment \"" + env +
+                                                   "\" (use builtin:studio or an id from POST /environments)");
     // A (valid) alias no placement names is dropped (issue #12.5): it would otherwise keep its
     // pattern "in use" after the last placement using it went, and DELETE /patterns/{id} answer 409.
     std::set<std::string> named;
@@ -304,6 +308,17 @@ void Service::State::loadStored(std::vector<std::string>& warnings) {
         images[b.id] = makePatternImage(std::move(*img));
         patterns[b.id] = PatternEntry{b.id, b.meta.value("name", ""), false, bytes->size(), nullptr,
                                       toHex(sha256(*bytes))};
+    }
+    // Environments before scenes (a scene may name one). Decoded when a frame needs one.
+    for (const Store::Blob& b : store->listBlobs("environments", warnings)) {
+        EnvironmentEntry e;
+        e.id = b.id;
+        e.name = b.meta.value("name", "");
+        e.file = b.file;
+        e.bytes = b.meta.value("bytes", std::size_t(0));
+        e.width = b.meta.value("width", 0);
+        e.height = b.meta.value("height", 0);
+        environments[b.id] = std::move(e);
     }
     for (const Store::SceneRecord& r : store->listScenes(warnings)) {
         auto prepared = prepare(r.doc);

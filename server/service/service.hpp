@@ -279,6 +279,22 @@ public:
     /// no placement names is dropped when a document is prepared, so it never holds a pattern).
     Status deletePattern(const std::string& id);
 
+    // --- environments (image-based light of pbr and skin frames: `render.environment`)
+    /// {"environments": [{"id", "name", "builtin"[, "width", "height", "bytes"]}]}: the built-in
+    /// studio ("builtin:studio") first, then every upload.
+    nlohmann::json listEnvironments() const;
+    /// Stores a Radiance .hdr or OpenEXR image of linear radiance (equirectangular, core/
+    /// environment.hpp), content-addressed: "e_" + 16 hex digits of the SHA-256 of the bytes; the
+    /// same bytes again answer the stored one with `*existing` set. Decoded once to check it
+    /// (and kept as the one decoded environment in memory). Fails: past maxUploadBytes
+    /// (TooLarge, "body"); neither format by its signature, or not decodable (Parse, "body");
+    /// a side over maxImageSide (TooLarge); negative or non-finite radiance (InvalidArgument);
+    /// no image module (Unavailable).
+    Result<nlohmann::json> addEnvironment(const std::vector<std::uint8_t>& bytes, const std::string& name,
+                                          bool* existing = nullptr);
+    /// Fails: NotFound for an unknown id; Conflict for the built-in or one a scene names.
+    Status deleteEnvironment(const std::string& id);
+
     // --- scenes (every answer is {"id", "revision", "scene"})
     // Every edit makes revision n+1 and keeps it (history), durably, with `ctx.client` and an op
     // such as "patch placement elbow_l"; events carry {type, scene, revision, client, op,

@@ -110,6 +110,14 @@ Result<Image8> Service::State::renderImage(const Snapshot& snap, const FramePara
     if (!outlines) return outlines.error();
     FrameRequest request = frameRequest(*plan, snap.model);
     request.outlines = std::move(*outlines);
+    // The scene's environment, where the frame's light is image-based (legacy frames never
+    // decode it).
+    if (request.render.shading != Shading::Legacy || request.view == FrameView::Lighting ||
+        request.view == FrameView::BaseColor) {
+        auto env = environmentImage(request.render.environment);
+        if (!env) return env.error();
+        request.environment = std::move(*env);
+    }
     auto result = renderer->renderFrame(request);
     if (!result) return result.error();
     if (camera)

@@ -28,7 +28,7 @@ Result<Store> Store::open(const std::string& dataDir) {
     std::error_code ec;
     s.dir_ = fs::absolute(dataDir, ec).lexically_normal().string();
     if (ec) s.dir_ = dataDir;
-    for (const char* sub : {"models", "patterns", "scenes"}) {
+    for (const char* sub : {"models", "patterns", "scenes", "environments"}) {
         fs::create_directories(fs::path(s.dir_) / sub, ec);
         if (ec)
             return makeError(ErrorCode::Io, "dermis::Store::open", s.dir_,
@@ -37,8 +37,8 @@ Result<Store> Store::open(const std::string& dataDir) {
     // Leftover temporary files and folders of an interrupted write are garbage: the rename
     // never happened. One rule for every writer: the name holds kTempMarker (atomic_file.hpp).
     std::vector<fs::path> leftovers;
-    for (const fs::path& folder : {fs::path(s.dir_), fs::path(s.dir_) / "models",
-                                   fs::path(s.dir_) / "patterns", fs::path(s.dir_) / "scenes"})
+    for (const fs::path& folder : {fs::path(s.dir_), fs::path(s.dir_) / "models", fs::path(s.dir_) / "patterns",
+                                   fs::path(s.dir_) / "scenes", fs::path(s.dir_) / "environments"})
         for (const auto& e : fs::directory_iterator(folder, ec))
             if (isTempName(e.path().filename().string())) leftovers.push_back(e.path());
     for (const fs::path& p : leftovers)

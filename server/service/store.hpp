@@ -9,6 +9,7 @@
 // Layout under the data directory:
 //   models/<id>.glb      + models/<id>.json    (metadata, written last: the commit record)
 //   patterns/<id>.<ext>  + patterns/<id>.json
+//   environments/<id>.<hdr|exr> + environments/<id>.json
 //   scenes/<id>.json     ({"id", "revision", "scene"}: the current revision)
 //   scenes/<id>.history/ (index.jsonl: one line per revision; c<B>.jsonl: chunks of up to
 //                         kChunkRevisions revisions from B on, a snapshot then patches

@@ -263,6 +263,18 @@ try {
   await api("DELETE", "/patterns/{id}", { params: { id: "crease" }, expect: 409 });
   await api("DELETE", "/patterns/{id}", { params: { id: pattern.id }, expect: 404 });
 
+  // environments: a 16 × 8 Radiance sky of radiance (1, 0.5, 0.25) (RGBE 128, 64, 32, exponent 129)
+  const sky = Buffer.concat([Buffer.from("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n"),
+    Buffer.from(Array.from({ length: 16 * 8 }, () => [128, 64, 32, 129]).flat())]);
+  const env = (await api("POST", "/environments", { query: "name=sky", body: { raw: sky, type: "image/vnd.radiance" }, expect: 201 })).json();
+  assert.equal((await api("POST", "/environments", { body: { raw: sky, type: "application/octet-stream" }, expect: 200 })).json().id, env.id);
+  await api("POST", "/environments", { body: { raw: png, type: "image/png" }, expect: 415 });
+  const envs = (await api("GET", "/environments", { expect: 200 })).json().environments;
+  assert.deepEqual(envs.map((e) => e.id), ["builtin:studio", env.id]);
+  await api("DELETE", "/environments/{id}", { params: { id: "builtin:studio" }, expect: 409 });
+  await api("DELETE", "/environments/{id}", { params: { id: env.id }, expect: 204 });
+  await api("DELETE", "/environments/{id}", { params: { id: env.id }, expect: 404 });
+
   // scenes: the default set (for inspection) and a small document (edits, renders, events)
   const created = await api("POST", "/scenes", { body: { default_patterns: true }, expect: 201 });
   const createdBody = created.json();

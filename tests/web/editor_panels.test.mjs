@@ -109,6 +109,21 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       assert.notEqual(await settledFrameHash(page), hash0);
       await page.selectOption("#viewMode", "shaded");
     }],
+    ["view modes: skin shading for this view, the scene untouched", async () => {
+      const hash0 = await settledFrameHash(page);
+      const rev0 = (await state(page)).revision;
+      await page.selectOption("#viewMode", "skin");
+      await until(() => page.$eval("#frame", (i) => /shading=skin/.test(i.dataset.url || "") && !/view=/.test(i.dataset.url || "")), "a skin-shaded frame");
+      const skinHash = await settledFrameHash(page);
+      assert.notEqual(skinHash, hash0, "skin shading draws another picture");
+      await page.selectOption("#viewMode", "pbr");
+      await until(() => page.$eval("#frame", (i) => /shading=pbr/.test(i.dataset.url || "")), "a pbr frame");
+      assert.notEqual(await settledFrameHash(page), skinHash, "pbr is not skin");
+      await screenshot(page, "editor-pbr-view.png");
+      await page.selectOption("#viewMode", "shaded");
+      await until(() => page.$eval("#frame", (i) => !/shading=/.test(i.dataset.url || "")), "the scene's own shading again");
+      assert.equal((await state(page)).revision, rev0, "a view mode is no edit");
+    }],
     ["the place tool adds a placement at the clicked skin with the suggested driver (Place as: in the texture)", async () => {
       await settle();
       const n0 = (await doc()).placements.length;
@@ -118,7 +133,8 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       const side = Math.min(box[2], box[3]);
       const at = [box[0] + (box[2] - side) / 2 + side * 0.5, box[1] + (box[3] - side) / 2 + side * 0.42]; // the torso
       await page.mouse.click(at[0], at[1]);
-      const d = await until(async () => { const x = await doc(); return x.placements.length === n0 + 1 && x; }, "a new placement");
+      // (A pick and an add on a sanitizer build of a busy machine took over 10 s once.)
+      const d = await until(async () => { const x = await doc(); return x.placements.length === n0 + 1 && x; }, "a new placement", 30000);
       const added = d.placements[d.placements.length - 1];
       const pick = await page.evaluate(([x, y]) => window.dermisEditor.pickAt(x, y), [Math.floor(512 * 0.5), Math.floor(512 * 0.42)]);
       assert.ok(pick.hit);

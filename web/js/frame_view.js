@@ -7,9 +7,10 @@
 // placement at the hit's UV. The selection is outlined on the skin (frame `highlight`), the hovered
 // placement too (`hover`), and the place tool's brush (`surface_brush`: a circle on the body, or
 // `brush`: a UV footprint) — with the tool off, `surface_brush` outlines the Propose… panel's
-// current proposal instead (its ghost). View modes shaded / bump / displacement / normal; compare
-// with a split slider, flicker, or the diff heat map against "patterns off" or a chosen revision
-// (compare images carry no outlines). The bar's Turntable button shows the selection's range of
+// current proposal instead (its ghost). View modes shaded (the scene's shading), pbr / skin (that
+// shading for this view) and bump / displacement / normal; compare with a split slider, flicker,
+// or the diff heat map against "patterns off" or a chosen revision (compare images carry no
+// outlines). The bar's Turntable button shows the selection's range of
 // motion as an animated WebP (GET turntable).
 //
 // While a drag runs in the texture view, frames preview the dragged placement (the frame route's
@@ -215,13 +216,24 @@ class FrameLoader {
 
 let mainLoader, cmpLoader;
 
+/// The frame parameters of the view mode: "shaded" is the scene's own shading (none), "pbr" and
+/// "skin" a shading for this view (`shading=`), the others an unlit view of the maps (`view=`).
+function viewParams() {
+  if (store.view === "shaded") return {};
+  if (store.view === "pbr" || store.view === "skin") return { shading: store.view };
+  return { view: store.view };
+}
+
 export function initFrameView(section, theApi) {
   api = theApi;
   section.innerHTML = `
     <div class="viewbar">
       <span class="title">3D</span>
       <label><span class="lbl">View</span> <select id="viewMode" aria-label="view mode" title="View mode">
-        <option value="shaded">shaded</option><option value="bump">bump</option>
+        <option value="shaded" title="the scene's own shading">shaded</option>
+        <option value="pbr" title="the character's glTF material under image-based light">pbr</option>
+        <option value="skin" title="pbr with light scattered under the skin: how a wrinkle reads on skin">skin</option>
+        <option value="bump">bump</option>
         <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
       <label><span class="lbl keep">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame: split, flicker, or a diff heat map">
         <option value="off">off</option><option value="split">split</option>
@@ -404,7 +416,7 @@ export function frameParams(outlines = true) {
     yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined,
     target: c.target ? c.target.join(",") : undefined,
     time: shownTime(),
-    view: store.view === "shaded" ? undefined : store.view,
+    ...viewParams(),
     only: store.solo.length ? store.solo.join(",") : undefined,
     revision: store.pinnedRevision ?? store.revision,
     preview: previewSource() ? JSON.stringify(previewSource()) : undefined,
@@ -548,7 +560,7 @@ export function openTurntable() {
   const c = store.camera;
   const url = turntableUrl(store.sceneId, { placement: pid, frames: 36, size: 320,
     yaw: c.yaw, pitch: c.pitch, distance: c.distance ?? undefined, target: c.target ? c.target.join(",") : undefined,
-    time: shownTime(), revision: store.pinnedRevision ?? undefined, view: store.view === "shaded" ? undefined : store.view });
+    time: shownTime(), revision: store.pinnedRevision ?? undefined, ...viewParams() });
   let dlg = document.getElementById("turntableDialog");
   if (!dlg) {
     dlg = document.createElement("dialog");

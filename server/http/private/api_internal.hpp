@@ -144,6 +144,7 @@ void installSystemRoutes(RouteTable& table);
 void installSessionRoutes(RouteTable& table);
 void installModelRoutes(RouteTable& table);
 void installPatternRoutes(RouteTable& table);
+void installEnvironmentRoutes(RouteTable& table);
 void installSceneRoutes(RouteTable& table);
 void installRenderRoutes(RouteTable& table);
 void installInspectRoutes(RouteTable& table);

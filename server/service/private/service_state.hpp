@@ -14,6 +14,7 @@
 #include "service/decode_budget.hpp"
 #include "service/service.hpp"
 
+#include "core/environment.hpp"
 #include "core/frame_plan.hpp"
 #include "core/model_derived.hpp"
 #include "io/gltf_loader.hpp"
@@ -57,6 +58,16 @@ struct PatternEntry {
     std::size_t bytes = 0;
     const PatternInfo* info = nullptr; ///< manifest entry of a built-in pattern
     std::string sha256; ///< hex SHA-256 of an uploaded pattern's bytes ("" for built-ins)
+};
+
+/// An uploaded environment (service_environments.cpp): the file is decoded when a frame needs
+/// it (State::environmentImage), not kept decoded per entry.
+struct EnvironmentEntry {
+    std::string id, name;
+    std::string file; ///< absolute path of the stored .hdr / .exr
+    bool builtin = false;
+    std::size_t bytes = 0;
+    int width = 0, height = 0;
 };
 
 /// Content a batch names by address ("sha256:<hex>", SPEC §7), resolved for one request: from
@@ -229,6 +240,17 @@ struct Service::State {
     mutable std::shared_mutex mutex;
     std::map<std::string, detail::ModelEntry> models;
     std::map<std::string, detail::PatternEntry> patterns;
+    std::map<std::string, detail::EnvironmentEntry> environments; ///< uploads, by id
+    /// The one environment kept decoded (id, image): the last a frame or an upload used. An
+    /// equirectangular float image is large (a 4096 × 2048 one is 100 MB), and an editor session
+    /// frames one environment at a time; the renderer keeps its prefiltered light while this
+    /// image lives (RendererOptions: the custom light is kept while its owner lives).
+    mutable std::mutex environmentCacheMutex;
+    mutable std::pair<std::string, std::shared_ptr<const EnvironmentImage>> environmentCache;
+    /// The image `render.environment` names: null for the studio (empty or builtin:studio),
+    /// the cached or freshly decoded upload otherwise. Takes `mutex` shared, then the cache's.
+    /// Fails: NotFound ("/render/environment") for an unknown id; the decoder's error.
+    Result<std::shared_ptr<const EnvironmentImage>> environmentImage(const std::string& id) const;
     PatternImages images; ///< by pattern id, built-in and uploaded
     std::map<std::string, detail::SceneEntry> scenes;
 

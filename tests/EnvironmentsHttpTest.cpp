@@ -1,0 +1,163 @@
+// EnvironmentsHttpTest — the /api/v1/environments routes and `render.environment` end to end on
+// one server (HttpTestFixture.hpp: a real dermis::Service + dermis::Api on 127.0.0.1, a GL
+// context on $DERMIS_TEST_GL). It checks:
+//   * the list starts with the built-in studio;
+//   * a Radiance .hdr upload (content-addressed: 201, then 200 with the same id) lights a pbr
+//     frame of a scene that names it (a red sky turns the character red), 409 while a scene
+//     names it, 204 once none does; a scene naming an unknown one is refused naming the field;
+//   * uploads that are no environment: 415 (not .hdr/.exr, a broken .hdr, a wrong Content-Type),
+//     413 (a side over the image limit), nothing left in the store;
+//   * uploads survive a restart of the service.
+#include "BuildPaths.hpp"
+#include "HttpTestFixture.hpp"
+
+#include <filesystem>
+
+using namespace dermis;
+using namespace dermis::test;
+using namespace dermis::test::http;
+
+namespace {
+
+class EnvironmentsHttpTest : public SharedServerTest {};
+
+std::vector<std::uint8_t> bytesOfText(const std::string& s) { return {s.begin(), s.end()}; }
+
+/// A sky of one radiance everywhere.
+std::vector<std::uint8_t> uniformSky(float r, float g, float b) {
+    const float c[3] = {r, g, b};
+    return bytesOfText(radianceHdr(64, 32, c, c));
+}
+
+/// Σ red / Σ green over the frame's pixels that are not the background (its top-left pixel).
+double redness(const Image8& img) {
+    double r = 0.0, g = 0.0;
+    for (std::size_t p = 0; p + 3 < img.rgba.size(); p += 4) {
+        if (img.rgba[p] == img.rgba[0] && img.rgba[p + 1] == img.rgba[1] && img.rgba[p + 2] == img.rgba[2]) continue;
+        r += img.rgba[p];
+        g += img.rgba[p + 1];
+    }
+    return r / std::max(g, 1.0);
+}
+
+std::size_t filesIn(const std::string& folder) {
+    std::error_code ec;
+    std::size_t n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(folder, ec)) {
+        (void)e;
+        ++n;
+    }
+    return n;
+}
+
+} // namespace
+
+TEST_F(EnvironmentsHttpTest, TheListStartsWithTheStudio) {
+    Reply list = http().get("/environments");
+    ASSERT_EQ(list.status, 200) << list;
+    const json all = list.js();
+    ASSERT_FALSE(all["environments"].empty());
+    EXPECT_EQ(all["environments"][0]["id"], "builtin:studio");
+    EXPECT_EQ(all["environments"][0]["builtin"], true);
+    expectError(http().del("/environments/builtin:studio"), 409, "id");
+    expectError(http().del("/environments/e_0000000000000000"), 404, "id");
+}
+
+TEST_F(EnvironmentsHttpTest, AnUploadedSkyLightsTheScenesThatNameIt) {
+    Http h = http();
+    const std::vector<std::uint8_t> red = uniformSky(1.5f, 0.0f, 0.0f);
+    Reply up = h.upload("/environments?name=red%20sky", red, "image/vnd.radiance");
+    ASSERT_EQ(up.status, 201) << up;
+    const std::string eid = up.js()["id"];
+    EXPECT_EQ(eid.rfind("e_", 0), 0u) << eid;
+    EXPECT_EQ(up.js()["name"], "red sky");
+    EXPECT_EQ(up.js()["width"], 64);
+    EXPECT_EQ(up.js()["height"], 32);
+    Reply again = h.upload("/environments", red, "application/octet-stream");
+    EXPECT_EQ(again.status, 200) << again;
+    EXPECT_EQ(again.js()["id"], eid);
+    bool listed = false;
+    for (const json all = h.get("/environments").js(); const json& e : all["environments"])
+        listed = listed || e["id"] == eid;
+    EXPECT_TRUE(listed);
+
+    // The same pbr scene under the studio and under the red sky.
+    json doc = smallScene();
+    doc["render"]["shading"] = "pbr";
+    const std::string studio = createScene(doc);
+    doc["render"]["environment"] = eid;
+    const std::string lit = createScene(doc);
+    ASSERT_FALSE(studio.empty() || lit.empty());
+    EXPECT_EQ(h.get("/scenes/" + lit).js()["scene"]["render"]["environment"], eid);
+    auto frame = [&](const std::string& sid, const std::string& query = "") {
+        Reply r = h.get("/scenes/" + sid + "/frame" + query);
+        EXPECT_EQ(r.status, 200) << r;
+        auto img = decodeFrame(r.bytes());
+        return img ? *img : Image8{};
+    };
+    const Image8 studioFrame = frame(studio), redFrame = frame(lit);
+    EXPECT_GT(redness(redFrame), 1.5 * redness(studioFrame))
+        << "red sky " << redness(redFrame) << ", studio " << redness(studioFrame);
+    // Legacy frames of that scene do not use it (one key light): the studio scene's legacy frame.
+    EXPECT_EQ(frame(lit, "?shading=legacy").rgba, frame(studio, "?shading=legacy").rgba);
+
+    // In use: 409 naming the id; once no scene names it, gone.
+    expectError(h.del("/environments/" + eid), 409, "id");
+    ASSERT_EQ(h.del("/scenes/" + lit).status, 204);
+    EXPECT_EQ(h.del("/environments/" + eid).status, 204);
+    for (const json all = h.get("/environments").js(); const json& e : all["environments"])
+        EXPECT_NE(e["id"], eid);
+    expectError(h.post("/scenes", doc), 404, "/render/environment");
+}
+
+TEST_F(EnvironmentsHttpTest, ScenesNameOnlyEnvironmentsThatExist) {
+    Http h = http();
+    json doc = smallScene();
+    doc["render"]["environment"] = "e_0123456789abcdef";
+    expectError(h.post("/scenes", doc), 404, "/render/environment");
+    doc["render"]["environment"] = "builtin:sunset";
+    expectError(h.post("/scenes", doc), 422, "/render/environment");
+    doc["render"]["environment"] = "builtin:studio";
+    EXPECT_FALSE(createScene(doc).empty());
+}
+
+TEST_F(EnvironmentsHttpTest, UploadsThatAreNoEnvironmentAreRefused) {
+    Http h = http();
+    const std::string folder = server_->dataDir() + "/environments";
+    const std::size_t before = filesIn(folder);
+    expectError(h.upload("/environments", bytesOfText("hello"), "image/vnd.radiance"), 415, "body");
+    expectError(h.upload("/environments", domePng(), "image/png"), 415, "body"); // a PNG is no radiance
+    expectError(h.upload("/environments", uniformSky(1, 1, 1), "text/plain"), 415, "body");
+    // A Radiance header over truncated data.
+    expectError(h.upload("/environments", bytesOfText("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32 +X 64\n\x01\x02"),
+                         "image/vnd.radiance"),
+                415, "body");
+    // A side over the server's image limit (4096).
+    const float c[3] = {1, 1, 1};
+    Reply wide = h.upload("/environments", bytesOfText(radianceHdr(5000, 2, c, c)), "image/vnd.radiance");
+    EXPECT_EQ(wide.status, 413) << wide;
+    EXPECT_EQ(filesIn(folder), before) << "nothing of a refused upload stays in the store";
+}
+
+TEST(EnvironmentsServiceTest, UploadsSurviveARestart) {
+    TempDir dir;
+    std::string id;
+    {
+        auto svc = Service::open(dir.str(), testBackend(), mainLimits());
+        ASSERT_TRUE(svc) << svc.error().message;
+        auto up = (*svc)->addEnvironment(uniformSky(0.5f, 0.6f, 0.7f), "dusk");
+        ASSERT_TRUE(up) << up.error().message;
+        id = (*up)["id"];
+    }
+    auto svc = Service::open(dir.str(), testBackend(), mainLimits());
+    ASSERT_TRUE(svc) << svc.error().message;
+    const json list = (*svc)->listEnvironments();
+    ASSERT_EQ(list["environments"].size(), 2u) << list.dump();
+    EXPECT_EQ(list["environments"][1]["id"], id);
+    EXPECT_EQ(list["environments"][1]["name"], "dusk");
+    EXPECT_EQ(list["environments"][1]["width"], 64);
+    // And a scene may name it.
+    json doc = smallScene();
+    doc["render"]["environment"] = id;
+    EXPECT_TRUE((*svc)->createScene(doc, {})) << "a scene names the restored environment";
+}
