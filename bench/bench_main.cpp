@@ -11,7 +11,8 @@
 //    with the first 15 placements of models/default.scene.json and 1024² maps, the pose moving
 //    along the squat clip: height pass, skin pass, post-process AA, readback, PNG encode and
 //    total, at 512² and 1024², anti-aliasing off, post (render.aa "post") and MSAA 4x, legacy and
-//    pbr shading (render.shading; pbr with GPU maps only), with GPU
+//    pbr and skin shading (render.shading; GPU maps only; at 1024² without AA also with the
+//    key light, render.key_light, unshadowed and shadowed: "key_light"), with GPU
 //    height maps and with CPU height maps (the paper's "CPU" configuration). Stages are
 //    separated by glFinish. "aa_quality": SSIM of one 1024² frame per mode against MSAA 4x and
 //    against a supersampled frame (2048² MSAA 4x, 2×2 blocks averaged).
@@ -39,6 +40,7 @@
 #include <cstring>
 #include <iostream>
 #include <random>
+#include <string_view>
 #include <thread>
 
 using namespace dermis;
@@ -91,9 +93,18 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
     for (bool cpuMaps : {false, true})
         for (const Shading shading : {Shading::Legacy, Shading::Pbr, Shading::Skin})
         for (int size : {512, 1024})
-            for (const AntiAliasing aa : {AntiAliasing::None, AntiAliasing::Post, AntiAliasing::Msaa}) {
-                // The pbr and skin shadings' cost is measured with GPU maps only.
+            for (const AntiAliasing aa : {AntiAliasing::None, AntiAliasing::Post, AntiAliasing::Msaa})
+            for (const char* key : {"none", "unshadowed", "shadowed"}) {
+                // The pbr and skin shadings' cost is measured with GPU maps only; the key light's
+                // (render.key_light, with and without its shadow map) at 1024² without AA.
                 if (cpuMaps && shading != Shading::Legacy) continue;
+                const bool keyLight = std::string_view(key) != "none";
+                if (keyLight && (shading == Shading::Legacy || size != 1024 || aa != AntiAliasing::None)) continue;
+                scene.render.keyLight.reset();
+                if (keyLight) {
+                    scene.render.keyLight = KeyLight{};
+                    scene.render.keyLight->shadow = std::string_view(key) == "shadowed";
+                }
                 // Off, the post-process edge pass (render.aa "post"), MSAA 4x.
                 const int msaa = aa == AntiAliasing::Msaa ? 4 : 1;
                 scene.render.shading = shading;
@@ -151,6 +162,7 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                 cases.push_back({{"name", "frame"},
                                  {"heightmaps", cpuMaps ? "cpu" : "gpu"},
                                  {"shading", toString(shading)},
+                                 {"key_light", key},
                                  {"frame_size", size},
                                  {"map_size", 1024},
                                  {"aa", toString(aa)},

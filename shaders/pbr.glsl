@@ -194,3 +194,87 @@ vec3 shadeSkin(vec3 baseColor, float metallic, float roughness, float occlusion,
     return (diffuse + specular) * occlusion;
 }
 #endif
+
+#ifdef DERMIS_KEY_LIGHT
+// The directional key light (`render.key_light`, core/render_settings.hpp KeyLight), added to the
+// image-based light: the glTF-Sample-Viewer's punctual-light BRDF (Lambert diffuse, GGX with the
+// height-correlated Smith visibility, Schlick's Fresnel), receiving colour × intensity ×
+// max(n·l, 0), times the shadow map's visibility. Under DERMIS_SKIN the diffuse part wraps past
+// the terminator per channel (Green 2004, "Real-Time Approximations to Subsurface Scattering":
+// max((n_c·l + w)/(1 + w), 0) with w = the channel's scattering width and n_c its softened
+// normal), and the specular has skin's second lobe. The material's occlusion map, which is
+// light from the environment, does not apply.
+layout(std140, binding = 5) uniform KeyLightBlock {
+    mat4 u_shadowViewProj; // world → the shadow map's clip space (core/key_light.hpp)
+    vec4 u_keyDirection;   // unit, towards the light (world); w 1 with a shadow map, else 0
+    vec4 u_keyRadiance;    // colour × intensity (linear), 0
+    vec4 u_shadowParams;   // normal offset (world units), depth bias (map depth units), 1 / map size, 0
+};
+layout(binding = 9) uniform sampler2DShadow u_shadowMap; // compare mode, border 1 (lit)
+
+// Visibility of the key light at `position` (world) on a surface of geometric normal `ng` (unit,
+// facing the camera): 1 lit, 0 in shadow. The lookup moves off the surface along the normal by
+// up to one offset, more where the light grazes it, and compares with a small bias; four
+// bilinear comparisons (a 3×3-texel tent) soften the edge.
+float keyLightVisibility(vec3 position, vec3 ng) {
+    if (u_keyDirection.w == 0.0) return 1.0;
+    float NdotL = dot(ng, u_keyDirection.xyz);
+    vec3 p = position + ng * (u_shadowParams.x * (1.5 - clamp(NdotL, 0.0, 1.0)));
+    vec3 s = (u_shadowViewProj * vec4(p, 1.0)).xyz * 0.5 + 0.5;
+    if (s.z >= 1.0) return 1.0;
+    float ref = s.z - u_shadowParams.y;
+    float d = 0.75 * u_shadowParams.z;
+    return 0.25 * (texture(u_shadowMap, vec3(s.xy + vec2(-d, -d), ref)) +
+                   texture(u_shadowMap, vec3(s.xy + vec2(d, -d), ref)) +
+                   texture(u_shadowMap, vec3(s.xy + vec2(-d, d), ref)) +
+                   texture(u_shadowMap, vec3(s.xy + vec2(d, d), ref)));
+}
+
+float distributionGgx(float NdotH, float alpha) {
+    float a2 = alpha * alpha;
+    float f = NdotH * NdotH * (a2 - 1.0) + 1.0;
+    return a2 / (kPi * f * f);
+}
+
+float visibilitySmithGgxCorrelated(float NdotL, float NdotV, float alpha) {
+    float a2 = alpha * alpha;
+    float ggxV = NdotL * sqrt(NdotV * NdotV * (1.0 - a2) + a2);
+    float ggxL = NdotV * sqrt(NdotL * NdotL * (1.0 - a2) + a2);
+    float s = ggxV + ggxL;
+    return s > 0.0 ? 0.5 / s : 0.0;
+}
+
+// Outgoing radiance from the key light (linear, before exposure): `n` the shading normal,
+// `nSmooth` the unbumped one (skin), `v` towards the camera, `ng` the geometric normal facing the
+// camera, `position` world.
+vec3 keyLight(vec3 baseColor, float metallic, float roughness, vec3 n, vec3 nSmooth, vec3 v, vec3 ng,
+              vec3 position) {
+    vec3 l = u_keyDirection.xyz;
+    vec3 f0 = mix(vec3(0.04), baseColor, metallic);
+    vec3 diffuseColor = baseColor * (1.0 - metallic);
+    vec3 h = normalize(l + v);
+    float VdotH = clamp(dot(v, h), 0.0, 1.0);
+    vec3 F = f0 + (1.0 - f0) * pow(1.0 - VdotH, 5.0);
+    float NdotL = clamp(dot(n, l), 0.0, 1.0);
+    float NdotV = clamp(dot(n, v), 1e-4, 1.0);
+    float NdotH = clamp(dot(n, h), 0.0, 1.0);
+    float alpha = roughness * roughness;
+    vec3 specular = F * (visibilitySmithGgxCorrelated(NdotL, NdotV, alpha) * distributionGgx(NdotH, alpha));
+#ifdef DERMIS_SKIN
+    float alpha2 = max(roughness * DERMIS_SKIN_LOBE_ROUGHNESS, 0.03);
+    alpha2 *= alpha2;
+    const float w = DERMIS_SKIN_LOBE_WEIGHT;
+    specular = (1.0 - w) * specular +
+               w * F * (visibilitySmithGgxCorrelated(NdotL, NdotV, alpha2) * distributionGgx(NdotH, alpha2));
+    const vec3 wrap = DERMIS_SKIN_SCATTER;
+    const vec3 blend = DERMIS_SKIN_NORMAL_BLEND;
+    vec3 wrapped = vec3(dot(normalize(mix(n, nSmooth, blend.r)), l), dot(normalize(mix(n, nSmooth, blend.g)), l),
+                        dot(normalize(mix(n, nSmooth, blend.b)), l));
+    wrapped = max((wrapped + wrap) / (1.0 + wrap), vec3(0.0));
+    vec3 diffuse = (1.0 - F) * diffuseColor / kPi * wrapped;
+#else
+    vec3 diffuse = (1.0 - F) * diffuseColor / kPi * NdotL;
+#endif
+    return (diffuse + specular * NdotL) * u_keyRadiance.rgb * keyLightVisibility(position, ng);
+}
+#endif

@@ -4,7 +4,8 @@
 // Blinn-Phong key light and a hemisphere fill; DERMIS_PBR, `render.shading` "pbr", glTF
 // metallic-roughness under image-based light (pbr.glsl), exposure and tone mapping; or
 // DERMIS_PBR with DERMIS_SKIN, "skin", that with subsurface scattering and a second specular lobe
-// (pbr.glsl shadeSkin). Writes linear colour; the sRGB render target encodes it.
+// (pbr.glsl shadeSkin); either of the last two with DERMIS_KEY_LIGHT adds the directional key
+// light and its shadow (pbr.glsl keyLight). Writes linear colour; the sRGB render target encodes it.
 //
 // Views (DERMIS_VIEW, FrameView in server/core/render_settings.hpp; one program per view, so that a
 // software rasterizer, which runs every branch for every pixel, shades only its view's code):
@@ -187,6 +188,9 @@ void main() {
         color = shadeSkin(base.rgb, metallic, roughness, occlusion, nn, ng, toCamera);
 #else
         color = shadePbr(base.rgb, metallic, roughness, occlusion, nn, toCamera);
+#endif
+#ifdef DERMIS_KEY_LIGHT
+        color += keyLight(base.rgb, metallic, roughness, nn, ng, toCamera, ng, v_position);
 #endif
         vec3 emissive = u_emissive.rgb;
         if (hasMap(16)) emissive *= texture(u_emissiveTexture, materialUv(4, v_uv, v_uv1)).rgb;

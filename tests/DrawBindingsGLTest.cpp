@@ -10,7 +10,8 @@
 //     placement), then flat maps after a bake without placements;
 //   * a frame of a many-part model (Barbarian), then of a one-part model (CesiumMan), then a
 //     height pass, then transform-feedback skinning;
-//   * pbr frames and tessellated displacement after both;
+//   * pbr frames and tessellated displacement after both; the key light's shadow pass on the
+//     many-part model, then a frame of the one-part model;
 //   * the images of the checked renderer equal those of an unchecked one (the check only reads).
 #include "BuildPaths.hpp"
 #include "GlTestBackend.hpp"
@@ -136,6 +137,16 @@ TEST(DrawBindingsGLTest, AManyPartModelThenAOnePartModelThenAHeightPass) {
     EXPECT_TRUE(skinned) << "transform feedback after Barbarian: "
                          << (skinned ? "" : skinned.error().message);
     frame(*gl, request(barbarian, std::nullopt), "Barbarian after transform feedback");
+    // The key light's shadow pass (its own FrameBlock buffer, the part blocks by range) on the
+    // many-part model, then a frame of the one-part model under it.
+    FrameRequest lit = request(barbarian, std::nullopt);
+    lit.render.shading = Shading::Skin;
+    lit.render.keyLight = KeyLight{};
+    frame(*gl, lit, "Barbarian, skin with a shadowed key light");
+    lit = request(cesium, heights(*pattern, 2));
+    lit.render.shading = Shading::Pbr;
+    lit.render.keyLight = KeyLight{};
+    frame(*gl, lit, "CesiumMan, pbr with a shadowed key light after the Barbarian");
 }
 
 TEST(DrawBindingsGLTest, TheCheckOnlyReads) {

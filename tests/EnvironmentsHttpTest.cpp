@@ -7,7 +7,8 @@
 //     names it, 204 once none does; a scene naming an unknown one is refused naming the field;
 //   * uploads that are no environment: 415 (not .hdr/.exr, a broken .hdr, a wrong Content-Type),
 //     413 (a side over the image limit), nothing left in the store;
-//   * uploads survive a restart of the service.
+//   * uploads survive a restart of the service;
+//   * a scene's `render.key_light` lights its frames, and a PUT with it null removes it.
 #include "BuildPaths.hpp"
 #include "HttpTestFixture.hpp"
 
@@ -108,6 +109,49 @@ TEST_F(EnvironmentsHttpTest, AnUploadedSkyLightsTheScenesThatNameIt) {
     for (const json all = h.get("/environments").js(); const json& e : all["environments"])
         EXPECT_NE(e["id"], eid);
     expectError(h.post("/scenes", doc), 404, "/render/environment");
+}
+
+TEST_F(EnvironmentsHttpTest, ASceneKeyLightLightsItsFramesAndAPutRemovesIt) {
+    // render.key_light over HTTP: a blue key light from the right turns a pbr frame of the
+    // scene's character blue against the same scene without it, a bad light is refused naming its
+    // field, and a PUT with `"key_light": null` gives back the plain frame.
+    Http h = http();
+    json doc = smallScene();
+    doc["render"]["shading"] = "pbr";
+    const std::string plain = createScene(doc);
+    doc["render"]["key_light"] = {{"direction", {1, 0.5, 0.5}}, {"intensity", 6}, {"color", {0, 0, 1}}};
+    const std::string lit = createScene(doc);
+    ASSERT_FALSE(plain.empty() || lit.empty());
+    EXPECT_EQ(h.get("/scenes/" + lit).js()["scene"]["render"]["key_light"]["shadow"], true);
+    auto frame = [&](const std::string& sid) {
+        Reply r = h.get("/scenes/" + sid + "/frame");
+        EXPECT_EQ(r.status, 200) << r;
+        auto img = decodeFrame(r.bytes());
+        return img ? *img : Image8{};
+    };
+    const Image8 plainFrame = frame(plain), litFrame = frame(lit);
+    // Σ blue / Σ red over the character (skin is red-heavy; tone mapping's desaturation of what
+    // the light brightens raises blue too).
+    auto blueness = [](const Image8& img) {
+        double r = 0.0, b = 0.0;
+        for (std::size_t p = 0; p + 3 < img.rgba.size(); p += 4) {
+            if (img.rgba[p] == img.rgba[0] && img.rgba[p + 1] == img.rgba[1] && img.rgba[p + 2] == img.rgba[2]) continue;
+            r += img.rgba[p];
+            b += img.rgba[p + 2];
+        }
+        return b / std::max(r, 1.0);
+    };
+    EXPECT_GT(blueness(litFrame), 1.2 * blueness(plainFrame))
+        << "key light " << blueness(litFrame) << ", none " << blueness(plainFrame);
+    json bad = doc;
+    bad["render"]["key_light"]["intensity"] = -1;
+    expectError(h.post("/scenes", bad), 422, "/render/key_light/intensity");
+    json off = h.get("/scenes/" + lit).js()["scene"];
+    off["render"]["key_light"] = nullptr;
+    Reply put = h.put("/scenes/" + lit, off);
+    ASSERT_EQ(put.status, 200) << put;
+    EXPECT_FALSE(h.get("/scenes/" + lit).js()["scene"]["render"].contains("key_light"));
+    EXPECT_EQ(frame(lit).rgba, plainFrame.rgba);
 }
 
 TEST_F(EnvironmentsHttpTest, ScenesNameOnlyEnvironmentsThatExist) {

@@ -1,6 +1,7 @@
 // Scene documents (`dermis.scene/1`, SPEC §2b): parsing, defaults, serialisation round trips,
 // and one test per kind of bad input, each checking the exact JSON pointer that the error names.
 // Pure: no files, no GL. (The pattern manifest: PatternManifestTest.)
+#include "core/key_light.hpp"
 #include "core/scene.hpp"
 #include "BuildPaths.hpp"
 
@@ -377,6 +378,58 @@ TEST(SceneTest, EnvironmentIsWrittenOnlyWhenNamed) {
     expectStableRoundTrip(doc(R"("render":{"environment":"builtin:studio"})"));
 }
 
+TEST(SceneTest, KeyLightIsWrittenOnlyWhenSetAndRoundTrips) {
+    const Scene plain = parseOk(doc(""));
+    EXPECT_FALSE(plain.render.keyLight);
+    EXPECT_FALSE(dermis::toJson(plain)["render"].contains("key_light")) << "older documents keep their text";
+    // An empty object is the default light, members fill in over it.
+    const Scene defaults = parseOk(doc(R"("render":{"key_light":{}})"));
+    ASSERT_TRUE(defaults.render.keyLight);
+    EXPECT_EQ(*defaults.render.keyLight, dermis::KeyLight{});
+    const Scene set = parseOk(doc(R"("render":{"key_light":{"direction":[1,2,3],"intensity":7.5,"color":[1,0.5,0.25],"shadow":false}})"));
+    ASSERT_TRUE(set.render.keyLight);
+    const dermis::KeyLight& k = *set.render.keyLight;
+    EXPECT_EQ(k.direction, (std::array<double, 3>{1, 2, 3}));
+    EXPECT_EQ(k.intensity, 7.5);
+    EXPECT_EQ(k.color, (std::array<double, 3>{1, 0.5, 0.25}));
+    EXPECT_FALSE(k.shadow);
+    const auto written = dermis::toJson(set)["render"]["key_light"];
+    EXPECT_EQ(written["direction"], nlohmann::json::array({1, 2, 3}));
+    EXPECT_EQ(written["shadow"], false);
+    expectStableRoundTrip(doc(R"("render":{"key_light":{"direction":[-0.5,1,0.6],"intensity":3,"color":[1,1,1],"shadow":true}})"));
+    // null removes it (what a PUT of a document without the light does too).
+    EXPECT_FALSE(parseOk(doc(R"("render":{"key_light":null})")).render.keyLight);
+    // The unit direction and the shadow camera (core/key_light.hpp).
+    const glm::vec3 l = dermis::keyLightDirection(k);
+    EXPECT_NEAR(glm::length(l), 1.0f, 1e-6f);
+    EXPECT_NEAR(l.z / l.x, 3.0f, 1e-5f);
+}
+
+TEST(SceneTest, TheShadowCameraSeesTheWholeCharacterFromTheLight) {
+    const glm::vec3 lo(-0.4f, 0.0f, -0.2f), hi(0.6f, 1.8f, 0.3f);
+    for (const glm::vec3 dir : {glm::vec3(0, 1, 0), glm::vec3(0, -1, 0), glm::vec3(1, 0.3f, 0.2f),
+                                glm::vec3(-0.5f, 1, 0.6f)}) {
+        const glm::vec3 l = glm::normalize(dir);
+        const dermis::ShadowCamera sc = dermis::shadowCamera(lo, hi, 0.05, l, 2048);
+        EXPECT_NEAR(sc.radius, 0.5f * glm::length(hi - lo) + 0.05f, 1e-5f);
+        EXPECT_NEAR(sc.texelWorld, 2.0f * sc.radius / 2048.0f, 1e-7f);
+        // Every corner of the bounds, pushed out by the displacement scale, lies in the clip volume.
+        for (int c = 0; c < 8; ++c) {
+            const glm::vec3 p((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+            const glm::vec4 q = sc.viewProj * glm::vec4(p, 1.0f);
+            for (int k = 0; k < 3; ++k) EXPECT_LE(std::abs(q[k] / q.w), 1.0f) << c;
+        }
+        // Nearer the light is smaller depth: the centre moved towards the light.
+        const glm::vec3 centre = 0.5f * (lo + hi);
+        const float z0 = (sc.viewProj * glm::vec4(centre, 1.0f)).z;
+        const float z1 = (sc.viewProj * glm::vec4(centre + 0.1f * l, 1.0f)).z;
+        EXPECT_LT(z1, z0);
+        // A step across the light does not change depth.
+        const glm::vec3 across = glm::normalize(glm::cross(l, std::abs(l.y) > 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0)));
+        EXPECT_NEAR((sc.viewProj * glm::vec4(centre + 0.3f * across, 1.0f)).z, z0, 1e-5f);
+    }
+}
+
 TEST(SceneTest, UvLayoutDefaultsToAutoAndRoundTrips) {
     EXPECT_EQ(parseOk(doc("")).uvLayout, dermis::UvLayoutMode::Auto);
     EXPECT_EQ(dermis::toJson(parseOk(doc("")))["uv_layout"], "auto");
@@ -689,6 +742,15 @@ const BadCase kBadCases[] = {
      "/render/environment_rotation"},
     {"EnvironmentRotationString", doc(R"("render":{"environment_rotation":"90"})"),
      "/render/environment_rotation"},
+    {"KeyLightNotAnObject", doc(R"("render":{"key_light":true})"), "/render/key_light"},
+    {"KeyLightDirectionZero", doc(R"("render":{"key_light":{"direction":[0,0,0]}})"), "/render/key_light/direction"},
+    {"KeyLightDirectionShort", doc(R"("render":{"key_light":{"direction":[0,1]}})"), "/render/key_light/direction"},
+    {"KeyLightDirectionHuge", doc(R"("render":{"key_light":{"direction":[0,1e9,0]}})"), "/render/key_light/direction"},
+    {"KeyLightIntensityNegative", doc(R"("render":{"key_light":{"intensity":-1}})"), "/render/key_light/intensity"},
+    {"KeyLightIntensityTooLarge", doc(R"("render":{"key_light":{"intensity":101}})"), "/render/key_light/intensity"},
+    {"KeyLightColorAboveOne", doc(R"("render":{"key_light":{"color":[1,1.5,1]}})"), "/render/key_light/color"},
+    {"KeyLightColorString", doc(R"("render":{"key_light":{"color":"white"}})"), "/render/key_light/color"},
+    {"KeyLightShadowNumber", doc(R"("render":{"key_light":{"shadow":1}})"), "/render/key_light/shadow"},
     // Bounds of every number (issue #12.7; scene.hpp kMax…).
     {"HeightHuge", placement(R"("h":1e39)"), "/placements/0/h"},
     {"HeightAboveMax", placement(R"("h":100.5)"), "/placements/0/h"},

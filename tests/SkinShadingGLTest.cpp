@@ -22,56 +22,6 @@ using nlohmann::json;
 
 namespace {
 
-/// A white rough dielectric sphere of radius 1 (a latitude-longitude grid, normals = positions).
-std::string whiteSphere(const TempDir& dir) {
-    namespace g = dermis::test::gltf;
-    constexpr int kLon = 48, kLat = 24;
-    std::vector<float> pos, uv;
-    std::vector<std::uint16_t> idx;
-    for (int j = 0; j <= kLat; ++j)
-        for (int i = 0; i <= kLon; ++i) {
-            const double th = M_PI * j / kLat, ph = 2.0 * M_PI * i / kLon;
-            pos.insert(pos.end(), {float(std::sin(th) * std::cos(ph)), float(std::cos(th)),
-                                   float(std::sin(th) * std::sin(ph))});
-            uv.insert(uv.end(), {float(i) / kLon, float(j) / kLat});
-        }
-    for (int j = 0; j < kLat; ++j)
-        for (int i = 0; i < kLon; ++i) {
-            const auto a = std::uint16_t(j * (kLon + 1) + i), b = std::uint16_t(a + kLon + 1);
-            idx.insert(idx.end(), {a, std::uint16_t(a + 1), b, std::uint16_t(a + 1), std::uint16_t(b + 1), b});
-        }
-    g::Builder b;
-    const int p = b.add(pos, g::kFloat, "VEC3"), n = b.add(pos, g::kFloat, "VEC3");
-    const int t = b.add(uv, g::kFloat, "VEC2"), i = b.add(idx, g::kUShort, "SCALAR");
-    json pbr = {{"baseColorFactor", {0.9, 0.9, 0.9, 1.0}}, {"metallicFactor", 0}, {"roughnessFactor", 0.6}};
-    b.doc["materials"] = json::array({{{"pbrMetallicRoughness", pbr}}});
-    json prim = {{"attributes", {{"POSITION", p}, {"NORMAL", n}, {"TEXCOORD_0", t}}}, {"indices", i}, {"material", 0}};
-    b.doc["meshes"] = json::array({{{"primitives", json::array({prim})}}});
-    b.doc["nodes"] = json::array({{{"mesh", 0}}});
-    b.doc["scenes"] = json::array({{{"nodes", {0}}}});
-    b.doc["scene"] = 0;
-    const std::vector<std::uint8_t> glb = b.glb();
-    writeText(dir / "sphere.glb", std::string(glb.begin(), glb.end()));
-    return dir / "sphere.glb";
-}
-
-/// Mean of channel `c` over the pixels of rows [y0, y1) that differ from the background.
-double meanChannel(const Image8& img, int c, int y0, int y1) {
-    double sum = 0.0;
-    std::size_t n = 0;
-    for (int y = y0; y < y1; ++y)
-        for (int x = 0; x < img.width; ++x) {
-            const std::size_t p = (std::size_t(y) * img.width + x) * 4;
-            bool fg = false;
-            for (int k = 0; k < 3; ++k)
-                fg = fg || std::abs(int(img.rgba[p + k]) - int(img.rgba[k])) > 8;
-            if (!fg) continue;
-            sum += img.rgba[p + c];
-            ++n;
-        }
-    return n ? sum / n : 0.0;
-}
-
 /// Energy of the detail of channel `c` inside the frame's foreground: the mean absolute
 /// difference of each pixel from its four neighbours' mean.
 double detail(const Image8& img, int c) {
@@ -95,7 +45,7 @@ TEST(SkinShadingGLTest, SkinScattersRedPastTheTerminator) {
     // A white sphere under a sky lit from above only: pbr shades its underside grey (every
     // channel alike); skin's scattering carries red furthest round the terminator, so the
     // underside turns red and the top keeps its light.
-    const std::string sphere = whiteSphere(dir);
+    const std::string sphere = whiteSphereGlb(dir);
     writeSkyHdr(dir / "sky.hdr", 64, 32, glm::vec3(2.0f), glm::vec3(0.0f));
     const std::string env = " --environment " + (dir / "sky.hdr");
     const Image8 pbr = render(dir, sphere, "--shading pbr" + env);
@@ -117,7 +67,7 @@ TEST(SkinShadingGLTest, SkinUnderAUniformSkyAddsNoLight) {
     TempDir dir;
     // Light from every direction alike has no bands for the scattering to blur: the diffuse
     // light is pbr's, and only the second specular lobe differs (a little).
-    const std::string sphere = whiteSphere(dir);
+    const std::string sphere = whiteSphereGlb(dir);
     writeUniformHdr(dir / "grey.hdr", 64, 32, glm::vec3(0.8f));
     const std::string env = " --environment " + (dir / "grey.hdr");
     const Image8 pbr = render(dir, sphere, "--shading pbr" + env);

@@ -157,6 +157,22 @@ Status validateRenderSettings(const RenderSettings& r, const RenderLimits& limit
         return bad("/render/environment_rotation", "must be in [" + fmt(-kMaxTurnAngle) + ", " +
                                                        fmt(kMaxTurnAngle) + "], got " +
                                                        fmt(r.environmentRotation));
+    if (r.keyLight) {
+        const KeyLight& k = *r.keyLight;
+        double length2 = 0.0;
+        for (double x : k.direction) {
+            if (!(std::isfinite(x) && std::abs(x) <= 1e6))
+                return bad("/render/key_light/direction", "each component must be a finite number in [-1e6, 1e6], got " + fmt(x));
+            length2 += x * x;
+        }
+        if (!(length2 > 1e-18)) return bad("/render/key_light/direction", "must not be the zero vector");
+        if (!(std::isfinite(k.intensity) && k.intensity >= 0.0 && k.intensity <= kMaxKeyLightIntensity))
+            return bad("/render/key_light/intensity",
+                       "must be in [0, " + fmt(kMaxKeyLightIntensity) + "], got " + fmt(k.intensity));
+        for (double channel : k.color)
+            if (!(std::isfinite(channel) && channel >= 0.0 && channel <= 1.0))
+                return bad("/render/key_light/color", "each component must be in [0, 1], got " + fmt(channel));
+    }
     return Ok{};
 }
 

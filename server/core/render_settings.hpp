@@ -78,6 +78,31 @@ std::optional<ToneMapping> toneMappingFromString(std::string_view s);
 /// Largest `render.exposure` (a linear scale of the light before tone mapping).
 constexpr double kMaxExposure = 64.0;
 
+/// A directional key light added to the image-based light of pbr and skin frames
+/// (`render.key_light`, issue #26), with an optional shadow map: the sun or the studio lamp that
+/// gives a wrinkle a hard side and a cast shadow, which an environment's soft light cannot.
+/// Shades the `shaded` and `lighting` views of the pbr programs; legacy frames keep their own
+/// camera-fixed key light and ignore this. Radiance as glTF's KHR_lights_punctual and three.js's
+/// DirectionalLight give it: the surface receives intensity × colour × max(n·l, 0) (irradiance
+/// in the environment's units; the studio's mean radiance ≈ 0.74 gives an irradiance of ≈ 2.3).
+struct KeyLight {
+    /// World space, from the surface towards the light (not normalised; not zero). The default
+    /// is above, in front (+z) and to the left (−x) of a character facing +z.
+    std::array<double, 3> direction{-0.5, 1.0, 0.6};
+    double intensity = 3.0;                    ///< [0, kMaxKeyLightIntensity]
+    std::array<double, 3> color{1.0, 1.0, 1.0}; ///< linear rgb, each in [0, 1]
+    /// Shadows from a depth map of the posed, displaced character seen from the light
+    /// (kKeyLightShadowMapSize², fitted to the character's bounding sphere; vertex displacement
+    /// even in tessellated frames; glTF BLEND parts cast none, MASK parts by their cutoff).
+    bool shadow = true;
+    bool operator==(const KeyLight&) const = default;
+};
+
+/// Largest `render.key_light.intensity`.
+constexpr double kMaxKeyLightIntensity = 100.0;
+/// Side of the key light's shadow map (texels).
+constexpr int kKeyLightShadowMapSize = 2048;
+
 struct RenderSettings {
     std::array<int, 2> size{1024, 1024};
     Camera camera;
@@ -98,6 +123,9 @@ struct RenderSettings {
     /// relative to the scene document on the command line. Not checked here (a path or an id
     /// of ≤ kMaxPathLength bytes; the parser checks its form, the shell that it exists).
     std::string environment;
+    /// pbr and skin: a directional key light with an optional shadow (`render.key_light`);
+    /// absent: the environment alone (the default).
+    std::optional<KeyLight> keyLight;
 };
 
 /// The default studio environment's name in `render.environment`.
@@ -149,7 +177,9 @@ ResolvedAntiAliasing resolveAntiAliasing(const RenderSettings& render, bool soft
 /// camera yaw in [−kMaxTurnAngle, kMaxTurnAngle], pitch in [−90, 90], distance in (0, kMaxCameraDistance]
 /// when set; displacement_scale in [0, kMaxDisplacementScale] when set; bump_strength in
 /// [0, kMaxBumpStrength] (bounds in scene.hpp); msaa 1, 2 or 4; exposure in [0, kMaxExposure];
-/// environment_rotation in [−kMaxTurnAngle, kMaxTurnAngle].
+/// environment_rotation in [−kMaxTurnAngle, kMaxTurnAngle]; key_light: direction finite, each
+/// component in [−1e6, 1e6] and not all zero, intensity in [0, kMaxKeyLightIntensity], colour
+/// components in [0, 1].
 /// `where` names the calling function in the message.
 Status validateRenderSettings(const RenderSettings& render, const RenderLimits& limits = {},
                               const char* where = "dermis::validateRenderSettings");

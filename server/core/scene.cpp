@@ -123,6 +123,11 @@ json toJson(const Scene& scene) {
     if (r.environmentRotation != defaults.environmentRotation)
         render["environment_rotation"] = r.environmentRotation;
     if (!r.environment.empty()) render["environment"] = r.environment;
+    if (r.keyLight) {
+        const KeyLight& k = *r.keyLight;
+        render["key_light"] = json{{"direction", k.direction}, {"intensity", k.intensity},
+                                   {"color", k.color}, {"shadow", k.shadow}};
+    }
     doc["render"] = std::move(render);
     return doc;
 }

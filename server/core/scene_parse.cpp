@@ -592,6 +592,37 @@ Status parseRender(const Reader& rd, const json& v, RenderSettings& render) {
                                                    std::string(kBuiltinStudioEnvironment) + "\", got '" + *s + "'");
         render.environment = *s;
     }
+    if (const json* kl = Reader::find(v, "key_light")) {
+        // null: no key light (what an absent member means), so that a PUT can remove it.
+        const std::string p = ptr + "/key_light";
+        if (kl->is_null()) {
+            render.keyLight.reset();
+        } else {
+            if (auto s = rd.object(*kl, p); !s) return s;
+            KeyLight k;
+            if (const json* d = Reader::find(*kl, "direction")) {
+                auto a = rd.numbers<3>(*d, p + "/direction");
+                if (!a) return a.error();
+                k.direction = *a;
+            }
+            if (const json* in = Reader::find(*kl, "intensity")) {
+                auto d = rd.number(*in, p + "/intensity");
+                if (!d) return d.error();
+                k.intensity = *d;
+            }
+            if (const json* c = Reader::find(*kl, "color")) {
+                auto a = rd.numbers<3>(*c, p + "/color");
+                if (!a) return a.error();
+                k.color = *a;
+            }
+            if (const json* sh = Reader::find(*kl, "shadow")) {
+                if (!sh->is_boolean())
+                    return rd.bad(p + "/shadow", "expected a boolean, got " + describeType(*sh));
+                k.shadow = sh->get<bool>();
+            }
+            render.keyLight = k;
+        }
+    }
     return validateRenderSettings(render, {}, kSceneWhere);
 }
 

@@ -163,7 +163,17 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
         uploadEnvironmentBlock(**light, rs);
     }
     const std::size_t partStride = uploadPartBlocks(model, **gm, **parts, req.view, pbr);
-    const auto program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr, skinShading);
+    // The key light (render.key_light) lights the pbr programs' shaded and lighting views; its
+    // shadow map is drawn before the frame (shadow_pass.cpp).
+    const bool keyLight = pbr && rs.keyLight &&
+                          (req.view == FrameView::Shaded || req.view == FrameView::Lighting);
+    if (keyLight)
+        if (auto s = keyLightStage(model, **gm, **parts, *rs.keyLight, bounds, dispScale,
+                                   heightSource->texture, heightSource->size, partStride);
+            !s)
+            return s.error();
+    const auto program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr,
+                                     skinShading, keyLight);
     if (!program) return program.error();
     std::vector<std::size_t> order(parts.value()->size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;

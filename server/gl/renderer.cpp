@@ -193,7 +193,17 @@ Status Renderer::Impl::buildPrograms() {
     return Ok{};
 }
 
-Result<GLuint> Renderer::Impl::skinProgram(bool tess, FrameView view, bool pbr, bool skinShading) {
+Result<GLuint> Renderer::Impl::skinProgram(bool tess, FrameView view, bool pbr, bool skinShading,
+                                           bool keyLight) {
+    if (keyLight && (pbr || skinShading)) {
+        GLuint& p = keyLightPrograms[tess ? 1 : 0][skinShading ? 1 : 0];
+        if (!p) {
+            auto built = buildSkinProgram(tess, FrameView::Shaded, true, skinShading, true);
+            if (!built) return built.error();
+            p = *built;
+        }
+        return p;
+    }
     if (skinShading) {
         GLuint& p = skinShadingPrograms[tess ? 1 : 0];
         if (!p) {
@@ -207,7 +217,8 @@ Result<GLuint> Renderer::Impl::skinProgram(bool tess, FrameView view, bool pbr, 
     return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
 }
 
-Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool pbr, bool skinShading) {
+Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool pbr, bool skinShading,
+                                                bool keyLight) {
     ProgramDesc desc;
     desc.stages = {{GL_VERTEX_SHADER, "skin.vert"}};
     if (tess) {
@@ -231,6 +242,7 @@ Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool 
         desc.defines.push_back("DERMIS_SKIN_LOBE_ROUGHNESS " + std::to_string(kSkinSecondLobeRoughness));
         desc.defines.push_back("DERMIS_SKIN_LOBE_WEIGHT " + std::to_string(kSkinSecondLobeWeight));
     }
+    if (keyLight) desc.defines.push_back("DERMIS_KEY_LIGHT");
     return buildProgram(desc);
 }
 
@@ -310,6 +322,19 @@ void Renderer::Impl::shutdown() {
         glDeleteProgram(p);
         p = 0;
     }
+    for (auto& bySkin : keyLightPrograms)
+        for (GLuint& p : bySkin) {
+            glDeleteProgram(p);
+            p = 0;
+        }
+    glDeleteProgram(shadowProgram);
+    shadowProgram = 0;
+    shadowMap.destroy();
+    glDeleteTextures(1, &noShadowTexture);
+    noShadowTexture = 0;
+    glDeleteBuffers(1, &keyLightUbo);
+    glDeleteBuffers(1, &shadowFrameUbo);
+    keyLightUbo = shadowFrameUbo = 0;
     studioLight.destroy();
     customLight.destroy();
     customKey = nullptr;
@@ -326,8 +351,14 @@ void Renderer::Impl::shutdown() {
 }
 
 Result<Renderer::BlockLayout> Renderer::Impl::blockLayout(const std::string& block) {
-    // The tessellated PBR program uses every member of the skin pass's blocks.
+    // The tessellated PBR program uses every member of the skin pass's blocks; its key light
+    // variant declares the KeyLightBlock.
     GLuint program = block == "HeightPassBlock" ? heightProgram : pbrPrograms[1];
+    if (block == "KeyLightBlock") {
+        auto p = skinProgram(true, FrameView::Shaded, true, false, true);
+        if (!p) return p.error();
+        program = *p;
+    }
     const GLuint index = glGetUniformBlockIndex(program, block.c_str());
     if (index == GL_INVALID_INDEX)
         return makeError(ErrorCode::NotFound, kWhere, block, "no such uniform block");

@@ -156,6 +156,15 @@ struct FrameTargets {
     void destroy();
 };
 
+/// The key light's shadow map (shadow_pass.cpp): a depth texture compared on lookup (border 1:
+/// outside the map is lit) and its framebuffer, kKeyLightShadowMapSize² once made.
+struct ShadowTarget {
+    GLuint fbo = 0, depth = 0;
+    int size = 0;
+
+    void destroy();
+};
+
 /// The height maps a frame samples: a texture (RG32F) and its size.
 struct HeightSource {
     GLuint texture = 0;
@@ -250,6 +259,16 @@ struct Renderer::Impl {
     /// that never shows it does not pay its link at start), on the render thread before the
     /// frame's draws, and kept.
     GLuint skinShadingPrograms[2] = {};
+    /// The pbr programs with a key light (DERMIS_KEY_LIGHT; `render.key_light`) by
+    /// [tessellated][skin shading], and the shadow map's depth program (skin.vert with
+    /// DERMIS_PBR + shadow.frag): linked on the first frame that asks, like the skin shading's.
+    GLuint keyLightPrograms[2][2] = {};
+    GLuint shadowProgram = 0;
+    gl::ShadowTarget shadowMap;
+    /// 1×1 depth texture (compare mode, depth 1: lit), bound for key lights without a shadow.
+    GLuint noShadowTexture = 0;
+    /// The KeyLightBlock, and the FrameBlock of the shadow pass (the light's view).
+    GLuint keyLightUbo = 0, shadowFrameUbo = 0;
     /// The image-based light of the pbr programs (pbr_pass.cpp): for the default studio
     /// environment and for the last environment a frame brought (FrameRequest::environment, kept
     /// while its owner lives), the GGX-prefiltered radiance with one mip level per roughness step
@@ -304,11 +323,15 @@ struct Renderer::Impl {
     /// it (never during a frame).
     /// With `skinShading` (and `pbr`), the skin shading's variant (DERMIS_SKIN, its constants
     /// from core/render_settings.hpp as defines).
-    Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false);
+    /// With `keyLight` (and `pbr`), the key light's variant (DERMIS_KEY_LIGHT).
+    Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false,
+                                    bool keyLight = false);
     /// The skin program of a frame (built at start by buildPrograms): the PBR one (every view
     /// it draws, chosen by PartBlock's u_part.w) with `pbr`; the skin shading's with
     /// `skinShading`, linked here the first time (fails with the GL's log).
-    Result<GLuint> skinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false);
+    /// With `keyLight` (and `pbr`), the key light's variant of either, linked here the first time.
+    Result<GLuint> skinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false,
+                               bool keyLight = false);
     /// The light of `env` (null: the default studio environment), prefiltered on the CPU the
     /// first time a frame asks for it (legacy frames never pay for it) and kept: the studio's for
     /// the renderer's life, a custom one until another replaces it or its owner is gone. Fails
@@ -393,6 +416,18 @@ struct Renderer::Impl {
                         GLuint skinProgram, GLuint heightTexture, std::size_t partStride, int samples,
                         const std::vector<std::size_t>* pbrOrder);
     Status readFrame(GLuint readFbo, Image8& image);
+
+    // shadow_pass.cpp: the key light (render.key_light).
+    /// The KeyLightBlock of `light` for a frame framed on `bounds` (kKeyLightBinding) and, when
+    /// it casts shadows, the shadow map drawn from it: every part but glTF BLEND ones, skinned and
+    /// displaced as the frame draws them (vertex displacement), MASK parts by their cutoff; the
+    /// part blocks must be uploaded (uploadPartBlocks with pbr) and the palette too. Binds the
+    /// map (or the 1×1 lit one) to unit 9 and leaves the frame's FrameBlock bound.
+    Status keyLightStage(const Model& model, const gl::GpuModel& gm,
+                         const std::vector<gl::GpuModel::Part>& parts, const KeyLight& light,
+                         const Bounds& bounds, double dispScale, GLuint heightTexture,
+                         glm::vec2 heightmapSize, std::size_t partStride);
+    Status ensureShadowTarget(int size);
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
                                                const std::vector<glm::mat4>& world,
                                                const std::vector<float>& morphWeights);

@@ -72,6 +72,15 @@ struct EnvironmentBlock {
     glm::ivec4 mode;           ///< tone mapping (0 none, 1 PBR Neutral, 2 ACES filmic), 0, 0, 0
 };
 
+/// KeyLightBlock, binding 5: the directional key light of the DERMIS_KEY_LIGHT programs
+/// (pbr.glsl; render.key_light).
+struct KeyLightBlock {
+    glm::mat4 shadowViewProj; ///< world → shadow map clip space (core/key_light.hpp)
+    glm::vec4 direction;      ///< unit, towards the light; w 1 with a shadow map, else 0
+    glm::vec4 radiance;       ///< colour × intensity, 0
+    glm::vec4 shadowParams;   ///< normal offset (world), depth bias (map depth), 1 / map size, 0
+};
+
 /// OutlineBlock, binding 3: the outlines of a frame's skin pass (FrameOutline in renderer.hpp).
 struct OutlineBlock {
     glm::ivec4 count;        ///< outlines in use (0..kOutlineSlots), 0, 0, 0
@@ -90,6 +99,7 @@ enum BlockBinding : unsigned {
     kPartBinding = 2,
     kOutlineBinding = 3,
     kEnvironmentBinding = 4,
+    kKeyLightBinding = 5,
     kPaletteBinding = 0,      // shader storage buffer bindings: the joint palette,
     kMorphDeltaBinding = 1,   // the drawn part's morph deltas,
     kMorphWeightBinding = 2,  // the frame's morph weights
@@ -100,6 +110,7 @@ static_assert(sizeof(HeightPassBlock) == 144);
 static_assert(sizeof(FrameBlock) == 144);
 static_assert(sizeof(PartBlock) == 32 + 3 * 16 + 10 * 16 + 16);
 static_assert(sizeof(EnvironmentBlock) == 9 * 16 + 2 * 16);
+static_assert(sizeof(KeyLightBlock) == 64 + 3 * 16);
 static_assert(sizeof(OutlineBlock) == 16 + 5 * 8 * 16);
 
 } // namespace dermis::gl

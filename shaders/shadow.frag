@@ -1,0 +1,20 @@
+// The key light's shadow map (`render.key_light`, core/render_settings.hpp KeyLight): depth only,
+// drawn from the light (core/key_light.hpp shadowCamera) by skin.vert with DERMIS_PBR, so that a
+// caster is skinned, morphed and displaced as the frame draws it (vertex displacement even when
+// the frame is tessellated). pbr.glsl comes before this file (materialUv, hasMap). A glTF MASK
+// part casts where its alpha reaches the cutoff, as skin.frag draws it; the renderer does not
+// draw BLEND parts into the map, and opaque parts write every fragment.
+
+layout(binding = 2) uniform sampler2D u_baseColorTexture; // sRGB8_A8: only its alpha is read
+
+in vec2 v_uv;
+in vec2 v_uv1;
+in vec4 v_color;
+
+void main() {
+    if (u_maps.y != 1) return;
+    float alpha = u_baseColor.a;
+    if ((u_maps.z & 4) != 0) alpha *= v_color.a;
+    if (hasMap(1)) alpha *= texture(u_baseColorTexture, materialUv(0, v_uv, v_uv1)).a;
+    if (alpha < u_emissive.w) discard;
+}
