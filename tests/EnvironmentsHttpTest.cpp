@@ -30,16 +30,20 @@ std::vector<std::uint8_t> uniformSky(float r, float g, float b) {
     return bytesOfText(radianceHdr(64, 32, c, c));
 }
 
-/// Σ red / Σ green over the frame's pixels that are not the background (its top-left pixel).
-double redness(const Image8& img) {
-    double r = 0.0, g = 0.0;
+/// Σ channel `a` / Σ channel `b` over the frame's pixels that are not the background (its
+/// top-left pixel).
+double channelRatio(const Image8& img, int a, int b) {
+    double sa = 0.0, sb = 0.0;
     for (std::size_t p = 0; p + 3 < img.rgba.size(); p += 4) {
         if (img.rgba[p] == img.rgba[0] && img.rgba[p + 1] == img.rgba[1] && img.rgba[p + 2] == img.rgba[2]) continue;
-        r += img.rgba[p];
-        g += img.rgba[p + 1];
+        sa += img.rgba[p + a];
+        sb += img.rgba[p + b];
     }
-    return r / std::max(g, 1.0);
+    return sa / std::max(sb, 1.0);
 }
+
+/// Σ red / Σ green over the character.
+double redness(const Image8& img) { return channelRatio(img, 0, 1); }
 
 std::size_t filesIn(const std::string& folder) {
     std::error_code ec;
@@ -132,15 +136,7 @@ TEST_F(EnvironmentsHttpTest, ASceneKeyLightLightsItsFramesAndAPutRemovesIt) {
     const Image8 plainFrame = frame(plain), litFrame = frame(lit);
     // Σ blue / Σ red over the character (skin is red-heavy; tone mapping's desaturation of what
     // the light brightens raises blue too).
-    auto blueness = [](const Image8& img) {
-        double r = 0.0, b = 0.0;
-        for (std::size_t p = 0; p + 3 < img.rgba.size(); p += 4) {
-            if (img.rgba[p] == img.rgba[0] && img.rgba[p + 1] == img.rgba[1] && img.rgba[p + 2] == img.rgba[2]) continue;
-            r += img.rgba[p];
-            b += img.rgba[p + 2];
-        }
-        return b / std::max(r, 1.0);
-    };
+    auto blueness = [](const Image8& img) { return channelRatio(img, 2, 0); };
     EXPECT_GT(blueness(litFrame), 1.2 * blueness(plainFrame))
         << "key light " << blueness(litFrame) << ", none " << blueness(plainFrame);
     json bad = doc;

@@ -185,3 +185,25 @@ TEST(KeyLightGLTest, ACharacterCastsShadowsVertexAndTessellated) {
             EXPECT_EQ(changed(b, a, 2).brighter, 0u) << shading << " " << displacement;
         }
 }
+
+TEST(KeyLightGLTest, TheCommandLineSetsAndRemovesTheLight) {
+    TempDir dir;
+    // --key-light X,Y,Z[,INTENSITY] and --no-shadows draw what the scene member draws; --key-light
+    // off removes the scene's; bad values exit 1 naming the option.
+    const std::string sphere = whiteSphereGlb(dir);
+    writeUniformHdr(dir / "dim.hdr", 64, 32, glm::vec3(0.05f));
+    const std::string opts = "--shading pbr --environment " + (dir / "dim.hdr");
+    const Image8 member = render(dir, sphere, opts, {{"key_light", keyLight({1, 0, 0.3}, 4.0, false)}});
+    const Image8 option = render(dir, sphere, opts + " --key-light 1,0,0.3,4 --no-shadows");
+    EXPECT_EQ(member.rgba, option.rgba);
+    const Image8 none = render(dir, sphere, opts);
+    const Image8 off = render(dir, sphere, opts + " --key-light off", {{"key_light", keyLight({1, 0, 0.3}, 4.0, true)}});
+    EXPECT_EQ(none.rgba, off.rgba);
+    writeText(dir / "s.json", json({{"format", "dermis.scene/1"}, {"model", sphere}}).dump());
+    for (const char* bad : {"1,2", "0,0,0", "1,1,1,-2", "up"}) {
+        CliRun r = runServer(dir, "render --scene " + (dir / "s.json") + " --out " + (dir / "x.png") +
+                                      " --key-light " + bad + gl());
+        EXPECT_EQ(r.code, 1) << bad << ": " << r.err;
+        EXPECT_NE(r.err.find("--key-light"), std::string::npos) << bad << ": " << r.err;
+    }
+}

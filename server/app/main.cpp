@@ -346,6 +346,10 @@ int main(int argc, char** argv) {
                           "pbr: light the frame with this equirectangular image (.hdr, .exr; linear radiance) "
                           "instead of the default studio environment")
         ->check(CLI::ExistingFile);
+    renderCmd->add_option("--key-light", render.keyLight,
+                          "pbr and skin: a directional key light with a shadow, X,Y,Z (world, towards the "
+                          "light) or X,Y,Z,INTENSITY, or off (overrides render.key_light)");
+    renderCmd->add_flag("--no-shadows", render.noShadows, "The key light casts no shadow");
     renderCmd->add_option("--view", render.view,
                           "shaded (default), or unlit: bump / displacement height as grey, normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal", "basecolor", "lighting"}));

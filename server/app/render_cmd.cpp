@@ -33,6 +33,42 @@ std::string withoutExtension(const std::string& path) {
 
 } // namespace
 
+namespace {
+
+/// --key-light and --no-shadows over the scene's render.key_light (RenderArgs::keyLight); the
+/// light then by validateRenderSettings, errors naming the option.
+Status applyKeyLightOptions(const RenderArgs& a, RenderSettings& render) {
+    const char* where = "dermis-server render";
+    if (a.keyLight == "off") {
+        render.keyLight.reset();
+    } else if (!a.keyLight.empty()) {
+        double v[4] = {0.0, 0.0, 0.0, -1.0};
+        char tail = 0;
+        const int n = std::sscanf(a.keyLight.c_str(), "%lf,%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &v[3], &tail);
+        if (n != 3 && n != 4)
+            return makeError(ErrorCode::InvalidArgument, where, "--key-light",
+                             "expected X,Y,Z or X,Y,Z,INTENSITY (numbers) or off, got \"" + a.keyLight + "\"");
+        KeyLight k = render.keyLight.value_or(KeyLight{});
+        k.direction = {v[0], v[1], v[2]};
+        if (n == 4) k.intensity = v[3];
+        render.keyLight = k;
+    }
+    if (a.noShadows && render.keyLight) render.keyLight->shadow = false;
+    if (auto s = validateRenderSettings(render, {}, where); !s) {
+        Error e = s.error();
+        if (!a.keyLight.empty() && e.field.rfind("/render/key_light", 0) == 0) {
+            const std::string prefix = std::string(where) + ": ";
+            if (e.message.rfind(prefix, 0) == 0) e.message.erase(0, prefix.size());
+            e.message = prefix + "--key-light: " + e.message;
+            e.field = "--key-light";
+        }
+        return e;
+    }
+    return Ok{};
+}
+
+} // namespace
+
 int runRender(const RenderArgs& a) {
     const char* where = "dermis-server render";
     auto t0 = std::chrono::steady_clock::now();
@@ -116,6 +152,7 @@ int runRender(const RenderArgs& a) {
     auto loaded = loadSceneFile(a.scene, a.content.empty() ? dermisContentDir() : a.content);
     timings["scene_load_ms"] = msSince(tLoad);
     if (!loaded) return fail(loaded.error());
+    if (auto s = applyKeyLightOptions(a, loaded->scene.render); !s) return fail(s.error());
     // SPEC §8: the height-map layout by the service's rule (core textureLayoutFor) and its
     // rest-surface map, baked once for every frame when a surface placement needs it — still
     // while the renderer starts.

@@ -27,6 +27,10 @@ struct RenderArgs {
     std::string toneMapping; ///< "": the scene's render.tone_mapping; neutral|aces|none
     double exposure = -1.0;  ///< < 0: the scene's render.exposure
     std::string environment; ///< "": the default studio environment; else an .hdr / .exr file
+    /// "": the scene's render.key_light; "off": none; "X,Y,Z" or "X,Y,Z,INTENSITY": a key light
+    /// towards (X, Y, Z) (world), its other members the scene's light's or the defaults.
+    std::string keyLight;
+    bool noShadows = false; ///< the key light casts no shadow
     bool hasTime = false, heightmaps = false, resume = false;
     /// Print where the time went as one JSON line on stderr: start-up (context, programs, scene
     /// load, the wait for the renderer), the first frame's stages (with a GL sync between them)
