@@ -12,7 +12,8 @@
 //     height pass, then transform-feedback skinning;
 //   * pbr frames and tessellated displacement after both; the key light's shadow pass on the
 //     many-part model, then a frame of the one-part model;
-//   * the images of the checked renderer equal those of an unchecked one (the check only reads).
+//   * the images of the checked renderer equal those of an unchecked one (the check only reads);
+//   * a key light's first frame (which makes its textures) equals its next.
 #include "BuildPaths.hpp"
 #include "GlTestBackend.hpp"
 #include "gl/renderer.hpp"
@@ -163,5 +164,25 @@ TEST(DrawBindingsGLTest, TheCheckOnlyReads) {
         const Image8 a = frame(*checked, req, "checked"), b = frame(**plain, req, "plain");
         ASSERT_FALSE(a.rgba.empty());
         EXPECT_EQ(a.rgba, b.rgba) << count << " placements";
+    }
+}
+
+TEST(DrawBindingsGLTest, AKeyLightsFirstFrameEqualsItsNext) {
+    // The key light's first frame makes its textures (the shadow map, the unshadowed one): on a
+    // unit of their own, or they would replace what the frame bound before (the environment's
+    // split-sum table on unit 8 was, once).
+    for (bool shadow : {true, false}) {
+        auto gl = checkedRenderer();
+        ASSERT_TRUE(gl);
+        const auto cesium = load("/CesiumMan/CesiumMan.glb");
+        ASSERT_TRUE(cesium);
+        FrameRequest lit = request(cesium, std::nullopt);
+        lit.render.shading = Shading::Pbr;
+        lit.render.keyLight = KeyLight{};
+        lit.render.keyLight->shadow = shadow;
+        const Image8 first = frame(*gl, lit, "first key light frame");
+        const Image8 next = frame(*gl, lit, "next key light frame");
+        ASSERT_FALSE(first.rgba.empty());
+        EXPECT_EQ(first.rgba, next.rgba) << (shadow ? "shadowed" : "unshadowed");
     }
 }

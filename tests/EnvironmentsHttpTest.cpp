@@ -8,7 +8,8 @@
 //   * uploads that are no environment: 415 (not .hdr/.exr, a broken .hdr, a wrong Content-Type),
 //     413 (a side over the image limit), nothing left in the store;
 //   * uploads survive a restart of the service;
-//   * a scene's `render.key_light` lights its frames, and a PUT with it null removes it.
+//   * a scene's `render.key_light` lights its frames, a frame's `key_light=on|off` overrides it,
+//     and a PUT with it null removes it.
 #include "BuildPaths.hpp"
 #include "HttpTestFixture.hpp"
 
@@ -127,8 +128,8 @@ TEST_F(EnvironmentsHttpTest, ASceneKeyLightLightsItsFramesAndAPutRemovesIt) {
     const std::string lit = createScene(doc);
     ASSERT_FALSE(plain.empty() || lit.empty());
     EXPECT_EQ(h.get("/scenes/" + lit).js()["scene"]["render"]["key_light"]["shadow"], true);
-    auto frame = [&](const std::string& sid) {
-        Reply r = h.get("/scenes/" + sid + "/frame");
+    auto frame = [&](const std::string& sid, const std::string& query = "") {
+        Reply r = h.get("/scenes/" + sid + "/frame" + query);
         EXPECT_EQ(r.status, 200) << r;
         auto img = decodeFrame(r.bytes());
         return img ? *img : Image8{};
@@ -139,6 +140,13 @@ TEST_F(EnvironmentsHttpTest, ASceneKeyLightLightsItsFramesAndAPutRemovesIt) {
     auto blueness = [](const Image8& img) { return channelRatio(img, 2, 0); };
     EXPECT_GT(blueness(litFrame), 1.2 * blueness(plainFrame))
         << "key light " << blueness(litFrame) << ", none " << blueness(plainFrame);
+    // The frame's key_light: off takes the scene's light away, on keeps it or adds the default.
+    EXPECT_EQ(frame(lit, "?key_light=off").rgba, plainFrame.rgba);
+    EXPECT_EQ(frame(lit, "?key_light=on").rgba, litFrame.rgba);
+    const Image8 defaultLight = frame(plain, "?key_light=on");
+    EXPECT_NE(defaultLight.rgba, plainFrame.rgba) << "the default key light on a scene without one";
+    EXPECT_NE(defaultLight.rgba, litFrame.rgba);
+    expectError(h.get("/scenes/" + plain + "/frame?key_light=maybe"), 422, "key_light");
     json bad = doc;
     bad["render"]["key_light"]["intensity"] = -1;
     expectError(h.post("/scenes", bad), 422, "/render/key_light/intensity");

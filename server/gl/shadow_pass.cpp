@@ -18,9 +18,12 @@ namespace {
 constexpr GLenum kUnitShadowMap = GL_TEXTURE9;
 
 /// A depth texture compared on lookup (LEQUAL, bilinear: four comparisons filtered), clamped to
-/// a border of depth 1, so that what lies outside the map is lit.
+/// a border of depth 1, so that what lies outside the map is lit. Made on the shadow map's own
+/// unit (left active), so that no texture a frame has bound elsewhere (the environment's on
+/// units 7 and 8) is replaced.
 GLuint makeShadowTexture(int size, const float* depth) {
     GLuint t = 0;
+    glActiveTexture(kUnitShadowMap);
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);
     glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, size, size);
@@ -107,7 +110,10 @@ Status Renderer::Impl::keyLightStage(const Model& model, const GpuModel& gm,
         if (!p) return p.error();
         shadowProgram = *p;
     }
-    if (auto s = ensureShadowTarget(size); !s) return s;
+    if (auto s = ensureShadowTarget(size); !s) {
+        glActiveTexture(GL_TEXTURE0);
+        return s;
+    }
     // The light's view in a FrameBlock of its own (skin.vert reads the displacement scale from it).
     FrameBlock fb{};
     fb.viewProj = sc.viewProj;

@@ -143,6 +143,14 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         }
         p.toneMapping = *tm;
     }
+    if (req.has_param("key_light")) {
+        const std::string v = req.get_param_value("key_light");
+        if (v != "on" && v != "off") {
+            sendError(res, 422, "invalid_argument", "dermis::Api: key_light: must be on or off", "key_light");
+            return false;
+        }
+        p.keyLight = v == "on";
+    }
     if (req.has_param("view")) {
         const auto view = frameViewFromString(req.get_param_value("view"));
         if (!view) {
@@ -248,7 +256,7 @@ bool framePostParams(const Req& req, Res& res, Req& out) {
     static const std::set<std::string> known = {"format", "width", "height", "msaa", "aa", "yaw", "pitch",
                                                 "distance", "time", "target", "highlight", "hover",
                                                 "brush", "surface_brush", "view", "patterns", "only",
-                                                "shading", "exposure", "tone_mapping",
+                                                "shading", "exposure", "tone_mapping", "key_light",
                                                 "preview", "revision"};
     json body;
     if (!jsonBody(req, res, body)) return false;

@@ -105,6 +105,9 @@ struct FrameParams {
     std::optional<Shading> shading;         ///< `shading`: legacy | pbr (render.shading)
     std::optional<double> exposure;         ///< `exposure` (render.exposure)
     std::optional<ToneMapping> toneMapping; ///< `tone_mapping` (render.tone_mapping)
+    /// `key_light`: on — the scene's render.key_light, or the default light (shadowed) when it
+    /// has none; off — none. Absent: the scene's.
+    std::optional<bool> keyLight;
     std::optional<double> yaw, pitch, distance, time;
     std::optional<std::array<double, 3>> target; ///< the camera's target (core Camera::target)
     // Outlines on the skin (the editor's selection, hover and place brush; nothing when empty:

@@ -35,6 +35,11 @@ Result<FramePlan> Service::State::plan(const Snapshot& snap, const FrameParams& 
     if (auto s = withLayout(snap.scene, *derivedOf(snap), o); !s) return s.error();
     auto planned = planFrame(snap.scene, *snap.model, snap.images, snap.base, o, rl);
     if (!planned) return detail::asParamError(planned.error(), p);
+    // key_light: on keeps the scene's light or adds the default one; off takes it away.
+    if (p.keyLight) {
+        if (!*p.keyLight) planned->render.keyLight.reset();
+        else if (!planned->render.keyLight) planned->render.keyLight = KeyLight{};
+    }
     return planned;
 }
 

@@ -118,10 +118,16 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       assert.notEqual(skinHash, hash0, "skin shading draws another picture");
       await page.selectOption("#viewMode", "pbr");
       await until(() => page.$eval("#frame", (i) => /shading=pbr/.test(i.dataset.url || "")), "a pbr frame");
-      assert.notEqual(await settledFrameHash(page), skinHash, "pbr is not skin");
+      const pbrHash = await settledFrameHash(page);
+      assert.notEqual(pbrHash, skinHash, "pbr is not skin");
       await screenshot(page, "editor-pbr-view.png");
+      await page.selectOption("#viewMode", "skin-key");
+      await until(() => page.$eval("#frame", (i) => /shading=skin/.test(i.dataset.url || "") && /key_light=on/.test(i.dataset.url || "")),
+                  "a skin frame with the key light");
+      assert.notEqual(await settledFrameHash(page), skinHash, "the key light and its shadows change the picture");
+      await screenshot(page, "editor-skin-key-light.png");
       await page.selectOption("#viewMode", "shaded");
-      await until(() => page.$eval("#frame", (i) => !/shading=/.test(i.dataset.url || "")), "the scene's own shading again");
+      await until(() => page.$eval("#frame", (i) => !/shading=|key_light=/.test(i.dataset.url || "")), "the scene's own shading again");
       assert.equal((await state(page)).revision, rev0, "a view mode is no edit");
     }],
     ["the place tool adds a placement at the clicked skin with the suggested driver (Place as: in the texture)", async () => {

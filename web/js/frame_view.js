@@ -8,7 +8,7 @@
 // placement too (`hover`), and the place tool's brush (`surface_brush`: a circle on the body, or
 // `brush`: a UV footprint) — with the tool off, `surface_brush` outlines the Propose… panel's
 // current proposal instead (its ghost). View modes shaded (the scene's shading), pbr / skin (that
-// shading for this view) and bump / displacement / normal; compare with a split slider, flicker,
+// shading for this view; with a shadowed key light: pbr-key / skin-key) and bump / displacement / normal; compare with a split slider, flicker,
 // or the diff heat map against "patterns off" or a chosen revision (compare images carry no
 // outlines). The bar's Turntable button shows the selection's range of
 // motion as an animated WebP (GET turntable).
@@ -217,10 +217,13 @@ class FrameLoader {
 let mainLoader, cmpLoader;
 
 /// The frame parameters of the view mode: "shaded" is the scene's own shading (none), "pbr" and
-/// "skin" a shading for this view (`shading=`), the others an unlit view of the maps (`view=`).
+/// "skin" a shading for this view (`shading=`), "pbr-key" and "skin-key" that shading with a
+/// shadowed key light (`key_light=on`: the scene's, or the default one), the others an unlit view
+/// of the maps (`view=`).
 function viewParams() {
   if (store.view === "shaded") return {};
   if (store.view === "pbr" || store.view === "skin") return { shading: store.view };
+  if (store.view === "pbr-key" || store.view === "skin-key") return { shading: store.view.slice(0, -4), key_light: "on" };
   return { view: store.view };
 }
 
@@ -233,6 +236,8 @@ export function initFrameView(section, theApi) {
         <option value="shaded" title="the scene's own shading">shaded</option>
         <option value="pbr" title="the character's glTF material under image-based light">pbr</option>
         <option value="skin" title="pbr with light scattered under the skin: how a wrinkle reads on skin">skin</option>
+        <option value="pbr-key" title="pbr with a key light and its shadows (the scene's render.key_light, or the default one)">pbr + key light</option>
+        <option value="skin-key" title="skin with a key light and its shadows: a wrinkle under one hard light">skin + key light</option>
         <option value="bump">bump</option>
         <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
       <label><span class="lbl keep">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame: split, flicker, or a diff heat map">
