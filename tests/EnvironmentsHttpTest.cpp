@@ -43,6 +43,14 @@ double channelRatio(const Image8& img, int a, int b) {
     return sa / std::max(sb, 1.0);
 }
 
+/// The frame of scene `sid` with `query`, decoded (empty when the answer is not 200 or no image).
+Image8 frameOf(const Http& h, const std::string& sid, const std::string& query = "") {
+    Reply r = h.get("/scenes/" + sid + "/frame" + query);
+    EXPECT_EQ(r.status, 200) << r;
+    auto img = decodeFrame(r.bytes());
+    return img ? *img : Image8{};
+}
+
 /// Σ red / Σ green over the character.
 double redness(const Image8& img) { return channelRatio(img, 0, 1); }
 
@@ -95,12 +103,7 @@ TEST_F(EnvironmentsHttpTest, AnUploadedSkyLightsTheScenesThatNameIt) {
     const std::string lit = createScene(doc);
     ASSERT_FALSE(studio.empty() || lit.empty());
     EXPECT_EQ(h.get("/scenes/" + lit).js()["scene"]["render"]["environment"], eid);
-    auto frame = [&](const std::string& sid, const std::string& query = "") {
-        Reply r = h.get("/scenes/" + sid + "/frame" + query);
-        EXPECT_EQ(r.status, 200) << r;
-        auto img = decodeFrame(r.bytes());
-        return img ? *img : Image8{};
-    };
+    auto frame = [&](const std::string& sid, const std::string& query = "") { return frameOf(h, sid, query); };
     const Image8 studioFrame = frame(studio), redFrame = frame(lit);
     EXPECT_GT(redness(redFrame), 1.5 * redness(studioFrame))
         << "red sky " << redness(redFrame) << ", studio " << redness(studioFrame);
@@ -128,12 +131,7 @@ TEST_F(EnvironmentsHttpTest, ASceneKeyLightLightsItsFramesAndAPutRemovesIt) {
     const std::string lit = createScene(doc);
     ASSERT_FALSE(plain.empty() || lit.empty());
     EXPECT_EQ(h.get("/scenes/" + lit).js()["scene"]["render"]["key_light"]["shadow"], true);
-    auto frame = [&](const std::string& sid, const std::string& query = "") {
-        Reply r = h.get("/scenes/" + sid + "/frame" + query);
-        EXPECT_EQ(r.status, 200) << r;
-        auto img = decodeFrame(r.bytes());
-        return img ? *img : Image8{};
-    };
+    auto frame = [&](const std::string& sid, const std::string& query = "") { return frameOf(h, sid, query); };
     const Image8 plainFrame = frame(plain), litFrame = frame(lit);
     // Σ blue / Σ red over the character (skin is red-heavy; tone mapping's desaturation of what
     // the light brightens raises blue too).

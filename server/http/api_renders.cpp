@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace dermis::api_detail {
@@ -61,6 +62,17 @@ std::vector<std::string> idList(const std::string& v) {
         start = comma + 1;
     }
     return ids;
+}
+
+/// An on/off parameter `name` of `req` (present): true for on, false for off; nullopt (and the
+/// 422 sent, naming it) for anything else.
+std::optional<bool> onOff(const Req& req, Res& res, const char* name) {
+    const std::string v = req.get_param_value(name);
+    if (v != "on" && v != "off") {
+        sendError(res, 422, "invalid_argument", std::string("dermis::Api: ") + name + ": must be on or off", name);
+        return std::nullopt;
+    }
+    return v == "on";
 }
 
 /// The frame query: size, camera, time, format, view and what to compare (patterns, only,
@@ -144,12 +156,9 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         p.toneMapping = *tm;
     }
     if (req.has_param("key_light")) {
-        const std::string v = req.get_param_value("key_light");
-        if (v != "on" && v != "off") {
-            sendError(res, 422, "invalid_argument", "dermis::Api: key_light: must be on or off", "key_light");
-            return false;
-        }
-        p.keyLight = v == "on";
+        const auto on = onOff(req, res, "key_light");
+        if (!on) return false;
+        p.keyLight = *on;
     }
     if (req.has_param("view")) {
         const auto view = frameViewFromString(req.get_param_value("view"));
@@ -162,12 +171,9 @@ bool frameParams(const Req& req, Res& res, FrameParams& p) {
         p.view = *view;
     }
     if (req.has_param("patterns")) {
-        const std::string v = req.get_param_value("patterns");
-        if (v != "on" && v != "off") {
-            sendError(res, 422, "invalid_argument", "dermis::Api: patterns: must be on or off", "patterns");
-            return false;
-        }
-        p.patternsOff = v == "off";
+        const auto on = onOff(req, res, "patterns");
+        if (!on) return false;
+        p.patternsOff = !*on;
     }
     if (req.has_param("only")) {
         const std::string v = req.get_param_value("only");
