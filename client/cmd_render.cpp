@@ -16,7 +16,7 @@ namespace dermis::cli {
 namespace {
 
 struct FrameOptions {
-    std::string id, sceneFile, out, frames, size, view = "shaded", map, format, aa, shading;
+    std::string id, sceneFile, out, frames, size, view = "shaded", map, format, aa, shading, keyLight;
     double time = -1, yaw = 0, pitch = 0, distance = 0;
     int width = 0, height = 0, msaa = 0, revision = 0, batch = 100, parallel = 1;
     bool hasYaw = false, hasPitch = false, hasDistance = false, resume = false;
@@ -53,6 +53,8 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
         ->check(CLI::IsMember({"auto", "msaa", "post", "none"}));
     frame->add_option("--shading", o->shading, "legacy, pbr (the model's glTF material under image-based light) or skin (pbr with subsurface scattering)")
         ->check(CLI::IsMember({"legacy", "pbr", "skin"}));
+    frame->add_option("--key-light", o->keyLight, "pbr and skin: on draws the scene's render.key_light (or the default one), off none")
+        ->check(CLI::IsMember({"on", "off"}));
     frame->add_option("--view", o->view, "shaded, or bump / displacement / normal")
         ->check(CLI::IsMember({"shaded", "bump", "displacement", "normal", "basecolor", "lighting"}));
     frame->add_option("--revision", o->revision, "The scene as it was at this revision")->check(CLI::PositiveNumber);
@@ -68,6 +70,7 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
             if (o->msaa) q.push_back({"msaa", std::to_string(o->msaa)});
             if (!o->aa.empty()) q.push_back({"aa", o->aa});
             if (!o->shading.empty()) q.push_back({"shading", o->shading});
+            if (!o->keyLight.empty()) q.push_back({"key_light", o->keyLight});
             if (o->view != "shaded") q.push_back({"view", o->view});
             if (o->revision) q.push_back({"revision", std::to_string(o->revision)});
             if (frame->count("--yaw")) q.push_back({"yaw", nlohmann::json(o->yaw).dump()});

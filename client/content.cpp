@@ -1,5 +1,5 @@
-// Content addresses of a scene file's model and patterns, and the multipart batch that carries
-// their bytes.
+// Content addresses of a scene file's model, patterns and environment, and the multipart batch
+// that carries their bytes.
 #include "content.hpp"
 
 #include "context.hpp"
@@ -59,6 +59,8 @@ ContentFiles addressContent(nlohmann::json& scene, const std::string& sceneFile)
         for (auto it = pm->begin(); it != pm->end(); ++it) address(it.value(), "/patterns/" + it.key());
     if (auto hm = scene.find("heightmap"); hm != scene.end() && hm->is_object())
         if (auto base = hm->find("base"); base != hm->end()) address(*base, "/heightmap/base");
+    if (auto r = scene.find("render"); r != scene.end() && r->is_object())
+        if (auto env = r->find("environment"); env != r->end()) address(*env, "/render/environment");
     return out;
 }
 

@@ -4,8 +4,9 @@
 // the bytes it renders, and the content cache then serves the same addresses without bytes; bytes
 // that do not match their address, malformed addresses and mixed roles are refused; uploads with
 // the same SHA-256 count; a small cache forgets (LRU) and frees the GPU copies; stored scenes never
-// name content by address; a cached model keeps its rest-surface map across batches. Plus
-// ContentCache itself.
+// name content by address; a cached model keeps its rest-surface map across batches; an
+// environment (render.environment) by address is listed, sent, cached, matched to an upload of
+// the same bytes, and refused when its bytes are no environment. Plus ContentCache itself.
 #include "BuildPaths.hpp"
 #include "ServiceFixture.hpp"
 
@@ -245,6 +246,79 @@ TEST_F(BatchContentTest, StoredScenesCannotNameContentByAddress) {
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().code, ErrorCode::NotFound);
     EXPECT_NE(r.error().message.find("POST /render"), std::string::npos) << r.error().message;
+}
+
+// The image-based light of a batch (render.environment, issue #26) by content address, as a farm
+// sends a scene file's .hdr: listed when lacking, decoded from its part, cached, served by an
+// upload with the same bytes; bytes that are no environment and role clashes are refused.
+TEST_F(BatchContentTest, AnEnvironmentByAddressIsListedSentCachedAndMatchedToUploads) {
+    const float sky[3] = {0.25f, 0.5f, 1.0f};
+    const std::string text = radianceHdr(16, 8, sky, sky);
+    const std::vector<std::uint8_t> hdr(text.begin(), text.end());
+    json doc = scene();
+    doc["render"]["shading"] = "pbr";
+    doc["render"]["environment"] = addressOf(hdr);
+
+    auto first = svc_->batch(body(doc), both());
+    ASSERT_FALSE(first);
+    EXPECT_EQ(first.error().code, ErrorCode::MissingContent);
+    EXPECT_EQ(first.error().missing, std::vector<std::string>{addressOf(hdr)});
+    EXPECT_EQ(first.error().field, "/scene/render/environment");
+
+    Parts parts = both();
+    parts[addressOf(hdr)] = hdr;
+    auto sent = svc_->batch(body(doc), parts);
+    ASSERT_TRUE(sent) << sent.error().message;
+    renderAll(*sent);
+    auto env = fake_->lastEnvironment();
+    ASSERT_TRUE(env);
+    EXPECT_EQ(env->width, 16);
+    EXPECT_EQ(env->height, 8);
+    EXPECT_NEAR(env->at(3, 2).z, 1.0f, 0.01f);
+    EXPECT_NEAR(env->at(3, 2).x, 0.25f, 0.01f);
+
+    // Again without bytes: from the cache, the same decoded image.
+    auto again = svc_->batch(body(doc));
+    ASSERT_TRUE(again) << again.error().message;
+    renderAll(*again);
+    EXPECT_EQ(fake_->lastEnvironment(), env);
+
+    // Legacy frames light nothing by it (and decode nothing).
+    json legacy = doc;
+    legacy["render"]["shading"] = "legacy";
+    auto l = svc_->batch(body(legacy));
+    ASSERT_TRUE(l) << l.error().message;
+    renderAll(*l);
+    EXPECT_FALSE(fake_->lastEnvironment());
+
+    // After a restart (empty cache) an upload with the same bytes serves the address.
+    open();
+    ASSERT_FALSE(svc_->batch(body(doc), both()));
+    ASSERT_TRUE(svc_->addEnvironment(hdr, "sky"));
+    auto up = svc_->batch(body(doc), both());
+    ASSERT_TRUE(up) << up.error().message;
+    renderAll(*up);
+    ASSERT_TRUE(fake_->lastEnvironment());
+    EXPECT_EQ(fake_->lastEnvironment()->width, 16);
+
+    // Bytes that are no environment, under their own (correct) address.
+    const auto png = patternPng(8, 8);
+    json notEnv = doc;
+    notEnv["render"]["environment"] = addressOf(png);
+    Parts withPng = both();
+    withPng[addressOf(png)] = png;
+    auto bad = svc_->batch(body(notEnv), withPng);
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().code, ErrorCode::Parse) << bad.error().message;
+    EXPECT_NE(bad.error().message.find("/render/environment"), std::string::npos) << bad.error().message;
+
+    // One address as a pattern and as the environment.
+    json clash = doc;
+    clash["patterns"]["mine"] = addressOf(hdr);
+    auto c = svc_->batch(body(clash), parts);
+    ASSERT_FALSE(c);
+    EXPECT_EQ(c.error().code, ErrorCode::InvalidArgument);
+    EXPECT_NE(c.error().message.find("environment"), std::string::npos) << c.error().message;
 }
 
 // --- ContentCache --------------------------------------------------------------------------------

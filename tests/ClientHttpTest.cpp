@@ -2,9 +2,12 @@
 // dermis-server as a real process on 127.0.0.1 (a GL context through $DERMIS_TEST_GL). It checks:
 //   * every subcommand: health, info, model upload|list|show|rm (content-addressed: the same id
 //     twice), pattern upload|list|rm, environment upload|list|rm, scene create|list|get|put|export|apply|rm|history|revert,
-//     pose set (joints, clip, time, --morph), placement add|set|rm|mirror, frame, maps, lint, watch, render, check;
+//     pose set (joints, clip, time, --morph), placement add|set|rm|mirror, frame (--key-light too), maps,
+//     lint, watch, render, check;
 //   * exit codes and messages: bad arguments → 2, server errors → 1 with
 //     "dermis: error: <message> (<field>)", an unreachable server → 3;
+//   * render --scene-file sends the scene file's environment (.hdr beside it) by content address:
+//     the same frames as with the environment uploaded and named by id, not the studio's;
 //   * render --resume after the client is killed (SIGKILL) mid-range writes exactly the remaining
 //     frames, byte-identical to an uninterrupted run, and leaves the finished ones untouched;
 //     Ctrl-C (SIGINT) stops with 130 and no partial file;
@@ -406,6 +409,19 @@ TEST_F(ClientHttpTest, FramesMapsLintAndWatch) {
     ASSERT_EQ(dermis({"frame", sid, "-o", jpg, "--width", "64", "--height", "64"}).code, 0);
     EXPECT_EQ(static_cast<unsigned char>(slurp(jpg)[0]), 0xFF);
     EXPECT_FALSE(fs::exists(png + ".dermis-part"));
+    // --key-light on adds the default key light to a pbr frame; off is the frame without it.
+    const auto pbrFrame = [&](const std::string& name, std::vector<std::string> extra) {
+        std::vector<std::string> args = {"frame", sid, "-o", *dir_ / ("frames/" + name), "--width", "64",
+                                         "--height", "64", "--shading", "pbr"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        ClientRun r = dermis(args);
+        EXPECT_EQ(r.code, 0) << r;
+        return slurp(*dir_ / ("frames/" + name));
+    };
+    const std::string lit = pbrFrame("lit.png", {"--key-light", "on"}), plain = pbrFrame("plain.png", {});
+    EXPECT_NE(lit, plain);
+    EXPECT_EQ(pbrFrame("off.png", {"--key-light", "off"}), plain);
+    EXPECT_EQ(dermis({"frame", sid, "-o", png, "--key-light", "maybe"}).code, 2);
     ClientRun maps = dermis({"maps", sid, "bump", "-o", *dir_ / "frames/bump.png"});
     ASSERT_EQ(maps.code, 0) << maps;
     EXPECT_EQ(slurp(*dir_ / "frames/bump.png").substr(1, 3), "PNG");
@@ -472,6 +488,41 @@ TEST_F(ClientHttpTest, BadArgumentsServerErrorsAndNoServer) {
     ClientRun down = dermis({"--server", "http://127.0.0.1:1", "--retries", "0", "health"});
     EXPECT_EQ(down.code, 3) << down;
     EXPECT_EQ(down.err, "dermis: error: cannot connect to http://127.0.0.1:1: connection refused or host unreachable (--server)\n");
+}
+
+// A farm's scene file names its image-based light by file, as dermis-server render --scene reads
+// it: the client sends it by content address like the model and patterns (issue #26).
+TEST_F(ClientHttpTest, SceneFileEnvironmentIsSentByContent) {
+    const float sky[3] = {1.6f, 0.5f, 0.1f}, ground[3] = {0.05f, 0.1f, 0.4f};
+    fs::create_directories(*dir_ / "shot");
+    writeText(*dir_ / "shot/sky.hdr", radianceHdr(64, 32, sky, ground));
+    const auto sceneWith = [&](const std::string& name, const std::string& environment) {
+        const json doc = {{"format", "dermis.scene/1"},
+                          {"model", "builtin:default"},
+                          {"render", {{"size", {64, 64}}, {"shading", "pbr"}, {"environment", environment}}}};
+        writeText(*dir_ / ("shot/" + name), doc.dump());
+        return *dir_ / ("shot/" + name);
+    };
+    const auto renderTo = [&](const std::string& scene, const std::string& dir) {
+        return dermis({"--json", "render", "--scene-file", scene, "--frames", "0:0.04:0.02", "-o",
+                       *dir_ / (dir + "/f_%04d.png")});
+    };
+    ClientRun byFile = renderTo(sceneWith("file.scene.json", "sky.hdr"), "file");
+    ASSERT_EQ(byFile.code, 0) << byFile;
+    EXPECT_GE(byFile.js()["content_sent"].get<int>(), 1) << byFile;
+
+    ClientRun up = dermis({"environment", "upload", *dir_ / "shot/sky.hdr"});
+    ASSERT_EQ(up.code, 0) << up;
+    ClientRun byId = renderTo(sceneWith("id.scene.json", up.firstLine()), "id");
+    ASSERT_EQ(byId.code, 0) << byId;
+    ClientRun studio = renderTo(sceneWith("studio.scene.json", "builtin:studio"), "studio");
+    ASSERT_EQ(studio.code, 0) << studio;
+    for (const char* f : {"f_0000.png", "f_0001.png"}) {
+        const std::string a = slurp(*dir_ / ("file/" + std::string(f)));
+        ASSERT_GT(a.size(), 100u) << f;
+        EXPECT_EQ(a, slurp(*dir_ / ("id/" + std::string(f)))) << f << ": by content and by id differ";
+        EXPECT_NE(a, slurp(*dir_ / ("studio/" + std::string(f)))) << f << ": the environment changed nothing";
+    }
 }
 
 TEST_F(ClientHttpTest, RenderResumeAfterKillWritesExactlyTheRest) {

@@ -36,6 +36,7 @@ public:
         std::lock_guard<std::mutex> lock(mutex_);
         ++frames_;
         last_ = req.render;
+        lastEnvironment_ = req.environment;
         double sum = req.render.camera.yaw * 0.37 + req.render.camera.pitch * 0.11;
         if (req.heights)
             for (const BakePlacement& p : req.heights->placements) sum += p.t * 97.0 + p.h;
@@ -84,6 +85,11 @@ public:
         std::lock_guard<std::mutex> lock(mutex_);
         return last_;
     }
+    /// The last frame's environment image (null: the built-in studio, or none decoded).
+    std::shared_ptr<const EnvironmentImage> lastEnvironment() const {
+        std::lock_guard<std::mutex> lock(mutex_);
+        return lastEnvironment_;
+    }
 
 private:
     void enterGate() {
@@ -98,6 +104,7 @@ private:
     mutable std::mutex mutex_;
     int frames_ = 0, bakes_ = 0;
     RenderSettings last_;
+    std::shared_ptr<const EnvironmentImage> lastEnvironment_;
     std::mutex gateMutex_;
     std::condition_variable gateCv_;
     bool blocked_ = false;

@@ -318,9 +318,8 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
         if (pbrOrder) {
             bindMaterialTextures(model, gm, gp, whiteTexture);
             // glTF BLEND: over what is behind, without hiding what is drawn after it.
-            const bool blend = gp.material >= 0 &&
-                               static_cast<std::size_t>(gp.material) < model.materials.size() &&
-                               model.materials[static_cast<std::size_t>(gp.material)].alphaMode == AlphaMode::Blend;
+            const Material* mat = materialOf(model, gp);
+            const bool blend = mat && mat->alphaMode == AlphaMode::Blend;
             if (blend) {
                 glEnable(GL_BLEND);
                 glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);

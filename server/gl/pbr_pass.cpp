@@ -44,12 +44,6 @@ EnvironmentImage resampled(const EnvironmentImage& img, int w, int h) {
     return out;
 }
 
-const Material* materialOf(const Model& model, const GpuModel::Part& gp) {
-    if (gp.material < 0 || static_cast<std::size_t>(gp.material) >= model.materials.size())
-        return nullptr;
-    return &model.materials[static_cast<std::size_t>(gp.material)];
-}
-
 GLuint imageTexture(const std::vector<GLuint>& textures, int image) {
     return image >= 0 && static_cast<std::size_t>(image) < textures.size()
                ? textures[static_cast<std::size_t>(image)]
@@ -57,6 +51,12 @@ GLuint imageTexture(const std::vector<GLuint>& textures, int image) {
 }
 
 } // namespace
+
+const Material* materialOf(const Model& model, const GpuModel::Part& gp) {
+    if (gp.material < 0 || static_cast<std::size_t>(gp.material) >= model.materials.size())
+        return nullptr;
+    return &model.materials[static_cast<std::size_t>(gp.material)];
+}
 
 Result<const Renderer::Impl::EnvironmentLight*>
 Renderer::Impl::environmentLight(const std::shared_ptr<const EnvironmentImage>& env) {

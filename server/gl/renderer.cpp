@@ -195,7 +195,7 @@ Status Renderer::Impl::buildPrograms() {
 
 Result<GLuint> Renderer::Impl::skinProgram(bool tess, FrameView view, bool pbr, bool skinShading,
                                            bool keyLight) {
-    if (keyLight && (pbr || skinShading)) {
+    if (keyLight) { // (asked for pbr and skin frames only)
         GLuint& p = keyLightPrograms[tess ? 1 : 0][skinShading ? 1 : 0];
         if (!p) {
             auto built = buildSkinProgram(tess, FrameView::Shaded, true, skinShading, true);

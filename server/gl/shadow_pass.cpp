@@ -143,10 +143,7 @@ Status Renderer::Impl::keyLightStage(const Model& model, const GpuModel& gm,
     for (std::size_t pi = 0; pi < parts.size(); ++pi) {
         const GpuModel::Part& gp = parts[pi];
         if (gp.indexCount == 0) continue;
-        const Material* m = gp.material >= 0 && static_cast<std::size_t>(gp.material) < model.materials.size()
-                                ? &model.materials[static_cast<std::size_t>(gp.material)]
-                                : nullptr;
-        if (m && m->alphaMode == AlphaMode::Blend) continue;
+        if (const Material* m = materialOf(model, gp); m && m->alphaMode == AlphaMode::Blend) continue;
         glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
                           static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));
         bindMaterialTextures(model, gm, gp, whiteTexture);

@@ -83,4 +83,8 @@ std::size_t ContentCache::approxBytes(const PatternImage& image) {
     return sizeof(PatternImage) + image.pixels.data.size() * sizeof(float) * 4 / 3;
 }
 
+std::size_t ContentCache::approxBytes(const EnvironmentImage& image) {
+    return sizeof(EnvironmentImage) + image.texels.size() * sizeof(glm::vec3);
+}
+
 } // namespace dermis

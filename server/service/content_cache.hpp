@@ -1,15 +1,16 @@
-// Dermis service — the content cache of a stateless replica (SPEC §7, issue #15): models and
-// pattern images that batch renders sent inline, kept by content address ("sha256:<64 hex>") so
+// Dermis service — the content cache of a stateless replica (SPEC §7, issue #15): models, pattern
+// images and environments that batch renders sent inline, kept by content address ("sha256:<64 hex>") so
 // that the next batch naming the same hash needs no bytes. Least recently used entries are dropped
 // once the decoded sizes exceed a byte budget.
 //
-// Holds decoded content only (a Model, a PatternImage), shared and immutable: an entry dropped
+// Holds decoded content only (a Model, a PatternImage, an EnvironmentImage), shared and immutable: an entry dropped
 // while a render uses it lives on until that render lets it go. Does not decode, hash or check
 // anything (service_content.cpp does), does not persist, and knows nothing of uploads (those are
 // stored; this is a cache that may forget at any time). Thread-safe: one mutex, held for map work
 // only.
 #pragma once
 
+#include "core/environment.hpp"
 #include "core/heightmap.hpp"
 #include "core/model.hpp"
 #include "core/model_derived.hpp"
@@ -27,13 +28,14 @@ namespace dermis {
 
 class ContentCache {
 public:
-    /// A cached item: one of `model` / `pattern` is set. A model comes with its derived data
+    /// A cached item: one of `model` / `pattern` / `environment` is set. A model comes with its derived data
     /// (its generated layout, rest-surface maps, UV index…: built on first use and kept with the
     /// model, so that the next batch naming it bakes none of them again).
     struct Item {
         std::shared_ptr<const Model> model;
         std::shared_ptr<const PatternImage> pattern;
         std::shared_ptr<const ModelDerived> derived; ///< with `model`
+        std::shared_ptr<const EnvironmentImage> environment;
     };
     struct Stats {
         std::size_t entries = 0, bytes = 0, budget = 0;
@@ -57,6 +59,8 @@ public:
     static std::size_t approxBytes(const Model& model);
     /// The bytes of a pattern image's pixels and mip levels.
     static std::size_t approxBytes(const PatternImage& image);
+    /// The bytes of an environment's texels.
+    static std::size_t approxBytes(const EnvironmentImage& image);
 
 private:
     struct Entry {

@@ -136,7 +136,8 @@ Result<Service::State::Prepared> Service::State::prepare(const json& docIn, bool
     auto scene = parseScene(doc, manifest);
     if (!scene) return scene.error();
     if (const std::string& env = scene->render.environment;
-        !env.empty() && env != kBuiltinStudioEnvironment && !environments.count(env))
+        !env.empty() && env != kBuiltinStudioEnvironment && !environments.count(env) &&
+        !(overlay && overlay->environments.count(env)))
         return notFound("/render/environment", "no environment \"" + env +
                                                    "\" (use builtin:studio or an id from POST /environments)");
     // A (valid) alias no placement names is dropped (issue #12.5): it would otherwise keep its
@@ -212,6 +213,9 @@ Service::State::Snapshot Service::State::snapshotOf(const Scene& scene, std::sha
     for (const Placement& p : snap.scene.placements)
         if (auto img = find(p.pattern)) snap.images.emplace(p.pattern, std::move(img));
     if (snap.scene.heightmapBase) snap.base = find(*snap.scene.heightmapBase);
+    if (overlay)
+        if (auto it = overlay->environments.find(scene.render.environment); it != overlay->environments.end())
+            snap.environment = it->second;
     // The model's derived data (layout, rest maps, UV index…): its entry's, built once per model;
     // for a batch's content-addressed model the one the content cache keeps with it.
     if (auto entry = models.find(scene.model);

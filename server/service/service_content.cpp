@@ -1,10 +1,11 @@
-// Content addresses in batches (SPEC §7, issue #15): a stateless batch may name its model and
-// patterns as "sha256:<hex>" so that any replica can serve it. What a replica lacks it lists in a
+// Content addresses in batches (SPEC §7, issue #15): a stateless batch may name its model,
+// patterns and environment as "sha256:<hex>" so that any replica can serve it. What a replica lacks it lists in a
 // MissingContent error; the client sends those bytes along (multipart parts named by address),
 // which are checked, decoded by the role the document gives them and kept in the content cache.
 #include "service_state.hpp"
 
 #include "common/sha256.hpp"
+#include "service/store.hpp"
 
 #include <algorithm>
 
@@ -17,7 +18,7 @@ namespace {
 constexpr const char* kWhere = "dermis::Service::batch";
 constexpr const char* kPrefix = "sha256:";
 
-enum class Role { Model, Pattern };
+enum class Role { Model, Pattern, Environment };
 
 /// Where a document names a content address, and as what.
 struct Ref {
@@ -25,11 +26,19 @@ struct Ref {
     Role role;
 };
 
-const char* roleName(Role r) { return r == Role::Model ? "model" : "pattern"; }
+/// The role with its article, for messages.
+const char* roleName(Role r) {
+    return r == Role::Model ? "a model" : r == Role::Pattern ? "a pattern" : "an environment";
+}
+
+/// Whether `item` holds content of `role`.
+bool holds(const ContentCache::Item& item, Role role) {
+    return role == Role::Model ? bool(item.model) : role == Role::Pattern ? bool(item.pattern) : bool(item.environment);
+}
 
 /// Every member of `doc` that may name content and does so with the "sha256:" prefix: the model,
-/// the pattern map's values, placements' patterns and the height map's base. Other members are
-/// left to the scene parser. Fails on a malformed address.
+/// the pattern map's values, placements' patterns, the height map's base and the render's
+/// environment. Other members are left to the scene parser. Fails on a malformed address.
 Result<std::vector<Ref>> collectRefs(const json& doc) {
     std::vector<Ref> out;
     const auto consider = [&](const json& v, const std::string& field, Role role) -> Status {
@@ -57,6 +66,9 @@ Result<std::vector<Ref>> collectRefs(const json& doc) {
     if (auto hm = doc.find("heightmap"); hm != doc.end() && hm->is_object())
         if (auto base = hm->find("base"); base != hm->end())
             if (auto s = consider(*base, "/heightmap/base", Role::Pattern); !s) return s.error();
+    if (auto r = doc.find("render"); r != doc.end() && r->is_object())
+        if (auto env = r->find("environment"); env != r->end())
+            if (auto s = consider(*env, "/render/environment", Role::Environment); !s) return s.error();
     return out;
 }
 
@@ -78,14 +90,15 @@ Result<ContentOverlay> Service::State::resolveContent(
         auto [it, added] = wanted.emplace(r.address, &r);
         if (!added && it->second->role != r.role)
             return makeError(ErrorCode::InvalidArgument, kWhere, r.field,
-                             "names " + r.address.substr(0, 19) + "… as a " + roleName(r.role) + ", but " +
-                                 it->second->field + " names it as a " + roleName(it->second->role));
+                             "names " + r.address.substr(0, 19) + "… as " + roleName(r.role) + ", but " +
+                                 it->second->field + " names it as " + roleName(it->second->role));
     }
     ContentOverlay out;
     const auto hold = [&](const std::string& address, const ContentCache::Item& item) {
         if (item.model) out.models[address] = item.model;
         if (item.model && item.derived) out.derived[address] = item.derived;
         if (item.pattern) out.images[address] = item.pattern;
+        if (item.environment) out.environments[address] = item.environment;
     };
 
     // The parts sent along: all checked against their names first (nothing is kept from a batch
@@ -105,8 +118,7 @@ Result<ContentOverlay> Service::State::resolveContent(
         auto use = wanted.find(address);
         if (use == wanted.end()) continue;
         // Sent again although cached (the client cannot know): not decoded twice.
-        if (ContentCache::Item cached = content->find(address);
-            use->second->role == Role::Model ? bool(cached.model) : bool(cached.pattern)) {
+        if (ContentCache::Item cached = content->find(address); holds(cached, use->second->role)) {
             hold(address, cached);
             continue;
         }
@@ -122,6 +134,15 @@ Result<ContentOverlay> Service::State::resolveContent(
             cost = ContentCache::approxBytes(*model);
             item.model = std::make_shared<const Model>(std::move(*model));
             item.derived = std::make_shared<const ModelDerived>(item.model);
+        } else if (use->second->role == Role::Environment) {
+            auto env = decodeEnvironmentBytes(bytes, store->dir(), limits.maxImageSide, address);
+            if (!env) {
+                Error e = env.error();
+                e.message = std::string(kWhere) + ": " + address + " (" + use->second->field + "): " + e.message;
+                return e;
+            }
+            item.environment = std::make_shared<const EnvironmentImage>(std::move(*env));
+            cost = ContentCache::approxBytes(*item.environment);
         } else {
             auto img = decodePatternBytes(bytes, limits, kWhere, address, decodeBudget.get());
             if (!img) {
@@ -144,13 +165,21 @@ Result<ContentOverlay> Service::State::resolveContent(
     std::vector<std::string> missing;
     std::string firstField;
     std::shared_lock<std::shared_mutex> lock(mutex);
+    std::vector<std::pair<std::string, std::string>> storedEnvironments; // address, upload id
     for (const auto& [address, ref] : wanted) {
-        if (out.models.count(address) || out.images.count(address)) continue;
+        if (out.models.count(address) || out.images.count(address) || out.environments.count(address)) continue;
         ContentCache::Item item = content->find(address);
-        if (ref->role == Role::Model ? !item.model : !item.pattern) {
+        if (!holds(item, ref->role)) {
             item = {};
             const std::string hex = address.substr(std::char_traits<char>::length(kPrefix));
-            if (ref->role == Role::Model) {
+            if (ref->role == Role::Environment) {
+                // An upload's id is its SHA-256's prefix (Store::contentId); decoded below, unlocked.
+                const std::string id = Store::contentId("e", hex);
+                if (environments.count(id)) {
+                    storedEnvironments.emplace_back(address, id);
+                    continue;
+                }
+            } else if (ref->role == Role::Model) {
                 for (const auto& [id, e] : models)
                     if (e.sha256 == hex) {
                         item.model = e.model;
@@ -162,12 +191,13 @@ Result<ContentOverlay> Service::State::resolveContent(
                         if (auto img = images.find(id); img != images.end()) item.pattern = img->second;
             }
         }
-        if (item.model || item.pattern) {
+        if (holds(item, ref->role)) {
             hold(address, item);
             continue;
         }
         missing.push_back(address);
     }
+    lock.unlock();
     if (!missing.empty()) {
         for (const Ref& r : *refs)
             if (std::find(missing.begin(), missing.end(), r.address) != missing.end()) {
@@ -181,6 +211,11 @@ Result<ContentOverlay> Service::State::resolveContent(
                                 "listed address (named by it) with the bytes");
         e.missing = std::move(missing);
         return e;
+    }
+    for (const auto& [address, id] : storedEnvironments) {
+        auto image = environmentImage(id);
+        if (!image) return image.error();
+        out.environments[address] = std::move(*image);
     }
     return out;
 }

@@ -36,6 +36,27 @@ std::string environmentExtension(const std::vector<std::uint8_t>& b) {
 
 } // namespace
 
+Result<EnvironmentImage> detail::decodeEnvironmentBytes(const std::vector<std::uint8_t>& bytes,
+                                                        const std::string& dataDir, int maxSide,
+                                                        const std::string& field) {
+    const char* where = "dermis::decodeEnvironmentBytes";
+    const std::string ext = environmentExtension(bytes);
+    if (ext.empty())
+        return makeError(ErrorCode::Parse, where, field, "expected a Radiance .hdr or an OpenEXR image of linear radiance");
+    const std::string temp = dataDir + "/environments/" + Store::newId("u") + kTempMarker + "upload." + ext;
+    if (auto s = writeFileAtomically(temp, bytes); !s) return withoutDataPath(s.error(), dataDir);
+    auto image = readEnvironmentImage(temp, maxSide);
+    std::error_code ec;
+    std::filesystem::remove(temp, ec);
+    if (!image) {
+        Error e = withoutDataPath(image.error(), dataDir);
+        e.field = field;
+        if (e.code == ErrorCode::NotFound) e.code = ErrorCode::Parse;
+        return e;
+    }
+    return image;
+}
+
 json Service::listEnvironments() const {
     std::shared_lock<std::shared_mutex> lock(state_->mutex);
     json out = json::array();
@@ -69,21 +90,11 @@ Result<json> Service::addEnvironment(const std::vector<std::uint8_t>& bytes, con
             return environmentSummary(known->second);
         }
     }
-    // Decoded from a temporary file first (the image module reads files; a unique name with the
-    // temp marker, which Store::open sweeps should this process die here), outside the write
-    // lock (scene edits do not wait for a decode), then stored with its size.
+    // Decoded first, outside the write lock (scene edits do not wait for a decode), then stored
+    // with its size.
     const std::string folder = state_->store->dir() + "/environments/";
-    const std::string temp = folder + Store::newId("u") + kTempMarker + "upload." + ext;
-    if (auto s = writeFileAtomically(temp, bytes); !s) return withoutDataPath(s.error(), state_->store->dir());
-    auto image = readEnvironmentImage(temp, limits_.maxImageSide);
-    std::error_code ec;
-    std::filesystem::remove(temp, ec);
-    if (!image) {
-        Error e = withoutDataPath(image.error(), state_->store->dir());
-        e.field = "body";
-        if (e.code == ErrorCode::NotFound) e.code = ErrorCode::Parse;
-        return e;
-    }
+    auto image = decodeEnvironmentBytes(bytes, state_->store->dir(), limits_.maxImageSide, "body");
+    if (!image) return image.error();
     std::lock_guard<std::mutex> write(state_->writeMutex);
     if (auto s = state_->store->putBlob("environments", id, ext, bytes,
                                         {{"name", sanitizeName(name)}, {"bytes", bytes.size()},

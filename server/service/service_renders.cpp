@@ -116,9 +116,12 @@ Result<Image8> Service::State::renderImage(const Snapshot& snap, const FramePara
     FrameRequest request = frameRequest(*plan, snap.model);
     request.outlines = std::move(*outlines);
     // The scene's environment, where the frame's light is image-based (legacy frames never
-    // decode it).
-    if (request.render.shading != Shading::Legacy || request.view == FrameView::Lighting ||
-        request.view == FrameView::BaseColor) {
+    // decode it): a batch's by content address, else the one its id names.
+    const bool imageBased = request.render.shading != Shading::Legacy || request.view == FrameView::Lighting ||
+                            request.view == FrameView::BaseColor;
+    if (imageBased && snap.environment) {
+        request.environment = snap.environment;
+    } else if (imageBased) {
         auto env = environmentImage(request.render.environment);
         if (!env) return env.error();
         request.environment = std::move(*env);

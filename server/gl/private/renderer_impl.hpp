@@ -177,6 +177,9 @@ struct HeightSource {
 /// their UV sets and KHR_texture_transform, alpha mode and flags. A part without a material
 /// gets the legacy skin tone as a rough dielectric.
 void fillMaterialBlock(PartBlock& pb, const Model& model, const GpuModel& gm, const GpuModel::Part& gp);
+/// The glTF material of part `gp`; null for a part without one (or with an index past the model's
+/// materials), which the pbr shading draws as the default material.
+const Material* materialOf(const Model& model, const GpuModel::Part& gp);
 /// Binds the material's textures of `gp` to units 2–6 (pbr.glsl), `white` where it has none.
 void bindMaterialTextures(const Model& model, const GpuModel& gm, const GpuModel::Part& gp, GLuint white);
 /// The order to draw `parts` in: opaque and masked parts first (as given), then blended ones

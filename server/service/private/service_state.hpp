@@ -79,7 +79,9 @@ struct ContentOverlay {
     /// upload keeps one: snapshots of the model share it instead of baking their own.
     std::map<std::string, std::shared_ptr<const ModelDerived>> derived;
     PatternImages images;
-    bool empty() const { return models.empty() && images.empty(); }
+    /// Environments (`render.environment` "sha256:<hex>"), decoded.
+    std::map<std::string, std::shared_ptr<const EnvironmentImage>> environments;
+    bool empty() const { return models.empty() && images.empty() && environments.empty(); }
 };
 
 /// "sha256:" followed by 64 lower-case hex digits.
@@ -97,6 +99,13 @@ Result<Model> decodeModelBytes(const std::vector<std::uint8_t>& bytes, const Ser
 Result<HeightImage> decodePatternBytes(const std::vector<std::uint8_t>& bytes, const ServerLimits& limits,
                                        const char* where, const std::string& field,
                                        DecodeBudget* budget = nullptr);
+/// An environment's bytes (a Radiance .hdr or an OpenEXR, recognised by their signature)
+/// decoded through a temporary file in data folder `dataDir`'s environments/ (the image module
+/// reads files; the name carries the temp marker, which Store::open sweeps should the process die
+/// there), sides within `maxSide`. Parse with `field` for bytes that are neither format or do not
+/// decode; messages show `dataDir` as <data>.
+Result<EnvironmentImage> decodeEnvironmentBytes(const std::vector<std::uint8_t>& bytes, const std::string& dataDir,
+                                                int maxSide, const std::string& field);
 
 /// One revision of a scene as it was validated: its canonical document and its scene (shared,
 /// immutable: readers keep them after the lock is released).
@@ -295,6 +304,9 @@ struct Service::State {
         /// listed: a batch's content-addressed model); null when made elsewhere (derivedOf
         /// finds it then).
         std::shared_ptr<const ModelDerived> derived;
+        /// A batch's environment named by content address (from its overlay); null: the one
+        /// `scene.render.environment` names (environmentImage).
+        std::shared_ptr<const EnvironmentImage> environment;
     };
     Result<Snapshot> snapshot(const std::string& id) const;
     /// The derived data of `snap`'s model (service_inspect.cpp): the one its model entry keeps,
