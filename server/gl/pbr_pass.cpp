@@ -52,7 +52,7 @@ GLuint imageTexture(const std::vector<GLuint>& textures, int image) {
 
 } // namespace
 
-const Material* materialOf(const Model& model, const GpuModel::Part& gp) {
+const Material* gl::materialOf(const Model& model, const GpuModel::Part& gp) {
     if (gp.material < 0 || static_cast<std::size_t>(gp.material) >= model.materials.size())
         return nullptr;
     return &model.materials[static_cast<std::size_t>(gp.material)];
