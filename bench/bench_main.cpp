@@ -12,7 +12,8 @@
 //    along the squat clip: height pass, skin pass, post-process AA, readback, PNG encode and
 //    total, at 512² and 1024², anti-aliasing off, post (render.aa "post") and MSAA 4x, legacy and
 //    pbr and skin shading (render.shading; GPU maps only; at 1024² without AA also with the
-//    key light, render.key_light, unshadowed and shadowed: "key_light"), with GPU
+//    key light, render.key_light, unshadowed and shadowed, and shadowed with the pose still and
+//    the camera turning, "shadowed_orbit", whose shadow map is reused: "key_light"), with GPU
 //    height maps and with CPU height maps (the paper's "CPU" configuration). Stages are
 //    separated by glFinish. "aa_quality": SSIM of one 1024² frame per mode against MSAA 4x and
 //    against a supersampled frame (2048² MSAA 4x, 2×2 blocks averaged).
@@ -94,16 +95,19 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
         for (const Shading shading : {Shading::Legacy, Shading::Pbr, Shading::Skin})
         for (int size : {512, 1024})
             for (const AntiAliasing aa : {AntiAliasing::None, AntiAliasing::Post, AntiAliasing::Msaa})
-            for (const char* key : {"none", "unshadowed", "shadowed"}) {
+            for (const char* key : {"none", "unshadowed", "shadowed", "shadowed_orbit"}) {
                 // The pbr and skin shadings' cost is measured with GPU maps only; the key light's
                 // (render.key_light, with and without its shadow map) at 1024² without AA.
                 if (cpuMaps && shading != Shading::Legacy) continue;
                 const bool keyLight = std::string_view(key) != "none";
+                // "shadowed_orbit": the pose still and the camera turning, as when orbiting the
+                // view in the editor: the shadow map is drawn once and reused.
+                const bool orbit = std::string_view(key) == "shadowed_orbit";
                 if (keyLight && (shading == Shading::Legacy || size != 1024 || aa != AntiAliasing::None)) continue;
                 scene.render.keyLight.reset();
                 if (keyLight) {
                     scene.render.keyLight = KeyLight{};
-                    scene.render.keyLight->shadow = std::string_view(key) == "shadowed";
+                    scene.render.keyLight->shadow = std::string_view(key) != "unshadowed";
                 }
                 // Off, the post-process edge pass (render.aa "post"), MSAA 4x.
                 const int msaa = aa == AntiAliasing::Msaa ? 4 : 1;
@@ -118,7 +122,8 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                     for (int r = 0; r <= repeat; ++r) {
                         const auto t0 = std::chrono::steady_clock::now();
                         FrameOverrides overrides;
-                        overrides.time = duration * (r % 8) / 8.0; // the pose moves every frame
+                        overrides.time = orbit ? duration * 0.5 : duration * (r % 8) / 8.0; // the pose moves every frame
+                        if (orbit) overrides.yaw = 15.0 * r;
                         auto plan = planFrame(scene, *model, ds.images, nullptr, overrides);
                         if (!plan) {
                             std::cerr << plan.error().message << "\n";
@@ -163,6 +168,7 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                                  {"heightmaps", cpuMaps ? "cpu" : "gpu"},
                                  {"shading", toString(shading)},
                                  {"key_light", key},
+                                 {"moves", orbit ? "camera" : "pose"},
                                  {"frame_size", size},
                                  {"map_size", 1024},
                                  {"aa", toString(aa)},

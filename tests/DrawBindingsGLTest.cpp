@@ -13,7 +13,9 @@
 //   * pbr frames and tessellated displacement after both; the key light's shadow pass on the
 //     many-part model, then a frame of the one-part model;
 //   * the images of the checked renderer equal those of an unchecked one (the check only reads);
-//   * a key light's first frame (which makes its textures) equals its next.
+//   * a key light's first frame (which makes its textures) equals its next;
+//   * a shadow map reused while only the camera moves, and drawn again when the pose, the heights
+//     (vertex displacement) or the light change, gives the frames a fresh renderer gives.
 #include "BuildPaths.hpp"
 #include "GlTestBackend.hpp"
 #include "gl/renderer.hpp"
@@ -185,4 +187,47 @@ TEST(DrawBindingsGLTest, AKeyLightsFirstFrameEqualsItsNext) {
         ASSERT_FALSE(first.rgba.empty());
         EXPECT_EQ(first.rgba, next.rgba) << (shadow ? "shadowed" : "unshadowed");
     }
+}
+
+TEST(DrawBindingsGLTest, AReusedShadowMapEqualsAFreshOne) {
+    // The shadow map is drawn again only when what casts changes (ShadowInputs): each frame of one
+    // renderer, some of them reusing its map, must equal that frame from a fresh renderer.
+    const auto cesium = load("/CesiumMan/CesiumMan.glb");
+    ASSERT_TRUE(cesium);
+    const auto pattern = dome();
+    auto gl = checkedRenderer();
+    ASSERT_TRUE(gl);
+    FrameRequest req = request(cesium, heights(*pattern, 4));
+    req.render.size = {128, 128};
+    req.render.shading = Shading::Pbr;
+    req.render.keyLight = KeyLight{};
+    req.render.keyLight->direction = {0.8, 0.6, 0.3};
+    req.render.displacementScale = 0.05; // the displaced placements move what casts
+    const auto fresh = [&](const FrameRequest& r, const char* what) {
+        auto other = checkedRenderer();
+        return other ? frame(*other, r, what) : Image8{};
+    };
+    const auto check = [&](const FrameRequest& r, const char* what) {
+        const Image8 mine = frame(*gl, r, what), theirs = fresh(r, what);
+        EXPECT_FALSE(mine.rgba.empty()) << what;
+        EXPECT_EQ(mine.rgba, theirs.rgba) << what;
+        return mine;
+    };
+    const Image8 first = check(req, "first");
+    FrameRequest orbit = req;
+    orbit.render.camera.yaw = 40.0;
+    const Image8 turned = check(orbit, "the camera turned (the map reused)");
+    EXPECT_NE(first.rgba, turned.rgba);
+    FrameRequest posed = orbit;
+    posed.world = worldMatrices(*cesium, sampleClip(*cesium, 0, 0.9f));
+    const Image8 moved = check(posed, "the pose moved");
+    FrameRequest displaced = posed;
+    displaced.heights->placements[1].t = 1.0; // a displacement placement at full activation
+    displaced.heights->placements[3].t = 0.0;
+    check(displaced, "the displacement changed");
+    FrameRequest relit = displaced;
+    relit.render.keyLight->direction = {-0.8, 0.6, 0.3};
+    check(relit, "the light moved");
+    check(displaced, "back to the first light");
+    EXPECT_NE(first.rgba, moved.rgba);
 }

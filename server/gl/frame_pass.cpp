@@ -168,8 +168,7 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
     const bool keyLight = pbr && rs.keyLight &&
                           (req.view == FrameView::Shaded || req.view == FrameView::Lighting);
     if (keyLight)
-        if (auto s = keyLightStage(model, **gm, **parts, *rs.keyLight, bounds, dispScale,
-                                   heightSource->texture, heightSource->size, partStride);
+        if (auto s = keyLightStage(req, layout, **gm, **parts, bounds, dispScale, *heightSource, partStride);
             !s)
             return s.error();
     const auto program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr,

@@ -262,6 +262,7 @@ Status Renderer::Impl::ensureHeightTargets(int w, int h) {
     if (heights.fbo && heights.width == w && heights.height == h) return Ok{};
     heights.destroy();
     lastHeights.reset();
+    ++heightsWritten;
     heights.width = w;
     heights.height = h;
     heights.maps = makeFloatTexture(w, h, nullptr, GL_LINEAR, 2);
@@ -309,12 +310,13 @@ Status Renderer::Impl::heightPass(const HeightPassInput& in) {
         settings.rest = in.rest.get();
         if (auto s = dermis::bakeHeightMapsInto(in.placements, settings, cpuBake); !s) return s;
         if (auto s = uploadHeightMaps(cpuBake); !s) return s;
-        lastHeights = std::move(key);
+        lastHeights = std::move(key); // (uploadHeightMaps counted the write)
         ++heightPasses;
         ++heightPassesOnCpu;
         return Ok{};
     }
     const std::size_t stride = uploadHeightBlocks(in, *resolved);
+    ++heightsWritten;
     drawHeightPass(in, *resolved, stride);
     // Mesa's llvmpipe (egl-surfaceless and OSMesa alike) was seen to let the skin pass sample
     // part of the previous content of the height targets when this pass follows an upload of CPU
@@ -429,6 +431,7 @@ Status Renderer::Impl::uploadHeightMaps(const HeightMaps& maps) {
                          "bump and displacement maps must be non-empty and of one size");
     if (auto s = ensureHeightTargets(W, H); !s) return s;
     lastHeights.reset(); // the targets now hold CPU maps
+    ++heightsWritten;
     const std::size_t n = static_cast<std::size_t>(W) * H;
     heights.staging.resize(2 * n);
     const float* b = maps.bump.data.data();

@@ -41,6 +41,13 @@ GLuint makeShadowTexture(int size, const float* depth) {
 
 } // namespace
 
+bool ShadowInputs::sameAs(const ShadowInputs& o) const {
+    const auto sameOwner = [](const auto& a, const auto& b) { return !a.owner_before(b) && !b.owner_before(a); };
+    return sameOwner(model, o.model) && !model.expired() && sameOwner(layout, o.layout) && world == o.world &&
+           morphWeights == o.morphWeights && viewProj == o.viewProj && dispScale == o.dispScale &&
+           heightTexture == o.heightTexture && heightsWritten == o.heightsWritten && heightmapSize == o.heightmapSize;
+}
+
 void ShadowTarget::destroy() {
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &depth);
@@ -50,6 +57,7 @@ void ShadowTarget::destroy() {
 Status Renderer::Impl::ensureShadowTarget(int size) {
     if (shadowMap.fbo && shadowMap.size == size) return Ok{};
     shadowMap.destroy();
+    lastShadow.reset();
     shadowMap.size = size;
     shadowMap.depth = makeShadowTexture(size, nullptr);
     glGenFramebuffers(1, &shadowMap.fbo);
@@ -65,10 +73,12 @@ Status Renderer::Impl::ensureShadowTarget(int size) {
     return checkGl("creating the shadow map");
 }
 
-Status Renderer::Impl::keyLightStage(const Model& model, const GpuModel& gm,
-                                     const std::vector<GpuModel::Part>& parts, const KeyLight& light,
-                                     const Bounds& bounds, double dispScale, GLuint heightTexture,
-                                     glm::vec2 heightmapSize, std::size_t partStride) {
+Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_ptr<const TextureLayout>& layout,
+                                     const GpuModel& gm, const std::vector<GpuModel::Part>& parts,
+                                     const Bounds& bounds, double dispScale, const HeightSource& heightSource,
+                                     std::size_t partStride) {
+    const Model& model = *req.model;
+    const KeyLight& light = *req.render.keyLight;
     if (!keyLightUbo) {
         glGenBuffers(1, &keyLightUbo);
         glGenBuffers(1, &shadowFrameUbo);
@@ -114,12 +124,22 @@ Status Renderer::Impl::keyLightStage(const Model& model, const GpuModel& gm,
         glActiveTexture(GL_TEXTURE0);
         return s;
     }
+    ShadowInputs inputs{req.model, layout, req.world, req.morphWeights, sc.viewProj, dispScale,
+                        heightSource.texture, heightsWritten, heightSource.size};
+    if (lastShadow && lastShadow->sameAs(inputs)) {
+        ++shadowPassesReused;
+        glActiveTexture(kUnitShadowMap);
+        glBindTexture(GL_TEXTURE_2D, shadowMap.depth);
+        glActiveTexture(GL_TEXTURE0);
+        return checkGl("key light");
+    }
+    lastShadow.reset(); // until drawn
     // The light's view in a FrameBlock of its own (skin.vert reads the displacement scale from it).
     FrameBlock fb{};
     fb.viewProj = sc.viewProj;
     fb.cameraPos = glm::vec4(0.5f * (bounds.min + bounds.max) + 2.0f * sc.radius * sc.towardsLight, 0.0f);
     fb.heights = glm::vec4(static_cast<float>(dispScale), 0.0f, 0.0f, 0.0f);
-    fb.heightmapSize = glm::vec4(heightmapSize, 1.0f / heightmapSize.x, 1.0f / heightmapSize.y);
+    fb.heightmapSize = glm::vec4(heightSource.size, 1.0f / heightSource.size.x, 1.0f / heightSource.size.y);
     fb.viewport = glm::vec4(static_cast<float>(size), static_cast<float>(size), 6.0f, 16.0f);
     glBindBuffer(GL_UNIFORM_BUFFER, shadowFrameUbo);
     glBufferSubData(GL_UNIFORM_BUFFER, 0, sizeof fb, &fb);
@@ -139,7 +159,7 @@ Status Renderer::Impl::keyLightStage(const Model& model, const GpuModel& gm,
     glClearBufferfv(GL_DEPTH, 0, &one);
     glUseProgram(shadowProgram);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, heightTexture);
+    glBindTexture(GL_TEXTURE_2D, heightSource.texture);
     for (std::size_t pi = 0; pi < parts.size(); ++pi) {
         const GpuModel::Part& gp = parts[pi];
         if (gp.indexCount == 0) continue;
@@ -158,7 +178,10 @@ Status Renderer::Impl::keyLightStage(const Model& model, const GpuModel& gm,
     glActiveTexture(kUnitShadowMap);
     glBindTexture(GL_TEXTURE_2D, shadowMap.depth);
     glActiveTexture(GL_TEXTURE0);
-    return checkGl("shadow pass");
+    if (auto s = checkGl("shadow pass"); !s) return s;
+    lastShadow = std::move(inputs);
+    ++shadowPasses;
+    return Ok{};
 }
 
 } // namespace dermis

@@ -165,6 +165,25 @@ struct ShadowTarget {
     void destroy();
 };
 
+/// What a shadow map was drawn from (shadow_pass.cpp): the model and height-map layout (by owner,
+/// so that a new object at a freed one's address is another), the pose, the light's view, the
+/// displacement and the height maps' content (heightsWritten). A key-light frame whose inputs
+/// equal the last drawn map's — only its camera moved, as when orbiting in the editor — reuses it.
+struct ShadowInputs {
+    std::weak_ptr<const Model> model;
+    std::weak_ptr<const TextureLayout> layout;
+    std::vector<glm::mat4> world;
+    std::vector<float> morphWeights;
+    glm::mat4 viewProj{1.0f};
+    double dispScale = 0.0;
+    GLuint heightTexture = 0;
+    std::uint64_t heightsWritten = 0;
+    glm::vec2 heightmapSize{0.0f};
+
+    /// The same model and layout objects and equal values.
+    bool sameAs(const ShadowInputs& o) const;
+};
+
 /// The height maps a frame samples: a texture (RG32F) and its size.
 struct HeightSource {
     GLuint texture = 0;
@@ -268,6 +287,9 @@ struct Renderer::Impl {
     GLuint keyLightPrograms[2][2] = {};
     GLuint shadowProgram = 0;
     gl::ShadowTarget shadowMap;
+    /// What `shadowMap` holds (drawn from); reset when the target is made anew.
+    std::optional<gl::ShadowInputs> lastShadow;
+    std::size_t shadowPasses = 0, shadowPassesReused = 0;
     /// 1×1 depth texture (compare mode, depth 1: lit), bound for key lights without a shadow.
     GLuint noShadowTexture = 0;
     /// The KeyLightBlock, and the FrameBlock of the shadow pass (the light's view).
@@ -305,6 +327,9 @@ struct Renderer::Impl {
     std::size_t patternBytes = 0, modelBytes = 0; ///< sums of the entries' bytes
     std::size_t evictions = 0, forgotten = 0;
     std::optional<gl::HeightKey> lastHeights; ///< what `heights` holds now, if from a height pass
+    /// Counts writes of the height targets (passes drawn or baked, uploads, new targets): what a
+    /// shadow map's reuse compares (vertex displacement moves what casts).
+    std::uint64_t heightsWritten = 0;
     std::size_t heightPasses = 0, heightPassesSkipped = 0, heightPassesOnCpu = 0;
     double softwareCpuBakeCoverage = 2.0; ///< RendererOptions::softwareCpuBakeCoverage
     bool checkBindings = false;           ///< RendererOptions::checkBindings
@@ -425,11 +450,13 @@ struct Renderer::Impl {
     /// it casts shadows, the shadow map drawn from it: every part but glTF BLEND ones, skinned and
     /// displaced as the frame draws them (vertex displacement), MASK parts by their cutoff; the
     /// part blocks must be uploaded (uploadPartBlocks with pbr) and the palette too. Binds the
-    /// map (or the 1×1 lit one) to unit 9 and leaves the frame's FrameBlock bound.
-    Status keyLightStage(const Model& model, const gl::GpuModel& gm,
-                         const std::vector<gl::GpuModel::Part>& parts, const KeyLight& light,
-                         const Bounds& bounds, double dispScale, GLuint heightTexture,
-                         glm::vec2 heightmapSize, std::size_t partStride);
+    /// map (or the 1×1 lit one) to unit 9 and leaves the frame's FrameBlock bound. The light is
+    /// req.render.keyLight (set); `layout` the parts' height-map layout (null: the model's UVs).
+    /// The map is not drawn again while its inputs stay the same (ShadowInputs).
+    Status keyLightStage(const FrameRequest& req, const std::shared_ptr<const TextureLayout>& layout,
+                         const gl::GpuModel& gm, const std::vector<gl::GpuModel::Part>& parts,
+                         const Bounds& bounds, double dispScale, const gl::HeightSource& heightSource,
+                         std::size_t partStride);
     Status ensureShadowTarget(int size);
     Result<std::vector<SkinnedPart>> skinOnGpu(const std::shared_ptr<const Model>& model,
                                                const std::vector<glm::mat4>& world,
