@@ -27,9 +27,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <fstream>
 #include <string>
 #include <thread>
@@ -413,6 +416,31 @@ std::vector<int> openConnections(int port, int n) {
     return socks;
 }
 
+/// One keep-alive GET /api/v1/health on `s`, read to the end of its body (Content-Length): the
+/// server has taken the connection (its thread registered it) and now waits for its next request.
+bool answeredOnce(int s) {
+    if (!sendAll(s, "GET /api/v1/health HTTP/1.1\r\nHost: t\r\n\r\n")) return false;
+    std::string text;
+    const auto t0 = Clock::now();
+    char buf[4096];
+    while (secondsSince(t0) < 5.0) {
+        pollfd p{s, POLLIN, 0};
+        if (::poll(&p, 1, 20) <= 0) continue;
+        const ssize_t n = ::recv(s, buf, sizeof buf, 0);
+        if (n <= 0) return false;
+        text.append(buf, static_cast<std::size_t>(n));
+        const std::size_t head = text.find("\r\n\r\n");
+        if (head == std::string::npos) continue;
+        std::string lower = text.substr(0, head);
+        std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+        const std::size_t at = lower.find("content-length:");
+        if (at == std::string::npos) return false;
+        const std::size_t length = std::strtoul(lower.c_str() + at + 15, nullptr, 10);
+        if (text.size() >= head + 4 + length) return text.rfind("HTTP/1.1 200", 0) == 0;
+    }
+    return false;
+}
+
 TEST(ConnectionLimitsHttpTest, PerAddressCapRefusesAFifthWhileFourAreBusy) {
     TempDir dir;
     Server server(dir, {"--max-connections-per-address", "4"});
@@ -447,10 +475,16 @@ TEST(ConnectionLimitsHttpTest, PerAddressCapClosesTheOldestIdleConnection) {
     TempDir dir;
     Server server(dir, {"--max-connections-per-address", "4"});
     ASSERT_GT(server.port(), 0) << "dermis-server did not start";
-    // Four idle connections (nothing sent yet): a fifth is answered, the oldest idle one goes.
-    std::vector<int> idle = openConnections(server.port(), 4);
-    ASSERT_EQ(idle.size(), 4u);
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    // Four idle connections, each answered once before the next opens (so that the server took
+    // them in this order: each one's thread registers it, and under load a later connection's
+    // thread could otherwise register first), now waiting for their next request: a fifth is
+    // answered, the oldest idle one goes.
+    std::vector<int> idle;
+    for (int k = 0; k < 4; ++k) {
+        idle.push_back(connectTo(server.port()));
+        ASSERT_GE(idle.back(), 0);
+        ASSERT_TRUE(answeredOnce(idle.back())) << "connection " << k;
+    }
     auto [status, took] = timedHealth(server.port());
     EXPECT_EQ(status, 200);
     EXPECT_LT(took, 1.0);
