@@ -1,10 +1,10 @@
 // Dermis service — the content cache of a stateless replica (SPEC §7, issue #15): models, pattern
-// images and environments that batch renders sent inline, kept by content address ("sha256:<64 hex>") so
-// that the next batch naming the same hash needs no bytes. Least recently used entries are dropped
-// once the decoded sizes exceed a byte budget.
+// images and environments that batch renders sent inline, kept by content address
+// ("sha256:<64 hex>") so that the next batch naming the same hash needs no bytes. Least recently
+// used entries are dropped once the decoded sizes exceed a byte budget.
 //
-// Holds decoded content only (a Model, a PatternImage, an EnvironmentImage), shared and immutable: an entry dropped
-// while a render uses it lives on until that render lets it go. Does not decode, hash or check
+// Holds decoded content only (a Model, a PatternImage, an EnvironmentImage), shared and
+// immutable: an entry dropped while a render uses it lives on until that render lets it go. Does not decode, hash or check
 // anything (service_content.cpp does), does not persist, and knows nothing of uploads (those are
 // stored; this is a cache that may forget at any time). Thread-safe: one mutex, held for map work
 // only.
@@ -28,9 +28,9 @@ namespace dermis {
 
 class ContentCache {
 public:
-    /// A cached item: one of `model` / `pattern` / `environment` is set. A model comes with its derived data
-    /// (its generated layout, rest-surface maps, UV index…: built on first use and kept with the
-    /// model, so that the next batch naming it bakes none of them again).
+    /// A cached item: one of `model` / `pattern` / `environment` is set. A model comes with its
+    /// derived data (its generated layout, rest-surface maps, UV index…: built on first use and
+    /// kept with the model, so that the next batch naming it bakes none of them again).
     struct Item {
         std::shared_ptr<const Model> model;
         std::shared_ptr<const PatternImage> pattern;

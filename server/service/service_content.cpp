@@ -1,7 +1,8 @@
 // Content addresses in batches (SPEC §7, issue #15): a stateless batch may name its model,
-// patterns and environment as "sha256:<hex>" so that any replica can serve it. What a replica lacks it lists in a
-// MissingContent error; the client sends those bytes along (multipart parts named by address),
-// which are checked, decoded by the role the document gives them and kept in the content cache.
+// patterns and environment as "sha256:<hex>" so that any replica can serve it. What a replica
+// lacks it lists in a MissingContent error; the client sends those bytes along (multipart parts
+// named by address), which are checked, decoded by the role the document gives them and kept in
+// the content cache.
 #include "service_state.hpp"
 
 #include "common/sha256.hpp"
