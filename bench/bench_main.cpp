@@ -12,8 +12,8 @@
 //    along the squat clip: height pass, skin pass, post-process AA, readback, PNG encode and
 //    total, at 512² and 1024², anti-aliasing off, post (render.aa "post") and MSAA 4x, legacy and
 //    pbr and skin shading (render.shading; GPU maps only; at 1024² without AA also with the
-//    key light, render.key_light, unshadowed and shadowed, and shadowed with the pose still and
-//    the camera turning, "shadowed_orbit", whose shadow map is reused: "key_light"), with GPU
+//    key light, render.key_light, unshadowed and shadowed, and both with the pose still and the
+//    camera turning, "…_orbit", whose shadow map is reused: "key_light"), with GPU
 //    height maps and with CPU height maps (the paper's "CPU" configuration). Stages are
 //    separated by glFinish. "aa_quality": SSIM of one 1024² frame per mode against MSAA 4x and
 //    against a supersampled frame (2048² MSAA 4x, 2×2 blocks averaged).
@@ -95,19 +95,21 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
         for (const Shading shading : {Shading::Legacy, Shading::Pbr, Shading::Skin})
         for (int size : {512, 1024})
             for (const AntiAliasing aa : {AntiAliasing::None, AntiAliasing::Post, AntiAliasing::Msaa})
-            for (const char* key : {"none", "unshadowed", "shadowed", "shadowed_orbit"}) {
+            for (const char* key : {"none", "unshadowed", "shadowed", "unshadowed_orbit", "shadowed_orbit"}) {
                 // The pbr and skin shadings' cost is measured with GPU maps only; the key light's
                 // (render.key_light, with and without its shadow map) at 1024² without AA.
                 if (cpuMaps && shading != Shading::Legacy) continue;
                 const bool keyLight = std::string_view(key) != "none";
-                // "shadowed_orbit": the pose still and the camera turning, as when orbiting the
-                // view in the editor: the shadow map is drawn once and reused.
-                const bool orbit = std::string_view(key) == "shadowed_orbit";
+                // "…_orbit": the pose still and the camera turning, as when orbiting the view in
+                // the editor: the shadow map is drawn once and reused (the unshadowed orbit is
+                // its baseline: the same pictures without the map).
+                const std::string_view keyName(key);
+                const bool orbit = keyName.size() > 6 && keyName.substr(keyName.size() - 6) == "_orbit";
                 if (keyLight && (shading == Shading::Legacy || size != 1024 || aa != AntiAliasing::None)) continue;
                 scene.render.keyLight.reset();
                 if (keyLight) {
                     scene.render.keyLight = KeyLight{};
-                    scene.render.keyLight->shadow = std::string_view(key) != "unshadowed";
+                    scene.render.keyLight->shadow = keyName.rfind("shadowed", 0) == 0;
                 }
                 // Off, the post-process edge pass (render.aa "post"), MSAA 4x.
                 const int msaa = aa == AntiAliasing::Msaa ? 4 : 1;
