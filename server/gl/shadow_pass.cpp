@@ -45,7 +45,7 @@ bool ShadowInputs::sameAs(const ShadowInputs& o) const {
     const auto sameOwner = [](const auto& a, const auto& b) { return !a.owner_before(b) && !b.owner_before(a); };
     return sameOwner(model, o.model) && !model.expired() && sameOwner(layout, o.layout) && world == o.world &&
            morphWeights == o.morphWeights && viewProj == o.viewProj && dispScale == o.dispScale &&
-           heightTexture == o.heightTexture && heightsWritten == o.heightsWritten && heightmapSize == o.heightmapSize;
+           heightTexture == o.heightTexture && heightsWritten == o.heightsWritten;
 }
 
 void ShadowTarget::destroy() {
@@ -125,9 +125,8 @@ Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_
         return s;
     }
     ShadowInputs inputs{req.model, layout, req.world, req.morphWeights, sc.viewProj, dispScale,
-                        heightSource.texture, heightsWritten, heightSource.size};
+                        heightSource.texture, heightsWritten};
     if (lastShadow && lastShadow->sameAs(inputs)) {
-        ++shadowPassesReused;
         glActiveTexture(kUnitShadowMap);
         glBindTexture(GL_TEXTURE_2D, shadowMap.depth);
         glActiveTexture(GL_TEXTURE0);
@@ -180,7 +179,6 @@ Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_
     glActiveTexture(GL_TEXTURE0);
     if (auto s = checkGl("shadow pass"); !s) return s;
     lastShadow = std::move(inputs);
-    ++shadowPasses;
     return Ok{};
 }
 

@@ -177,8 +177,7 @@ struct ShadowInputs {
     glm::mat4 viewProj{1.0f};
     double dispScale = 0.0;
     GLuint heightTexture = 0;
-    std::uint64_t heightsWritten = 0;
-    glm::vec2 heightmapSize{0.0f};
+    std::uint64_t heightsWritten = 0; ///< (new targets, of another size, count as a write)
 
     /// The same model and layout objects and equal values.
     bool sameAs(const ShadowInputs& o) const;
@@ -289,7 +288,6 @@ struct Renderer::Impl {
     gl::ShadowTarget shadowMap;
     /// What `shadowMap` holds (drawn from); reset when the target is made anew.
     std::optional<gl::ShadowInputs> lastShadow;
-    std::size_t shadowPasses = 0, shadowPassesReused = 0;
     /// 1×1 depth texture (compare mode, depth 1: lit), bound for key lights without a shadow.
     GLuint noShadowTexture = 0;
     /// The KeyLightBlock, and the FrameBlock of the shadow pass (the light's view).
