@@ -51,7 +51,7 @@ void addRenderCommands(CLI::App& app, Context& ctx) {
     frame->add_option("--msaa", o->msaa, "MSAA with 1, 2 or 4 samples")->check(CLI::IsMember({1, 2, 4}));
     frame->add_option("--aa", o->aa, "Anti-aliasing: auto (post on software rasterizers, else MSAA), msaa, post or none")
         ->check(CLI::IsMember({"auto", "msaa", "post", "none"}));
-    frame->add_option("--shading", o->shading, "legacy, pbr (the model's glTF material under image-based light) or skin (pbr with subsurface scattering)")
+    frame->add_option("--shading", o->shading, "pbr (the model's glTF material under image-based light), skin (pbr with subsurface scattering) or legacy (the look before PBR)")
         ->check(CLI::IsMember({"legacy", "pbr", "skin"}));
     frame->add_option("--key-light", o->keyLight, "pbr and skin: on draws the scene's render.key_light (or the default one), off none")
         ->check(CLI::IsMember({"on", "off"}));

@@ -13,6 +13,10 @@
 // height as grey byte 128 + 127·height (clamped to [−1, 1]), 3 the perturbed world normal as bytes
 // 255·(n·0.5 + 0.5). Those are picture values: written through the sRGB EOTF so that the
 // target's encoding gives them back.
+// The pbr programs draw the shaded view; with DERMIS_PBR_VIEWS also the material's views, chosen
+// by u_part.w (3 normal, 4 base colour, 5 lighting). Without DERMIS_PBR_MAPS they never read the
+// metallic-roughness, normal, occlusion and emissive textures (for materials that have none:
+// their checks of u_maps would not spare a software rasterizer the lookups, for the same reason).
 #ifndef DERMIS_VIEW
 #define DERMIS_VIEW 0
 #endif
@@ -154,16 +158,22 @@ void main() {
     if (u_maps.y == 1 && base.a < u_emissive.w) discard;
     // Views of the material (FrameView; u_part.w): 4 base colour as it is, 5 the light alone on a
     // white rough dielectric, 3 the world normal with the model's normal map and the bump.
+#ifdef DERMIS_PBR_VIEWS
     const int view = u_part.w;
+#else
+    const int view = 0;
+#endif
     vec3 color;
     if (view == 4 || ((u_maps.z & 1) != 0 && view != 5 && view != 3)) {
         color = base.rgb; // the base colour view, or KHR_materials_unlit
     } else {
         vec3 gradient = u_part.z != 0 ? bumpGradient(ng) : vec3(0.0);
+#ifdef DERMIS_PBR_MAPS
         if (hasMap(4)) {
             vec3 g = normalMapGradient(ng, materialUv(2, v_uv, v_uv1), v_tangent, v_position);
             gradient += back ? -g : g;
         }
+#endif
         vec3 nn = normalize(ng - gradient);
         if (view == 3) {
             o_color = vec4(outlined(pictureValue(nn * 0.5 + 0.5)), 1.0);
@@ -174,16 +184,21 @@ void main() {
             base = vec4(1.0);
             metallic = 0.0;
             roughness = 1.0;
-        } else if (hasMap(2)) {
+        }
+#ifdef DERMIS_PBR_MAPS
+        else if (hasMap(2)) {
             vec4 mr = texture(u_metallicRoughnessTexture, materialUv(1, v_uv, v_uv1));
             roughness *= mr.g;
             metallic *= mr.b;
         }
+#endif
         metallic = clamp(metallic, 0.0, 1.0);
         roughness = clamp(roughness, 0.03, 1.0);
         float occlusion = 1.0;
+#ifdef DERMIS_PBR_MAPS
         if (hasMap(8) && view != 5)
             occlusion = 1.0 + u_material.w * (texture(u_occlusionTexture, materialUv(3, v_uv, v_uv1)).r - 1.0);
+#endif
 #ifdef DERMIS_SKIN
         color = shadeSkin(base.rgb, metallic, roughness, occlusion, nn, ng, toCamera);
 #else
@@ -193,7 +208,9 @@ void main() {
         color += keyLight(base.rgb, metallic, roughness, nn, ng, toCamera, ng, v_position);
 #endif
         vec3 emissive = u_emissive.rgb;
+#ifdef DERMIS_PBR_MAPS
         if (hasMap(16)) emissive *= texture(u_emissiveTexture, materialUv(4, v_uv, v_uv1)).rgb;
+#endif
         if (view != 5) color += emissive;
     }
     if (view == 4) {

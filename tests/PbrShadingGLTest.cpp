@@ -2,8 +2,8 @@
 // #26), on the backend named by $DERMIS_TEST_GL: the Khronos material models of
 // tests/models/fidelity shaded by their glTF materials under the default studio environment, and
 // the characters still drawn. What each test checks is what the material says: alpha-mask holes,
-// blended cards that let the background through, exposure and tone mapping, and that the default
-// (legacy) frame is untouched. (`skin`: SkinShadingGLTest.)
+// blended cards that let the background through, exposure and tone mapping, that pbr is the
+// default and that `legacy` keeps the old look. (`skin`: SkinShadingGLTest.)
 #include "BuildPaths.hpp"
 #include "GltfTestBuilder.hpp"
 #include "RenderCliTestHelpers.hpp"
@@ -48,12 +48,11 @@ double meanLuma(const Image8& img) {
 
 } // namespace
 
-TEST(PbrShadingGLTest, TheHelmetIsShadedByItsMaterialAndLegacyStaysTheDefault) {
+TEST(PbrShadingGLTest, TheHelmetIsShadedByItsMaterialAndPbrIsTheDefault) {
     TempDir dir;
-    const Image8 legacy = render(dir, kHelmet, "");
-    const Image8 legacyNamed = render(dir, kHelmet, "--shading legacy");
-    EXPECT_EQ(legacy.rgba, legacyNamed.rgba) << "legacy is the default shading";
+    const Image8 legacy = render(dir, kHelmet, "--shading legacy");
     const Image8 pbr = render(dir, kHelmet, "--shading pbr");
+    EXPECT_EQ(render(dir, kHelmet, "").rgba, pbr.rgba) << "pbr is the default shading";
     ASSERT_EQ(pbr.rgba.size(), legacy.rgba.size());
     EXPECT_GT(foreground(pbr), 128u * 128u / 8) << "the helmet fills its frame";
     std::size_t differ = 0;
@@ -61,8 +60,8 @@ TEST(PbrShadingGLTest, TheHelmetIsShadedByItsMaterialAndLegacyStaysTheDefault) {
         if (std::abs(int(pbr.rgba[p]) - int(legacy.rgba[p])) > 16) ++differ;
     EXPECT_GT(differ, pbr.rgba.size() / 20) << "pbr looks like legacy";
     // The scene member says the same as the option.
-    const Image8 fromScene = render(dir, kHelmet, "", {{"shading", "pbr"}});
-    EXPECT_EQ(fromScene.rgba, pbr.rgba);
+    const Image8 fromScene = render(dir, kHelmet, "", {{"shading", "legacy"}});
+    EXPECT_EQ(fromScene.rgba, legacy.rgba);
 }
 
 TEST(PbrShadingGLTest, ExposureZeroLeavesABlackSilhouette) {
@@ -129,6 +128,76 @@ std::string alphaQuad(const TempDir& dir, const std::string& alphaMode, double a
     const std::string path = dir / (alphaMode + ".glb");
     writeText(path, std::string(glb.begin(), glb.end()));
     return path;
+}
+
+/// Two squares of side 0.9 facing +Z, left (x < 0) and right, each with the base colour texture
+/// of a 2×2 image; the right one's material also has an occlusion texture of one grey `occlusion`
+/// (0–255) when `occlusion` ≥ 0. (For the pbr program variants with and without the material's
+/// other maps.)
+std::string twoSquares(const TempDir& dir, const std::string& name, int occlusion) {
+    namespace g = dermis::test::gltf;
+    g::Builder b;
+    std::vector<float> pos, nrm, uv;
+    for (const float x0 : {-1.0f, 0.1f}) {
+        pos.insert(pos.end(), {x0, -0.45f, 0, x0 + 0.9f, -0.45f, 0, x0 + 0.9f, 0.45f, 0, x0, 0.45f, 0});
+        nrm.insert(nrm.end(), {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1});
+        uv.insert(uv.end(), {0, 1, 1, 1, 1, 0, 0, 0});
+    }
+    const int p = b.add(pos, g::kFloat, "VEC3");
+    const int n = b.add(nrm, g::kFloat, "VEC3");
+    const int t = b.add(uv, g::kFloat, "VEC2");
+    const int left = b.add(std::vector<std::uint16_t>{0, 1, 2, 0, 2, 3}, g::kUShort, "SCALAR");
+    const int right = b.add(std::vector<std::uint16_t>{4, 5, 6, 4, 6, 7}, g::kUShort, "SCALAR");
+    writeImage(dir / "base.png", 2, 2, 4,
+               std::vector<std::uint8_t>{200, 120, 90, 255, 90, 160, 220, 255, 240, 230, 120, 255, 120, 200, 130, 255},
+               OIIO::TypeDesc::UINT8);
+    const std::uint8_t o = static_cast<std::uint8_t>(std::max(occlusion, 0));
+    writeImage(dir / "occ.png", 2, 2, 4, std::vector<std::uint8_t>{o, o, o, 255, o, o, o, 255, o, o, o, 255, o, o, o, 255},
+               OIIO::TypeDesc::UINT8);
+    b.doc["images"] = json::array({{{"bufferView", b.view(readBytes(dir / "base.png"))}, {"mimeType", "image/png"}},
+                                   {{"bufferView", b.view(readBytes(dir / "occ.png"))}, {"mimeType", "image/png"}}});
+    b.doc["textures"] = json::array({{{"source", 0}}, {{"source", 1}}});
+    json plain = {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicFactor", 0.2}, {"roughnessFactor", 0.4}}}};
+    json occluded = plain;
+    if (occlusion >= 0) occluded["occlusionTexture"] = {{"index", 1}};
+    b.doc["materials"] = json::array({plain, occluded});
+    json mesh = {{"primitives", json::array()}};
+    for (const auto& [indices, material] : {std::pair{left, 0}, std::pair{right, 1}})
+        mesh["primitives"].push_back({{"attributes", {{"POSITION", p}, {"NORMAL", n}, {"TEXCOORD_0", t}}},
+                                      {"indices", indices}, {"material", material}});
+    b.doc["meshes"] = json::array({mesh});
+    b.doc["nodes"] = json::array({{{"mesh", 0}}});
+    b.doc["scenes"] = json::array({{{"nodes", {0}}}});
+    b.doc["scene"] = 0;
+    const std::vector<std::uint8_t> glb = b.glb();
+    const std::string path = dir / (name + ".glb");
+    writeText(path, std::string(glb.begin(), glb.end()));
+    return path;
+}
+
+// A frame whose materials have no texture besides the base colour is drawn by the pbr program
+// without the others' lookups (DERMIS_PBR_MAPS, renderer_impl.hpp pbrPrograms); one with them by
+// the program with. Both shade the same pixels: a white occlusion map (occlusion 1) on the right
+// square draws the frame without it, while a grey one darkens that square alone.
+TEST(PbrShadingGLTest, TheProgramWithoutMaterialMapsShadesAsTheOneWithThem) {
+    TempDir dir;
+    const json front = {{"camera", {{"yaw", 0}, {"pitch", 0}}}};
+    const Image8 none = render(dir, twoSquares(dir, "none", -1), "--shading pbr", front);
+    const Image8 white = render(dir, twoSquares(dir, "white", 255), "--shading pbr", front);
+    const Image8 grey = render(dir, twoSquares(dir, "grey", 100), "--shading pbr", front);
+    ASSERT_EQ(none.width, 128);
+    EXPECT_GT(foreground(none), 128u * 128u / 8) << "the squares are drawn";
+    EXPECT_EQ(white.rgba, none.rgba) << "the variants differ where the map has no effect";
+    std::size_t leftDiffer = 0, rightDarker = 0;
+    for (int y = 0; y < 128; ++y)
+        for (int x = 0; x < 128; ++x) {
+            const std::size_t i = (static_cast<std::size_t>(y) * 128 + x) * 4;
+            const bool differ = grey.rgba[i] != none.rgba[i] || grey.rgba[i + 1] != none.rgba[i + 1];
+            if (x < 64) leftDiffer += differ;
+            else rightDarker += grey.rgba[i + 1] + 8 < none.rgba[i + 1];
+        }
+    EXPECT_EQ(leftDiffer, 0u) << "the left square's material has no occlusion map";
+    EXPECT_GT(rightDarker, 500u) << "the grey occlusion map darkens the right square";
 }
 
 TEST(PbrShadingGLTest, AlphaMaskCutsHolesAndBlendLetsTheBackgroundThrough) {
@@ -215,7 +284,7 @@ TEST(PbrShadingGLTest, MaterialViewsTakeTheMaterialApart) {
     const Image8 base = render(dir, kHelmet, "--shading pbr --view basecolor");
     const Image8 light = render(dir, kHelmet, "--shading pbr --view lighting");
     const Image8 normal = render(dir, kHelmet, "--shading pbr --view normal");
-    const Image8 legacyNormal = render(dir, kHelmet, "--view normal");
+    const Image8 legacyNormal = render(dir, kHelmet, "--shading legacy --view normal");
     EXPECT_NE(base.rgba, shaded.rgba);
     EXPECT_NE(light.rgba, shaded.rgba);
     EXPECT_NE(normal.rgba, legacyNormal.rgba)

@@ -365,6 +365,13 @@ TEST(SceneTest, EveryShadingRoundTrips) {
     EXPECT_EQ(s.render.shading, dermis::Shading::Skin);
     EXPECT_EQ(dermis::toJson(s)["render"]["shading"], "skin");
     expectStableRoundTrip(doc(R"("render":{"shading":"skin"})"));
+    // pbr is the default (since 2026-11-30): not written; legacy, the old default, is.
+    const Scene plain = parseOk(doc(""));
+    EXPECT_EQ(plain.render.shading, dermis::Shading::Pbr);
+    EXPECT_FALSE(dermis::toJson(plain)["render"].contains("shading"));
+    const Scene legacy = parseOk(doc(R"("render":{"shading":"legacy"})"));
+    EXPECT_EQ(dermis::toJson(legacy)["render"]["shading"], "legacy");
+    expectStableRoundTrip(doc(R"("render":{"shading":"legacy"})"));
 }
 
 TEST(SceneTest, EnvironmentIsWrittenOnlyWhenNamed) {

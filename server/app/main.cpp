@@ -333,9 +333,9 @@ int main(int argc, char** argv) {
                           "(overrides render.aa)")
         ->check(CLI::IsMember({"auto", "msaa", "post", "none"}));
     renderCmd->add_option("--shading", render.shading,
-                          "legacy (one key light, the look before PBR), pbr (the model's glTF material "
-                          "under image-based light) or skin (pbr with light scattered under the skin and a "
-                          "second specular lobe; overrides render.shading)")
+                          "pbr (the default: the model's glTF material under image-based light), skin (pbr "
+                          "with light scattered under the skin and a second specular lobe) or legacy (one key "
+                          "light, the look before PBR; overrides render.shading)")
         ->check(CLI::IsMember({"legacy", "pbr", "skin"}));
     renderCmd->add_option("--exposure", render.exposure, "pbr: light scale before tone mapping (overrides render.exposure)")
         ->check(CLI::Range(0.0, 64.0));

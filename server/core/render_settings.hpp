@@ -44,10 +44,11 @@ std::string_view toString(AntiAliasing a);
 std::optional<AntiAliasing> antiAliasingFromString(std::string_view s);
 
 /// How the skin pass shades (`render.shading`). Legacy: the base colour under one Blinn-Phong key
-/// light and a hemisphere fill (Dermis ≤ 2026-11; kept for comparisons). Pbr: the model's glTF
-/// metallic-roughness material (base colour, metallic-roughness, normal, occlusion and emissive
-/// textures, alpha modes, vertex colours, KHR_texture_transform, unlit) under image-based light
-/// from the default studio environment (core/environment.hpp), with exposure and tone mapping.
+/// light and a hemisphere fill (the default until 2026-11-30; kept for comparisons). Pbr, the
+/// default: the model's glTF metallic-roughness material (base colour, metallic-roughness,
+/// normal, occlusion and emissive textures, alpha modes, vertex colours, KHR_texture_transform,
+/// unlit) under image-based light from the default studio environment (core/environment.hpp),
+/// with exposure and tone mapping.
 /// Skin: pbr for previews of skin (issue #26), so that a wrinkle reads as it would on skin —
 /// light scattered under the surface, approximated for image-based light: the irradiance's
 /// spherical-harmonic bands 1 and 2 attenuated per channel as a Gaussian diffusion profile of
@@ -113,7 +114,7 @@ struct RenderSettings {
     /// "vertex": displace the mesh's own vertices (the paper); "tessellated": subdivide each
     /// triangle on the GPU first, so that bulges smaller than a triangle still move the surface.
     DisplacementMode displacement = DisplacementMode::Vertex;
-    Shading shading = Shading::Legacy;
+    Shading shading = Shading::Pbr; ///< legacy before 2026-11-30 (issue #26)
     double exposure = 1.0;                        ///< pbr: light × exposure before tone mapping
     ToneMapping toneMapping = ToneMapping::Neutral; ///< pbr only
     double environmentRotation = 0.0; ///< pbr: degrees the environment turns about +Y

@@ -50,6 +50,14 @@ GLuint imageTexture(const std::vector<GLuint>& textures, int image) {
                : 0;
 }
 
+/// The default studio environment prefiltered, once per process (the first caller computes it,
+/// ≈ 0.1 s; C++ statics make the others wait): every renderer of a process (a server's, a test
+/// suite's many) shares the same deterministic result instead of prefiltering it again.
+const PrefilteredEnvironment& studioPrefiltered() {
+    static const PrefilteredEnvironment pre = prefilterEnvironment(studioEnvironment());
+    return pre;
+}
+
 } // namespace
 
 const Material* gl::materialOf(const Model& model, const GpuModel::Part& gp) {
@@ -84,7 +92,9 @@ Renderer::Impl::environmentLight(const std::shared_ptr<const EnvironmentImage>& 
     } else if (studioLight.specular) {
         return &studioLight;
     }
-    const PrefilteredEnvironment pre = prefilterEnvironment(env ? *env : studioEnvironment());
+    PrefilteredEnvironment custom;
+    if (env) custom = prefilterEnvironment(*env);
+    const PrefilteredEnvironment& pre = env ? custom : studioPrefiltered();
     for (std::size_t k = 0; k < 9; ++k) light->block.irradianceSh[k] = glm::vec4(pre.irradianceSh[k], 0.0f);
     const int levels = static_cast<int>(pre.specular.size());
     light->block.params = glm::vec4(1.0f, 1.0f, 0.0f, static_cast<float>(std::max(levels - 1, 0)));
@@ -138,32 +148,49 @@ void fillMaterialBlock(PartBlock& pb, const Model& model, const GpuModel& gm,
     pb.emissive = glm::vec4(m.emissiveFactor, m.alphaCutoff);
     pb.material =
         glm::vec4(m.metallicFactor, m.roughnessFactor, m.normalScale, m.occlusionStrength);
-    const struct {
-        int image;
-        const TextureUv* uv;
-        bool data;
-        int bit;
-    } maps[5] = {{m.baseColorTexture, &m.baseColorUv, false, kMapBaseColor},
-                 {m.metallicRoughnessTexture, &m.metallicRoughnessUv, true, kMapMetallicRoughness},
-                 {m.normalTexture, &m.normalUv, true, kMapNormal},
-                 {m.occlusionTexture, &m.occlusionUv, true, kMapOcclusion},
-                 {m.emissiveTexture, &m.emissiveUv, false, kMapEmissive}};
-    int present = 0, uvSets = 0;
+    // The textures in pbr.glsl's order (materialUv's k): their UV sets and transforms.
+    const TextureUv* uvs[5] = {&m.baseColorUv, &m.metallicRoughnessUv, &m.normalUv, &m.occlusionUv,
+                               &m.emissiveUv};
+    int uvSets = 0;
     for (int k = 0; k < 5; ++k) {
-        const auto& t = maps[k];
-        const bool uvOk = t.uv->texCoord == 1 ? gp.hasUVs1 : gp.hasUVs;
-        if (imageTexture(t.data ? gm.dataTextures : gm.textures, t.image) && uvOk) present |= t.bit;
-        if (t.uv->texCoord == 1) uvSets |= 1 << k;
-        const glm::mat3 x = t.uv->matrix();
+        if (uvs[k]->texCoord == 1) uvSets |= 1 << k;
+        const glm::mat3 x = uvs[k]->matrix();
         pb.uvTransform[2 * k] = glm::vec4(x[0][0], x[1][0], x[2][0], 0.0f);
         pb.uvTransform[2 * k + 1] = glm::vec4(x[0][1], x[1][1], x[2][1], 0.0f);
     }
     const int alpha = m.alphaMode == AlphaMode::Mask ? 1 : m.alphaMode == AlphaMode::Blend ? 2 : 0;
     const int flags = (m.unlit ? kPartUnlit : 0) | (gp.hasTangents ? kPartTangents : 0) |
                       (gp.hasColors ? kPartColors : 0);
-    pb.maps = glm::ivec4(present, alpha, flags, uvSets);
+    pb.maps = glm::ivec4(materialMaps(model, gm, gp), alpha, flags, uvSets);
     if (!mat) pb.baseColor = glm::vec4(0.80f, 0.62f, 0.54f, 1.0f); // the legacy skin tone
     if (!mat) pb.material = glm::vec4(0.0f, 0.6f, 1.0f, 1.0f);     // a dielectric, not glTF's metal
+}
+
+int materialMaps(const Model& model, const GpuModel& gm, const GpuModel::Part& gp) {
+    const Material* m = materialOf(model, gp);
+    if (!m) return 0;
+    const struct {
+        int image;
+        const TextureUv& uv;
+        bool data;
+        int bit;
+    } maps[5] = {{m->baseColorTexture, m->baseColorUv, false, kMapBaseColor},
+                 {m->metallicRoughnessTexture, m->metallicRoughnessUv, true, kMapMetallicRoughness},
+                 {m->normalTexture, m->normalUv, true, kMapNormal},
+                 {m->occlusionTexture, m->occlusionUv, true, kMapOcclusion},
+                 {m->emissiveTexture, m->emissiveUv, false, kMapEmissive}};
+    int present = 0;
+    for (const auto& t : maps) {
+        const bool uvOk = t.uv.texCoord == 1 ? gp.hasUVs1 : gp.hasUVs;
+        if (imageTexture(t.data ? gm.dataTextures : gm.textures, t.image) && uvOk) present |= t.bit;
+    }
+    return present;
+}
+
+bool needsMaterialMaps(const Model& model, const GpuModel& gm, const std::vector<GpuModel::Part>& parts) {
+    return std::any_of(parts.begin(), parts.end(), [&](const GpuModel::Part& gp) {
+        return (materialMaps(model, gm, gp) & ~kMapBaseColor) != 0;
+    });
 }
 
 void bindMaterialTextures(const Model& model, const GpuModel& gm, const GpuModel::Part& gp,

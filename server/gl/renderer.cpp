@@ -187,38 +187,28 @@ Status Renderer::Impl::buildPrograms() {
         for (FrameView view : {FrameView::Shaded, FrameView::Bump, FrameView::Displacement, FrameView::Normal})
             if (auto p = buildSkinProgram(tess, view); !p) return p.error();
             else skinPrograms[tess ? 1 : 0][static_cast<int>(view)] = *p;
-        if (auto p = buildSkinProgram(tess, FrameView::Shaded, true); !p) return p.error();
-        else pbrPrograms[tess ? 1 : 0] = *p;
+        if (auto p = skinProgram(tess, FrameView::Shaded, true); !p) return p.error();
     }
     return Ok{};
 }
 
 Result<GLuint> Renderer::Impl::skinProgram(bool tess, FrameView view, bool pbr, bool skinShading,
-                                           bool keyLight) {
-    if (keyLight) { // (asked for pbr and skin frames only)
-        GLuint& p = keyLightPrograms[tess ? 1 : 0][skinShading ? 1 : 0];
-        if (!p) {
-            auto built = buildSkinProgram(tess, FrameView::Shaded, true, skinShading, true);
-            if (!built) return built.error();
-            p = *built;
-        }
-        return p;
+                                           bool keyLight, bool maps) {
+    if (!pbr) return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
+    // The skin shading's program draws its shaded view only; its other views are pbr's.
+    const unsigned variant = (tess ? kPbrTess : 0u) | (skinShading ? kPbrSkin : 0u) |
+                             (keyLight ? kPbrKeyLight : 0u) | (maps ? kPbrMaps : 0u) |
+                             (view != FrameView::Shaded ? kPbrViews : 0u);
+    GLuint& p = pbrPrograms[variant];
+    if (!p) {
+        auto built = buildSkinProgram(tess, FrameView::Shaded, true, variant);
+        if (!built) return built.error();
+        p = *built;
     }
-    if (skinShading) {
-        GLuint& p = skinShadingPrograms[tess ? 1 : 0];
-        if (!p) {
-            auto built = buildSkinProgram(tess, FrameView::Shaded, true, true);
-            if (!built) return built.error();
-            p = *built;
-        }
-        return p;
-    }
-    if (pbr) return pbrPrograms[tess ? 1 : 0];
-    return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
+    return p;
 }
 
-Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool pbr, bool skinShading,
-                                                bool keyLight) {
+Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool pbr, unsigned variant) {
     ProgramDesc desc;
     desc.stages = {{GL_VERTEX_SHADER, "skin.vert"}};
     if (tess) {
@@ -228,11 +218,10 @@ Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool 
     }
     desc.stages.push_back({GL_FRAGMENT_SHADER, "skin.frag"});
     desc.defines.push_back("DERMIS_VIEW " + std::to_string(static_cast<int>(view)));
-    if (pbr) {
-        desc.defines.push_back("DERMIS_PBR");
-        desc.includes.push_back({GL_FRAGMENT_SHADER, "pbr.glsl"});
-    }
-    if (skinShading) {
+    if (!pbr) return buildProgram(desc);
+    desc.defines.push_back("DERMIS_PBR");
+    desc.includes.push_back({GL_FRAGMENT_SHADER, "pbr.glsl"});
+    if (variant & kPbrSkin) {
         auto vec3 = [](const double (&v)[3]) {
             return "vec3(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
         };
@@ -242,7 +231,9 @@ Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool 
         desc.defines.push_back("DERMIS_SKIN_LOBE_ROUGHNESS " + std::to_string(kSkinSecondLobeRoughness));
         desc.defines.push_back("DERMIS_SKIN_LOBE_WEIGHT " + std::to_string(kSkinSecondLobeWeight));
     }
-    if (keyLight) desc.defines.push_back("DERMIS_KEY_LIGHT");
+    if (variant & kPbrKeyLight) desc.defines.push_back("DERMIS_KEY_LIGHT");
+    if (variant & kPbrMaps) desc.defines.push_back("DERMIS_PBR_MAPS");
+    if (variant & kPbrViews) desc.defines.push_back("DERMIS_PBR_VIEWS");
     return buildProgram(desc);
 }
 
@@ -314,19 +305,9 @@ void Renderer::Impl::shutdown() {
             glDeleteProgram(p);
             p = 0;
         }
-    for (GLuint& p : pbrPrograms) {
+    for (const auto& [variant, p] : pbrPrograms)
         glDeleteProgram(p);
-        p = 0;
-    }
-    for (GLuint& p : skinShadingPrograms) {
-        glDeleteProgram(p);
-        p = 0;
-    }
-    for (auto& bySkin : keyLightPrograms)
-        for (GLuint& p : bySkin) {
-            glDeleteProgram(p);
-            p = 0;
-        }
+    pbrPrograms.clear();
     glDeleteProgram(shadowProgram);
     shadowProgram = 0;
     shadowMap.destroy();
@@ -351,11 +332,11 @@ void Renderer::Impl::shutdown() {
 }
 
 Result<Renderer::BlockLayout> Renderer::Impl::blockLayout(const std::string& block) {
-    // The tessellated PBR program uses every member of the skin pass's blocks; its key light
-    // variant declares the KeyLightBlock.
-    GLuint program = block == "HeightPassBlock" ? heightProgram : pbrPrograms[1];
-    if (block == "KeyLightBlock") {
-        auto p = skinProgram(true, FrameView::Shaded, true, false, true);
+    // The tessellated PBR program with the material's maps and views uses every member of the
+    // skin pass's blocks; its key light variant declares the KeyLightBlock.
+    GLuint program = heightProgram;
+    if (block != "HeightPassBlock") {
+        auto p = skinProgram(true, FrameView::Lighting, true, false, block == "KeyLightBlock", true);
         if (!p) return p.error();
         program = *p;
     }

@@ -120,6 +120,10 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       await until(() => page.$eval("#frame", (i) => /shading=pbr/.test(i.dataset.url || "")), "a pbr frame");
       const pbrHash = await settledFrameHash(page);
       assert.notEqual(pbrHash, skinHash, "pbr is not skin");
+      assert.equal(pbrHash, hash0, "pbr is the default shading: the scene's own frame");
+      await page.selectOption("#viewMode", "legacy");
+      await until(() => page.$eval("#frame", (i) => /shading=legacy/.test(i.dataset.url || "")), "a legacy frame");
+      assert.notEqual(await settledFrameHash(page), pbrHash, "legacy, the old look, is another picture");
       await screenshot(page, "editor-pbr-view.png");
       await page.selectOption("#viewMode", "skin-key");
       await until(() => page.$eval("#frame", (i) => /shading=skin/.test(i.dataset.url || "") && /key_light=on/.test(i.dataset.url || "")),

@@ -216,13 +216,13 @@ class FrameLoader {
 
 let mainLoader, cmpLoader;
 
-/// The frame parameters of the view mode: "shaded" is the scene's own shading (none), "pbr" and
-/// "skin" a shading for this view (`shading=`), "pbr-key" and "skin-key" that shading with a
+/// The frame parameters of the view mode: "shaded" is the scene's own shading (none), "pbr",
+/// "skin" and "legacy" a shading for this view (`shading=`), "pbr-key" and "skin-key" that shading with a
 /// shadowed key light (`key_light=on`: the scene's, or the default one), the others an unlit view
 /// of the maps (`view=`).
 function viewParams() {
   if (store.view === "shaded") return {};
-  if (store.view === "pbr" || store.view === "skin") return { shading: store.view };
+  if (store.view === "pbr" || store.view === "skin" || store.view === "legacy") return { shading: store.view };
   if (store.view === "pbr-key" || store.view === "skin-key") return { shading: store.view.slice(0, -4), key_light: "on" };
   return { view: store.view };
 }
@@ -238,6 +238,7 @@ export function initFrameView(section, theApi) {
         <option value="skin" title="pbr with light scattered under the skin: how a wrinkle reads on skin">skin</option>
         <option value="pbr-key" title="pbr with a key light and its shadows (the scene's render.key_light, or the default one)">pbr + key light</option>
         <option value="skin-key" title="skin with a key light and its shadows: a wrinkle under one hard light">skin + key light</option>
+        <option value="legacy" title="the old default shading (one Blinn-Phong light, base colour only), for comparisons">legacy</option>
         <option value="bump">bump</option>
         <option value="displacement">displacement</option><option value="normal">normal</option></select></label>
       <label><span class="lbl keep">Compare</span> <select id="compareMode" aria-label="compare mode" title="Compare with another frame: split, flicker, or a diff heat map">

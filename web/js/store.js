@@ -56,7 +56,7 @@ export const store = {
   solo: [],             // placement ids shown alone in the 3D view (frame only=…)
   presence: new Map(),  // client -> {selection, color, until}; replaced, never changed in place
   layoutMode: "both",   // texture | 3d | both
-  view: "shaded",       // shaded (the scene's shading) | pbr | skin | pbr-key | skin-key | bump | displacement | normal
+  view: "shaded",       // shaded (the scene's shading) | pbr | skin | pbr-key | skin-key | legacy | bump | displacement | normal
   camera: { yaw: 0, pitch: 10, distance: null },
   time: null,           // null: the scene's pose time; else the shown time (playback, scrub)
   pinnedRevision: null, // a permalink's revision, shown until the person edits or leaves it

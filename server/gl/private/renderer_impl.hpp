@@ -195,6 +195,12 @@ struct HeightSource {
 /// their UV sets and KHR_texture_transform, alpha mode and flags. A part without a material
 /// gets the legacy skin tone as a rough dielectric.
 void fillMaterialBlock(PartBlock& pb, const Model& model, const GpuModel& gm, const GpuModel::Part& gp);
+/// The kMap* bits of the textures the pbr shading samples for part `gp` (PartBlock::maps.x as
+/// fillMaterialBlock sets it): those whose image was uploaded and whose UV set the part has.
+int materialMaps(const Model& model, const GpuModel& gm, const GpuModel::Part& gp);
+/// Whether any of `parts` samples a texture besides the base colour (metallic-roughness, normal,
+/// occlusion, emissive): the frame then needs the pbr program with DERMIS_PBR_MAPS.
+bool needsMaterialMaps(const Model& model, const GpuModel& gm, const std::vector<GpuModel::Part>& parts);
 /// The glTF material of part `gp`; null for a part without one (or with an index past the model's
 /// materials), which the pbr shading draws as the default material.
 const Material* materialOf(const Model& model, const GpuModel::Part& gp);
@@ -272,18 +278,19 @@ struct Renderer::Impl {
     /// once blamed on a program linked mid-frame were a stale uniform range past a store that had
     /// shrunk; see checkDrawBindings.)
     GLuint skinPrograms[2][4] = {};
-    /// The shaded view with `render.shading` pbr by [tessellated]: skin.frag + pbr.glsl with
-    /// DERMIS_PBR (built at start with the others).
-    GLuint pbrPrograms[2] = {};
-    /// The shaded view with `render.shading` skin by [tessellated]: the pbr program with
-    /// DERMIS_SKIN. Built on the first frame that asks for skin (a preview shading: a server
-    /// that never shows it does not pay its link at start), on the render thread before the
-    /// frame's draws, and kept.
-    GLuint skinShadingPrograms[2] = {};
-    /// The pbr programs with a key light (DERMIS_KEY_LIGHT; `render.key_light`) by
-    /// [tessellated][skin shading], and the shadow map's depth program (skin.vert with
-    /// DERMIS_PBR + shadow.frag): linked on the first frame that asks, like the skin shading's.
-    GLuint keyLightPrograms[2][2] = {};
+    /// The pbr programs (skin.frag + pbr.glsl with DERMIS_PBR) by the PbrVariant bits they were
+    /// built with: tessellated; DERMIS_SKIN, the shaded view with `render.shading` skin;
+    /// DERMIS_KEY_LIGHT (`render.key_light`); DERMIS_PBR_MAPS, for materials with textures
+    /// besides the base colour; DERMIS_PBR_VIEWS, for the material views (basecolor, lighting,
+    /// normal) besides the shaded one. Each variant leaves out code that a software rasterizer
+    /// would otherwise run for every pixel (1024² pbr skin pass on llvmpipe, default scene:
+    /// docs/benchmarks.md). The plain shaded ones (vertex and tessellated: the default shading)
+    /// are built at start; any other on the first frame that asks for it, on the render thread
+    /// before the frame's draws, and kept.
+    enum PbrVariant : unsigned { kPbrTess = 1, kPbrSkin = 2, kPbrKeyLight = 4, kPbrMaps = 8, kPbrViews = 16 };
+    std::map<unsigned, GLuint> pbrPrograms;
+    /// The shadow map's depth program (skin.vert with DERMIS_PBR + shadow.frag): linked on the
+    /// first frame with a shadowed key light.
     GLuint shadowProgram = 0;
     gl::ShadowTarget shadowMap;
     /// What `shadowMap` holds (drawn from); reset when the target is made anew.
@@ -345,19 +352,19 @@ struct Renderer::Impl {
     void readDriverInfo();
     Status buildPrograms();
     /// Links skin.vert/.frag (+ the tessellation stages when `tess`) with DERMIS_VIEW = `view`
-    /// (+ DERMIS_PBR and pbr.glsl when `pbr`); fails with the GL's log. Only buildPrograms calls
-    /// it (never during a frame).
-    /// With `skinShading` (and `pbr`), the skin shading's variant (DERMIS_SKIN, its constants
-    /// from core/render_settings.hpp as defines).
-    /// With `keyLight` (and `pbr`), the key light's variant (DERMIS_KEY_LIGHT).
-    Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false,
-                                    bool keyLight = false);
-    /// The skin program of a frame (built at start by buildPrograms): the PBR one (every view
-    /// it draws, chosen by PartBlock's u_part.w) with `pbr`; the skin shading's with
-    /// `skinShading`, linked here the first time (fails with the GL's log).
-    /// With `keyLight` (and `pbr`), the key light's variant of either, linked here the first time.
+    /// (+ DERMIS_PBR and pbr.glsl when `pbr`, with the defines of the PbrVariant bits in
+    /// `variant`: kPbrSkin the skin shading's (DERMIS_SKIN, its constants from
+    /// core/render_settings.hpp as defines), kPbrKeyLight DERMIS_KEY_LIGHT, kPbrMaps
+    /// DERMIS_PBR_MAPS, kPbrViews DERMIS_PBR_VIEWS); fails with the GL's log. Called by
+    /// buildPrograms and skinProgram, on the render thread, never between a frame's draws.
+    Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false, unsigned variant = 0);
+    /// The skin program of a frame: with `pbr`, the pbr variant (pbrPrograms) for `view` (the
+    /// shaded view or a material view, chosen in the shader by PartBlock's u_part.w), the skin
+    /// shading's with `skinShading`, the key light's with `keyLight`, sampling the material's
+    /// other textures with `maps`; without, skinPrograms' for `view`. Links a variant the first
+    /// time it is asked for (fails with the GL's log).
     Result<GLuint> skinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false,
-                               bool keyLight = false);
+                               bool keyLight = false, bool maps = false);
     /// The light of `env` (null: the default studio environment), prefiltered on the CPU the
     /// first time a frame asks for it (legacy frames never pay for it) and kept: the studio's for
     /// the renderer's life, a custom one until another replaces it or its owner is gone. Fails
