@@ -1,9 +1,11 @@
-// The key light's shadow map (`render.key_light`, core/render_settings.hpp KeyLight): depth only,
-// drawn from the light (core/key_light.hpp shadowCamera) by skin.vert with DERMIS_PBR, so that a
-// caster is skinned, morphed and displaced as the frame draws it (vertex displacement even when
-// the frame is tessellated). pbr.glsl comes before this file (materialUv, hasMap). A glTF MASK
-// part casts where its alpha reaches the cutoff, as skin.frag draws it; the renderer does not
-// draw BLEND parts into the map, and opaque parts write every fragment.
+// Depth only, for two passes: the key light's shadow map (`render.key_light`,
+// core/render_settings.hpp KeyLight), drawn from the light (core/key_light.hpp shadowCamera), and
+// the skin pass's depth prepass, drawn from the frame's camera (frame_pass.cpp drawSkinPass). By
+// skin.vert with DERMIS_PBR, so that a part is skinned, morphed and displaced as the frame draws
+// it (vertex displacement even when the frame is tessellated; the prepass is not drawn for
+// tessellated frames). pbr.glsl comes before this file (materialUv, hasMap). A glTF MASK part
+// (u_maps.y 1: pbr frames) writes where its alpha reaches the cutoff, as skin.frag draws it; the
+// renderer draws no BLEND parts into either, and opaque parts write every fragment.
 
 layout(binding = 2) uniform sampler2D u_baseColorTexture; // sRGB8_A8: only its alpha is read
 

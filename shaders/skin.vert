@@ -34,6 +34,13 @@ layout(std430, binding = 2) readonly buffer MorphWeights {
 
 layout(binding = 0) uniform sampler2D u_heightMap; // RG32F in the layout's UV space: bump, displacement
 
+#if !defined(DERMIS_TESSELLATED) && !defined(DERMIS_CAPTURE)
+// The skin pass's depth prepass draws with another program (shadow.frag's) and the shading pass
+// keeps only the fragments at exactly its depths (GL_EQUAL): both must compute the same
+// positions, whatever their other outputs let a compiler do.
+invariant gl_Position;
+#endif
+
 out vec3 v_position; // world space
 out vec3 v_normal;   // world space, unit
 out vec2 v_uv;    // the model's TEXCOORD_0: base colour

@@ -304,29 +304,19 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
     glClearBufferfv(GL_COLOR, 0, background);
     glClearBufferfv(GL_DEPTH, 0, &one);
     const bool tess = rs.displacement == DisplacementMode::Tessellated;
-    glUseProgram(skinProgram);
-    if (tess) glPatchParameteri(GL_PATCH_VERTICES, 3);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, heightTexture);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-        const std::size_t pi = pbrOrder ? (*pbrOrder)[k] : k;
+    // glTF BLEND parts (pbr): over what is behind, without hiding what is drawn after them.
+    auto blended = [&](const GpuModel::Part& gp) {
+        const Material* mat = pbrOrder ? materialOf(model, gp) : nullptr;
+        return mat && mat->alphaMode == AlphaMode::Blend;
+    };
+    auto bindPart = [&](std::size_t pi) {
         const GpuModel::Part& gp = parts[pi];
-        if (gp.indexCount == 0) continue;
         glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
                           static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));
         if (pbrOrder) {
             bindMaterialTextures(model, gm, gp, whiteTexture);
-            // glTF BLEND: over what is behind, without hiding what is drawn after it.
-            const Material* mat = materialOf(model, gp);
-            const bool blend = mat && mat->alphaMode == AlphaMode::Blend;
-            if (blend) {
-                glEnable(GL_BLEND);
-                glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-                glDepthMask(GL_FALSE);
-            } else {
-                glDisable(GL_BLEND);
-                glDepthMask(GL_TRUE);
-            }
         } else {
             glActiveTexture(GL_TEXTURE2);
             const GLuint colorTex = gm.baseColorTexture(model, gp);
@@ -334,9 +324,48 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
         }
         bindMorphDeltas(gp);
         glBindVertexArray(gp.vao);
+    };
+    // Depth prepass (vertex displacement): the opaque and masked parts' depths first, by the
+    // depth-only program (a MASK part's cut-out fragments write none), so that the shading pass
+    // below shades each pixel once — the fragments at exactly those depths (GL_EQUAL; skin.vert's
+    // gl_Position is invariant) — instead of every surface that is nearest when it is drawn
+    // (with the default scene's squat at 1024² that was 1.9 fragments per covered pixel, and a
+    // software rasterizer pays the full shading for each). Blended parts are not in it: they
+    // test against it and write no depth, as before.
+    const bool prepass = !tess;
+    if (prepass) {
+        glUseProgram(depthProgram);
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        glDepthMask(GL_TRUE);
+        for (std::size_t pi = 0; pi < parts.size(); ++pi) {
+            if (parts[pi].indexCount == 0 || blended(parts[pi])) continue;
+            bindPart(pi);
+            checkDrawBindings("depth prepass");
+            glDrawElements(GL_TRIANGLES, parts[pi].indexCount, GL_UNSIGNED_INT, nullptr);
+        }
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    }
+    glUseProgram(skinProgram);
+    if (tess) glPatchParameteri(GL_PATCH_VERTICES, 3);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        const std::size_t pi = pbrOrder ? (*pbrOrder)[k] : k;
+        const GpuModel::Part& gp = parts[pi];
+        if (gp.indexCount == 0) continue;
+        if (blended(gp)) {
+            glEnable(GL_BLEND);
+            glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+            glDepthFunc(GL_LESS);
+            glDepthMask(GL_FALSE);
+        } else {
+            glDisable(GL_BLEND);
+            glDepthFunc(prepass ? GL_EQUAL : GL_LESS);
+            glDepthMask(prepass ? GL_FALSE : GL_TRUE);
+        }
+        bindPart(pi);
         checkDrawBindings("skin pass");
         glDrawElements(tess ? GL_PATCHES : GL_TRIANGLES, gp.indexCount, GL_UNSIGNED_INT, nullptr);
     }
+    glDepthFunc(GL_LESS);
     glBindVertexArray(0);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);

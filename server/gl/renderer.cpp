@@ -177,6 +177,9 @@ Status Renderer::Impl::buildPrograms() {
         {&heightBaseProgram, {{{GL_VERTEX_SHADER, "fullscreen.vert"}, {GL_FRAGMENT_SHADER, "heightbase.frag"}}, {}, {}, {}}},
         {&captureProgram,
          {{{GL_VERTEX_SHADER, "skin.vert"}}, {"DERMIS_CAPTURE"}, {"v_position", "v_normal"}, {}}},
+        {&depthProgram,
+         {{{GL_VERTEX_SHADER, "skin.vert"}, {GL_FRAGMENT_SHADER, "shadow.frag"}}, {"DERMIS_PBR"}, {},
+          {{GL_FRAGMENT_SHADER, "pbr.glsl"}}}},
     };
     for (Build& b : builds) {
         auto p = buildProgram(b.desc);
@@ -308,8 +311,8 @@ void Renderer::Impl::shutdown() {
     for (const auto& [variant, p] : pbrPrograms)
         glDeleteProgram(p);
     pbrPrograms.clear();
-    glDeleteProgram(shadowProgram);
-    shadowProgram = 0;
+    glDeleteProgram(depthProgram);
+    depthProgram = 0;
     shadowMap.destroy();
     glDeleteTextures(1, &noShadowTexture);
     noShadowTexture = 0;

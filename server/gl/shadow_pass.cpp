@@ -111,15 +111,6 @@ Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_
         return checkGl("key light");
     }
 
-    if (!shadowProgram) {
-        ProgramDesc desc;
-        desc.stages = {{GL_VERTEX_SHADER, "skin.vert"}, {GL_FRAGMENT_SHADER, "shadow.frag"}};
-        desc.defines = {"DERMIS_PBR"};
-        desc.includes = {{GL_FRAGMENT_SHADER, "pbr.glsl"}};
-        auto p = buildProgram(desc);
-        if (!p) return p.error();
-        shadowProgram = *p;
-    }
     if (auto s = ensureShadowTarget(size); !s) {
         glActiveTexture(GL_TEXTURE0);
         return s;
@@ -156,7 +147,7 @@ Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_
     glPolygonOffset(1.1f, 2.0f);
     const float one = 1.0f;
     glClearBufferfv(GL_DEPTH, 0, &one);
-    glUseProgram(shadowProgram);
+    glUseProgram(depthProgram);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, heightSource.texture);
     for (std::size_t pi = 0; pi < parts.size(); ++pi) {

@@ -289,9 +289,9 @@ struct Renderer::Impl {
     /// before the frame's draws, and kept.
     enum PbrVariant : unsigned { kPbrTess = 1, kPbrSkin = 2, kPbrKeyLight = 4, kPbrMaps = 8, kPbrViews = 16 };
     std::map<unsigned, GLuint> pbrPrograms;
-    /// The shadow map's depth program (skin.vert with DERMIS_PBR + shadow.frag): linked on the
-    /// first frame with a shadowed key light.
-    GLuint shadowProgram = 0;
+    /// The depth-only program (skin.vert with DERMIS_PBR + shadow.frag) of the key light's shadow
+    /// map and of the skin pass's depth prepass (built at start).
+    GLuint depthProgram = 0;
     gl::ShadowTarget shadowMap;
     /// What `shadowMap` holds (drawn from); reset when the target is made anew.
     std::optional<gl::ShadowInputs> lastShadow;
