@@ -325,14 +325,16 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
         bindMorphDeltas(gp);
         glBindVertexArray(gp.vao);
     };
-    // Depth prepass (vertex displacement): the opaque and masked parts' depths first, by the
-    // depth-only program (a MASK part's cut-out fragments write none), so that the shading pass
-    // below shades each pixel once — the fragments at exactly those depths (GL_EQUAL; skin.vert's
-    // gl_Position is invariant) — instead of every surface that is nearest when it is drawn
-    // (with the default scene's squat at 1024² that was 1.9 fragments per covered pixel, and a
-    // software rasterizer pays the full shading for each). Blended parts are not in it: they
-    // test against it and write no depth, as before.
-    const bool prepass = !tess;
+    // Depth prepass (pbr and skin shading, one sample, vertex displacement): the opaque and
+    // masked parts' depths first, by the depth-only program (a MASK part's cut-out fragments
+    // write none), so that the shading pass below shades each pixel once — the fragments at
+    // exactly those depths (GL_EQUAL; skin.vert's gl_Position is invariant) — instead of every
+    // surface that is nearest when it is drawn (with the default scene's squat at 1024² that was
+    // 1.9 fragments per covered pixel, and a software rasterizer pays the full shading for each).
+    // Blended parts are not in it: they test against it and write no depth, as before. Where it
+    // does not pay on llvmpipe it is not drawn: legacy's shading costs about what the prepass
+    // does, and with MSAA the prepass tests every sample twice (docs/benchmarks.md).
+    const bool prepass = !tess && pbrOrder && samples == 1;
     if (prepass) {
         glUseProgram(depthProgram);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
