@@ -31,10 +31,15 @@ const $ = (id) => document.getElementById(id);
 const api = new Api({ client: makeClientName(), signIn });
 
 /// Reads the current scene again (after a 412, another person's edit, a reconnect).
+/// Reads can overlap (two changes by someone else in quick succession) and their answers can come
+/// back in either order: an answer older than the revision the editor has, or for a scene it has
+/// left, is dropped, so a late read never takes the editor back.
 async function reloadScene() {
   if (!store.sceneId) return;
+  const id = store.sceneId;
   try {
-    const answer = await api.get(scenePath(store.sceneId));
+    const answer = await api.get(scenePath(id));
+    if (id !== store.sceneId || answer.revision < store.revision) return;
     if (answer.revision !== store.revision || JSON.stringify(answer.scene) !== JSON.stringify(store.doc)) {
       set({ doc: answer.scene, revision: answer.revision }, [Topic.DOC, Topic.REVISION]);
     }
