@@ -7,7 +7,8 @@
 // the identical frame (SHA-256 of the bytes); killing the server shows the offline banner, which
 // clears when it is back (same port, same data) and the editor re-syncs; the scene document
 // downloads; a dropped .glb makes a new scene; Transfer from… another scene previews what comes
-// over (and what does not) and applies it in one revision.
+// over (and what does not) and applies it in one revision; two quick changes by someone else whose
+// reads answer out of order leave the editor at the newest revision.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, runSuite, until, sleep } from "./editor_lib.mjs";
@@ -151,6 +152,33 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       const copied = (await api("GET", `/scenes/${empty.body.id}`)).body.scene.placements;
       assert.deepEqual(copied.map((p) => p.id), source.map((p) => p.id));
       await a.keyboard.press("Escape");
+    }],
+    ["two changes by someone else in quick succession: a late answer to the first read does not take the editor back", async () => {
+      // Each change event starts a read of the scene; here the first read's answer (the older
+      // revision) is held back until after the second one's. The editor must end at the newest.
+      const path = new URL(`${server.base}/api/v1/scenes/${sceneId}`).pathname;
+      let held = 0;
+      await b.route((url) => url.pathname === path, async (route) => {
+        if (route.request().method() !== "GET" || held++ > 0) return route.continue();
+        const answer = await route.fetch(); // read now (the older revision), delivered late
+        await sleep(1000);
+        await route.fulfill({ response: answer });
+      });
+      const d = (await api("GET", `/scenes/${sceneId}`)).body;
+      let r = d.revision;
+      for (const id of ["neck", "stomach"]) {
+        const p = d.scene.placements.find((q) => q.id === id);
+        const answer = await api("PATCH", `/scenes/${sceneId}/placements/${id}`, { h: p.h > 0.5 ? p.h - 0.1 : p.h + 0.1 });
+        assert.equal(answer.status, 200);
+        r = answer.body.revision;
+        await sleep(150); // the first event's read is on its way before the second change
+      }
+      await until(async () => held >= 2, "two reads");
+      await sleep(1500); // the held answer has arrived
+      await b.unroute((url) => url.pathname === path);
+      const s = await state(b);
+      assert.equal(s.revision, r, `the editor is at the newest revision (${s.revision}, server ${r}, reads ${held})`);
+      assert.deepEqual(s.doc, (await api("GET", `/scenes/${sceneId}`)).body.scene);
     }],
     ["no script errors", async () => { assert.deepEqual(a.errors, []); assert.deepEqual(b.errors, []); }],
   ]);
