@@ -187,6 +187,33 @@ TEST(RenderCliGLTest, RendersAnAnimationRangeWithHeightMaps) {
     EXPECT_NE(frames[1], frames[2]);
 }
 
+TEST(RenderCliGLTest, RangeFramesAreTheOneShotFrames) {
+    // A range runs post-process AA on its writer thread (render_cmd.cpp); each file must still be
+    // byte-equal to the one-shot render of its time, which runs the edge pass on the render thread.
+    // 320² so that the edge pass splits the frame between threads as at full size.
+    TempDir dir;
+    CliRun r = runServer(dir, "render --scene " + kDefaultScene + " --out " + (dir / "range/f_%04d.png") +
+                                  " --frames 0.25:0.75:0.5 --size 320x320 --aa post" + gl());
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (int k = 0; k < 2; ++k) {
+        const std::string time = k == 0 ? "0.25" : "0.75";
+        const std::string one = "one_" + std::to_string(k) + ".png";
+        CliRun o = runServer(dir, "render --scene " + kDefaultScene + " --out " + (dir / one) + " --time " +
+                                      time + " --size 320x320 --aa post" + gl());
+        ASSERT_EQ(o.code, 0) << o.err;
+        char name[32];
+        std::snprintf(name, sizeof name, "range/f_%04d.png", k);
+        const auto ranged = readBytes(dir / name);
+        ASSERT_FALSE(ranged.empty()) << name;
+        EXPECT_TRUE(ranged == readBytes(dir / one)) << name << " differs from render --time " << time;
+    }
+    // And the edge pass ran: the same range without it gives other bytes.
+    CliRun n = runServer(dir, "render --scene " + kDefaultScene + " --out " + (dir / "none/f_%04d.png") +
+                                  " --frames 0.25:0.75:0.5 --size 320x320 --aa none" + gl());
+    ASSERT_EQ(n.code, 0) << n.err;
+    EXPECT_FALSE(readBytes(dir / "none/f_0000.png") == readBytes(dir / "range/f_0000.png"));
+}
+
 TEST(RenderCliGLTest, RendersTheSharedModels) {
     TempDir dir;
     // The three test characters (skinned, posed half a second into their first clip) and the
