@@ -188,9 +188,10 @@ TEST(RenderCliGLTest, RendersAnAnimationRangeWithHeightMaps) {
 }
 
 TEST(RenderCliGLTest, RangeFramesAreTheOneShotFrames) {
-    // A range runs post-process AA on its writer thread (render_cmd.cpp); each file must still be
-    // byte-equal to the one-shot render of its time, which runs the edge pass on the render thread.
-    // 320² so that the edge pass splits the frame between threads as at full size.
+    // A range renders its frames one after another on one renderer and encodes them on a writer
+    // thread while the next renders (render_cmd.cpp); each file must be byte-equal to the one-shot
+    // render of its time: nothing of one frame leaks into the next, and the post-process edge
+    // pass runs on each. 320² so that the edge pass splits the frame between threads as at full size.
     TempDir dir;
     CliRun r = runServer(dir, "render --scene " + kDefaultScene + " --out " + (dir / "range/f_%04d.png") +
                                   " --frames 0.25:0.75:0.5 --size 320x320 --aa post" + gl());

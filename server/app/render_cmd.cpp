@@ -1,7 +1,6 @@
 #include "app/render_cmd.hpp"
 
 #include "app/cli_common.hpp"
-#include "core/edge_aa.hpp"
 #include "core/frame_plan.hpp"
 #include "core/frame_range.hpp"
 #include "core/layout_gen.hpp"
@@ -218,18 +217,6 @@ int runRender(const RenderArgs& a) {
         request.environment = environment;
         request.profile = a.timings && first; // a GL sync between stages: per-stage figures
         used = plan->render;
-        // In a range, post-process AA (core/edge_aa.hpp: a pure function of the read-back frame)
-        // runs on the writer before the encode, so the render thread goes on to the next frame
-        // while it runs: the renderer draws the same one-sample frame without its edge pass, and
-        // the file's bytes are those of the sequential path (RenderCliGLTest checks them against
-        // one-shot renders).
-        bool postAaOnWriter = false;
-        if (todo.size() > 1 && !request.profile &&
-            resolveAntiAliasing(request.render, (*renderer)->info().software, (*renderer)->info().maxSamples)
-                    .mode == AntiAliasing::Post) {
-            request.render.aa = AntiAliasing::None;
-            postAaOnWriter = true;
-        }
         auto result = (*renderer)->renderFrame(request);
         if (!result) return fail(result.error());
         if (a.timings && first) {
@@ -242,8 +229,7 @@ int runRender(const RenderArgs& a) {
         auto frame = std::make_shared<FrameResult>(std::move(*result));
         const bool heightmaps = a.heightmaps;
         const FrameFormat f = *format;
-        auto job = [&, path, frame, heightmaps, f, k, postAaOnWriter]() -> Status {
-            if (postAaOnWriter) antiAliasEdges(frame->image);
+        auto job = [&, path, frame, heightmaps, f, k]() -> Status {
             if (auto s = createFolderOf(path); !s) return s;
             auto bytes = encodeFrame(frame->image, f);
             if (!bytes) return bytes.error();
