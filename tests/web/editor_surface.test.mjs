@@ -134,6 +134,17 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
         if (hit.hit && Math.hypot(...hit.anchor.position.map((x, i) => x - before.anchor.position[i])) > 1e-5) { step = [dx, dy]; break; }
       }
       assert.ok(step, "a texel on the body beside the anchor's");
+      // The slide's answer comes back late (the server has applied it): an undo pressed as soon as
+      // the server has the move undoes the move, not the add before it (which would take the
+      // placement away — what CI once saw under ASan, where answers are slow).
+      const patchPath = `/api/v1/scenes/${sceneId}/placements/${encodeURIComponent(placedId)}`;
+      const late = (url) => url.pathname === patchPath;
+      await page.route(late, async (route) => {
+        if (route.request().method() !== "PATCH") return route.continue();
+        const answer = await route.fetch();
+        await sleep(1500);
+        await route.fulfill({ response: answer });
+      });
       await page.mouse.move(...g.center);
       await page.mouse.down();
       await page.mouse.move(g.center[0] + step[0] / 2, g.center[1] + step[1] / 2);
@@ -142,8 +153,10 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       const moved = await until(async () => { const p = (await doc()).placements.find((q) => q.id === placedId); return !near(p.anchor.position, before.anchor.position, 1e-6) && p; }, "the anchor moved");
       assert.equal(moved.projection, "surface");
       assert.deepEqual(moved.size, before.size);
-      await page.keyboard.press("Control+z");
-      await until(async () => near((await doc()).placements.find((q) => q.id === placedId).anchor.position, before.anchor.position, 1e-9), "undo puts it back");
+      await page.keyboard.press("Control+z"); // while the move's answer is still on its way
+      const back = await until(async () => { const d = await doc(); const p = d.placements.find((q) => q.id === placedId); return (!p || near(p.anchor.position, before.anchor.position, 1e-9)) && { p }; }, "undo puts it back");
+      assert.ok(back.p, "the undo took the placement away: it undid the add, not the move");
+      await page.unroute(late);
     }],
     ["+ scales its size in model units and ] turns it", async () => {
       const before = (await doc()).placements.find((p) => p.id === placedId);

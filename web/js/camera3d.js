@@ -23,7 +23,7 @@
 import { store, set, placementById } from "./store.js";
 import { focusPath } from "./scene_resource.js";
 import * as geo from "./geometry.js";
-import { Stream, patchPlacement } from "./edits.js";
+import { Stream, patchPlacement, committingChange } from "./edits.js";
 import { hold, release, withPending } from "./pending.js";
 
 const FOV_Y = (30 * Math.PI) / 180;
@@ -188,8 +188,8 @@ export function initCamera(stage, theApi, ctx) {
     const d = drag;
     drag = null;
     stage.classList.remove("panning", "orbiting", "moving");
-    if (d && d.decal) endDecalDrag(d.decal, e.type === "pointerup" && d.moved, ctx);
-    if (d && !d.moved && d.button === 0 && !d.pan && e.type === "pointerup") ctx.onClick(e);
+    if (d && d.decal) committingChange(() => endDecalDrag(d.decal, e.type === "pointerup" && d.moved, ctx));
+    if (d && !d.moved && d.button === 0 && !d.pan && e.type === "pointerup") committingChange(() => ctx.onClick(e)); // a pick, then maybe a new placement
   };
   stage.addEventListener("pointerup", end);
   stage.addEventListener("pointercancel", end);

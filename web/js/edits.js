@@ -39,6 +39,30 @@ export function pushUndo(revision, what) {
 }
 
 let beforeEdit = () => {};
+const committing = new Set(); // this person's changes on their way (see committingChange)
+
+/// Runs `work` (an async function or a promise) as one of this person's changes on its way — a
+/// gesture's commit, a pick and then its edit: undo and redo wait until it is answered and recorded,
+/// so that Ctrl+Z right after a change undoes that change, not the one before it (whose revision
+/// would take the new change away with it). Resolves to work's result; a rejection is passed on.
+export function committingChange(work) {
+  const p = Promise.resolve(typeof work === "function" ? work() : work);
+  committing.add(p);
+  p.finally(() => committing.delete(p)).catch(() => {});
+  return p;
+}
+
+/// Resolves once every change this editor has made is answered and on the undo stack: a waiting
+/// key burst sent, no change committing, no edit queued or in flight.
+async function ownChangesAnswered() {
+  for (;;) {
+    await beforeEdit();
+    await Promise.allSettled([...committing]);
+    const q = queue;
+    await q;
+    if (q === queue && committing.size === 0) return;
+  }
+}
 /// `fn` runs before every edit is queued (pending.js sends a waiting key burst first, so edits
 /// stay in the order the person made them); undo and redo wait for the promise it returns.
 export function setBeforeEdit(fn) { beforeEdit = fn; }
@@ -166,7 +190,7 @@ export async function revert(revision, { undoable = true, what = null } = {}) {
 /// were. A notice names what was undone or redone (the words kept with the step), with the way
 /// back as its button.
 async function travel(from, to, nothing, verb, back) {
-  await beforeEdit(); // a key burst still waiting is sent (and becomes the step undone) first
+  await ownChangesAnswered(); // a key burst still waiting, an edit on its way: each becomes the step undone first
   if (!from.length) return notify(nothing, "info");
   const step = from.pop();
   const here = store.revision;
@@ -228,8 +252,10 @@ export class Stream {
     this.pending = undefined;
     this.go(value);
   }
-  /// Sends the last value (when it was not sent yet); resolves once it is answered.
-  async finish() {
+  /// Sends the last value (when it was not sent yet); resolves once it is answered (undo waits
+  /// for it: committingChange).
+  finish() { return committingChange(() => this.finishNow()); }
+  async finishNow() {
     this.done = true;
     if (this.timer) { clearTimeout(this.timer); this.timer = null; }
     if (this.inFlight) await this.inFlight;

@@ -4,7 +4,7 @@
 import { store, set, placementById, heightmapSize } from "./store.js";
 import { pickUVPath, outlinePath } from "./scene_resource.js";
 import * as geo from "./geometry.js";
-import { removePlacements, mirrorPlacement, addPlacement, patchPlacement, undo, redo } from "./edits.js";
+import { removePlacements, mirrorPlacement, addPlacement, patchPlacement, undo, redo, committingChange } from "./edits.js";
 import { nudge } from "./pending.js";
 import { cancelDrag, dragging, viewCentreUV, zoomBy, panBy } from "./texture_view.js";
 import { setPlaceTool, placeToolOn, resizeBrush } from "./frame_view.js";
@@ -87,7 +87,7 @@ function onKey(e, { dlg, fitTexture }) {
   const k = e.key;
   let handled = true;
   if (k === "?") dlg.showModal();
-  else if (/^[1-9]$/.test(k)) placeNth(+k - 1);
+  else if (/^[1-9]$/.test(k)) committingChange(() => placeNth(+k - 1));
   else if (k === "Escape" && placeToolOn()) setPlaceTool(false); // Esc leaves the place tool first
   else if (k === "Escape") set({ selection: [] });
   else if (k === "n" || k === "N") selectNext(e.shiftKey ? -1 : 1);
@@ -97,7 +97,7 @@ function onKey(e, { dlg, fitTexture }) {
     const uvSel = sel.filter((id) => geo.inTexture(placementById(id)));
     if (uvSel.length) nudge(uvSel, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }), "move");
     const onBody = sel.filter((id) => !geo.inTexture(placementById(id)));
-    if (onBody.length) nudgeOnBody(onBody, d);
+    if (onBody.length) committingChange(() => nudgeOnBody(onBody, d));
   } else if (k.startsWith("Arrow") && inTextureView()) {
     const step = e.shiftKey ? 200 : 40; // css px; nothing is selected: the arrows pan
     panBy(...ARROWS[k].map((c) => c * step));
@@ -115,7 +115,7 @@ function onKey(e, { dlg, fitTexture }) {
     removePlacements(sel);
     set({ selection: [] });
   } else if ((k === "m" || k === "M") && sel.length) sel.forEach((id) => mirrorPlacement(id));
-  else if ((k === "d" || k === "D") && sel.length) duplicate(sel);
+  else if ((k === "d" || k === "D") && sel.length) committingChange(() => duplicate(sel));
   else if ((k === "h" || k === "H") && sel.length) toggleEnabled(sel);
   else if ((k === "s" || k === "S") && sel.length) toggleSolo(sel);
   else if (k === "p" || k === "P") setPlaceTool(!placeToolOn());

@@ -46,8 +46,15 @@ async function reloadScene() {
   } catch (e) { notify(`Reading the scene: ${e.message}`, "error"); }
 }
 
+let lintReads = 0; // lint reads started (see loadLint)
+
+/// Reads the scene's lint. Reads can overlap (quick revisions); only the newest read's answer is
+/// shown, and none for a scene the editor has left.
 async function loadLint() {
-  try { set({ lint: await api.get(lintPath(store.sceneId)) }); } catch { set({ lint: [] }); }
+  const read = ++lintReads, id = store.sceneId;
+  let lint;
+  try { lint = await api.get(lintPath(id)); } catch { lint = []; }
+  if (read === lintReads && id === store.sceneId) set({ lint });
 }
 
 /// Opens scene `id`; `link` (a permalink's fields) sets revision, time, camera and selection.

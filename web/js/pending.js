@@ -10,7 +10,7 @@
 // commits through edits.js's Stream.
 
 import { store, on, emit, set, placementById, Topic } from "./store.js";
-import { patchPlacement, pushUndo, setBeforeEdit } from "./edits.js";
+import { patchPlacement, pushUndo, setBeforeEdit, committingChange } from "./edits.js";
 
 const BURST_MS = 450;
 const shownFields = new Map(); // placement id -> fields shown over the document's
@@ -69,8 +69,13 @@ export function nudge(ids, change, verb = "adjust") {
   burst.timer = setTimeout(commitBurst, BURST_MS);
 }
 
-/// Sends the key burst now (one PATCH per placement); resolves when they are answered.
-export async function commitBurst() {
+/// Sends the key burst now (one PATCH per placement); resolves when they are answered and the
+/// burst is on the undo stack (undo waits for that: committingChange).
+export function commitBurst() {
+  return burst ? committingChange(sendBurst) : Promise.resolve();
+}
+
+async function sendBurst() {
   if (!burst) return;
   const b = burst;
   burst = null;

@@ -18,7 +18,7 @@ import { store, on, emit, set, placementById, heightmapSize, Topic } from "./sto
 import { heightmapPath, pickUVPath } from "./scene_resource.js";
 import * as geo from "./geometry.js";
 import { image, heightOverlay, onImageLoaded, patternImagePath } from "./images.js";
-import { Stream, patchPlacement } from "./edits.js";
+import { Stream, patchPlacement, committingChange } from "./edits.js";
 import { withPending, pendingPreview, hold, release } from "./pending.js";
 import { trace } from "./trace.js";
 import { addsToSelection } from "./selection.js";
@@ -504,7 +504,7 @@ async function pointerUp(e) {
   const d = drag;
   drag = null;
   if (d.kind === "pan") return;
-  if (d.kind === "smove") { await slideOnBody(d); return; }
+  if (d.kind === "smove") { await committingChange(() => slideOnBody(d)); return; }
   if (!d.value) { d.stream.done = true; d.stream.end(); return; }
   await d.stream.finish(); // one edit: the gesture's last value
   release(d.id, d.value);
