@@ -4,7 +4,8 @@
 // Checks: one outline per placement and a decoded frame; dragging a footprint moves it (server
 // within one texel) and changes the frame; a 2 s drag sends one edit and ends where the
 // pointer stopped; Shift-rotate snaps to 15°; Esc cancels (server unchanged); a number key
-// places a pattern; nudge / rotate / scale keys; Delete, undo, redo; a history click reverts; the
+// places a pattern; nudge / rotate / scale keys; an undo while a drag's or a key burst's edit is
+// still on its way undoes that edit only; Delete, undo, redo; a history click reverts; the
 // history list is one Tab stop (arrows / Home / End move, Enter reverts);
 // H sends enabled:false and zeroes that region of the bump map; S solos; M mirrors.
 import assert from "node:assert/strict";
@@ -185,6 +186,42 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       const p = await until(async () => { const q = await serverPlacement("elbow_l"); return q.scale[0] > p0.scale[0] && q; }, "scaled up");
       assert.ok(Math.abs(p.center[0] - p0.center[0] - texel) < 2e-4, `nudged right: ${p.center[0]} vs ${p0.center[0]}`);
       assert.ok(Math.abs(p.scale[0] / p0.scale[0] - 1.05) < 0.01 && Math.abs(p.scale[1] / p0.scale[1] - 1.05) < 0.01);
+    }],
+    ["an undo pressed while a drag's or a key burst's edit is on its way undoes that edit, not the one before", async () => {
+      await settle();
+      const scene = async () => (await api("GET", `/scenes/${sceneId}`)).body.scene;
+      // Every PATCH answer comes back 1.5 s late (the server has applied it by then).
+      const late = (url) => url.pathname.startsWith(`/api/v1/scenes/${sceneId}/placements/`);
+      await page.route(late, async (route) => {
+        if (route.request().method() !== "PATCH") return route.continue();
+        const answer = await route.fetch();
+        await sleep(1500);
+        await route.fulfill({ response: answer });
+      });
+      try {
+        const before = await scene();
+        const p0 = before.placements.find((p) => p.id === "stomach");
+        const g = await footprint(page, "stomach");
+        await page.mouse.move(g.center[0], g.center[1]);
+        await page.mouse.down();
+        for (let i = 1; i <= 4; ++i) { await page.mouse.move(g.center[0] + 6 * i, g.center[1]); await sleep(30); }
+        await page.mouse.up();
+        await until(async () => (await serverPlacement("stomach")).center[0] > p0.center[0] + 2 * texel, "the drag on the server");
+        await page.keyboard.press("Control+z"); // the drag's answer is still on its way
+        await until(async () => JSON.stringify(await scene()) === JSON.stringify(before), "undo takes back the drag and nothing else");
+        await settle();
+        assert.deepEqual(await scene(), before, "and no earlier edit went with it");
+        // A key burst: `]` commits after a pause; Ctrl+Z as soon as the server has it.
+        await select("stomach");
+        await page.keyboard.press("]");
+        await until(async () => (await serverPlacement("stomach")).rotation === p0.rotation + 5, "the burst on the server");
+        await page.keyboard.press("Control+z");
+        await until(async () => JSON.stringify(await scene()) === JSON.stringify(before), "undo takes back the burst and nothing else");
+        await settle();
+        assert.deepEqual(await scene(), before, "and no earlier edit went with it");
+      } finally {
+        await page.unroute(late);
+      }
     }],
     ["Delete, then undo restores it and redo removes it again (server state)", async () => {
       await settle();
