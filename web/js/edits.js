@@ -63,6 +63,7 @@ async function ownChangesAnswered() {
     if (q === queue && committing.size === 0) return;
   }
 }
+
 /// `fn` runs before every edit is queued (pending.js sends a waiting key burst first, so edits
 /// stay in the order the person made them); undo and redo wait for the promise it returns.
 export function setBeforeEdit(fn) { beforeEdit = fn; }
