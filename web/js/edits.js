@@ -41,12 +41,12 @@ export function pushUndo(revision, what) {
 let beforeEdit = () => {};
 const committing = new Set(); // this person's changes on their way (see committingChange)
 
-/// Runs `work` (an async function or a promise) as one of this person's changes on its way — a
-/// gesture's commit, a pick and then its edit: undo and redo wait until it is answered and recorded,
-/// so that Ctrl+Z right after a change undoes that change, not the one before it (whose revision
+/// Runs `work` (an async function) as one of this person's changes on its way — a gesture's
+/// commit, a pick and then its edit: undo and redo wait until it is answered and recorded, so
+/// that Ctrl+Z right after a change undoes that change, not the one before it (whose revision
 /// would take the new change away with it). Resolves to work's result; a rejection is passed on.
 export function committingChange(work) {
-  const p = Promise.resolve(typeof work === "function" ? work() : work);
+  const p = work();
   committing.add(p);
   p.finally(() => committing.delete(p)).catch(() => {});
   return p;

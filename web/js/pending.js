@@ -76,7 +76,6 @@ export function commitBurst() {
 }
 
 async function sendBurst() {
-  if (!burst) return;
   const b = burst;
   burst = null;
   clearTimeout(b.timer);
