@@ -230,7 +230,19 @@ TEST(FrameIoTest, EncodeFrameDispatches) {
     auto jpg = encodeFrame(img, FrameFormat::Jpeg);
     auto exr = encodeFrame(img, FrameFormat::Exr);
     ASSERT_TRUE(png.ok() && jpg.ok() && exr.ok());
-    EXPECT_EQ(*png, *encodePng(img, true));
+    EXPECT_EQ(*png, *encodePng(img, true)); // alpha varies: RGBA
+    // An opaque frame (every rendered one) is written as RGB: smaller, decoded to the same bytes.
+    Image8 opaque = img;
+    for (std::size_t k = 3; k < opaque.rgba.size(); k += 4) opaque.rgba[k] = 255;
+    auto rgb = encodeFrame(opaque, FrameFormat::Png);
+    ASSERT_TRUE(rgb.ok());
+    EXPECT_EQ(*rgb, *encodePng(opaque, false));
+    EXPECT_LT(rgb->size(), encodePng(opaque, true)->size());
+    auto back = decodeFrame(*rgb);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back->rgba, opaque.rgba);
+    opaque.rgba[opaque.rgba.size() - 1] = 254; // one pixel not opaque: RGBA again
+    EXPECT_EQ(*encodeFrame(opaque, FrameFormat::Png), *encodePng(opaque, true));
     EXPECT_EQ(*jpg, *encodeJpeg(img, 90));
     ASSERT_GE(exr->size(), 4u);
     const std::vector<std::uint8_t> exrMagic = {0x76, 0x2F, 0x31, 0x01};

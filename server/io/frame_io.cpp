@@ -277,10 +277,21 @@ Result<std::vector<std::uint8_t>> encodeJpeg(const Image8& img, int quality) {
     return std::vector<std::uint8_t>(buf.get(), buf.get() + size);
 }
 
+namespace {
+
+/// Whether every pixel's alpha is 255.
+bool opaque(const Image8& img) {
+    std::uint8_t all = 255;
+    for (std::size_t k = 3; k < img.rgba.size(); k += 4) all &= img.rgba[k];
+    return all == 255;
+}
+
+} // namespace
+
 Result<std::vector<std::uint8_t>> encodeFrame(const Image8& img, FrameFormat f) {
     switch (f) {
     case FrameFormat::Png:
-        return encodePng(img, true);
+        return encodePng(img, !opaque(img));
     case FrameFormat::Jpeg:
         return encodeJpeg(img, 90);
     case FrameFormat::Exr:

@@ -49,7 +49,9 @@ Result<std::vector<std::uint8_t>> encodePng(const Image8& img, bool keepAlpha = 
 /// dropped (not composited: RGB are encoded as stored).
 Result<std::vector<std::uint8_t>> encodeJpeg(const Image8& img, int quality = 90);
 
-/// Encodes a frame in format `f`: Png = encodePng(img, true), Jpeg = encodeJpeg(img, 90), Webp =
+/// Encodes a frame in format `f`: Png = encodePng(img, keepAlpha) with alpha kept only when some
+/// pixel's alpha is not 255 (an opaque frame, as every rendered one is, is written as RGB: ≈ 20 %
+/// smaller, decoded to the same RGBA bytes), Jpeg = encodeJpeg(img, 90), Webp =
 /// encodeWebpLossless(img, true) (io/webp_encode.hpp), Exr =
 /// 4-channel (R, G, B, A) half-float OpenEXR in LINEAR light, encoded by OpenImageIO in memory
 /// with its default compression: each colour byte c is decoded with the exact sRGB EOTF
