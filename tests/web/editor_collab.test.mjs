@@ -8,7 +8,10 @@
 // clears when it is back (same port, same data) and the editor re-syncs; the scene document
 // downloads; a dropped .glb makes a new scene; Transfer from… another scene previews what comes
 // over (and what does not) and applies it in one revision; two quick changes by someone else whose
-// reads answer out of order leave the editor at the newest revision.
+// reads answer out of order leave the editor at the newest revision; with every edit's answer held
+// back 1 s: D right after `]` copies the turned placement, two quick Alt+↓ move a row two places, a
+// key burst waiting when another scene is opened goes to its own scene (the other untouched, its
+// undo steps left behind), and a deletion's Undo clicked in another scene does not touch it.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, runSuite, until, sleep } from "./editor_lib.mjs";
@@ -179,6 +182,68 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       const s = await state(b);
       assert.equal(s.revision, r, `the editor is at the newest revision (${s.revision}, server ${r}, reads ${held})`);
       assert.deepEqual(s.doc, (await api("GET", `/scenes/${sceneId}`)).body.scene);
+    }],
+    ["changes whose answers are slow stay with their scene, and add up (every PATCH, PUT and DELETE answer held 1 s)", async () => {
+      // A person on a slow link: each edit's answer arrives a second after the server has it.
+      const s1 = (await api("POST", "/scenes", { default_patterns: true })).body.id;
+      const s2 = (await api("POST", "/scenes", { default_patterns: true })).body.id;
+      const c = await openEditor(await browser.newContext(), `${server.base}/?scene=${s1}`);
+      await c.route((url) => url.pathname.startsWith("/api/v1/scenes/"), async (route) => {
+        if (!["PATCH", "PUT", "DELETE"].includes(route.request().method())) return route.continue();
+        const answer = await route.fetch();
+        await sleep(1000);
+        await route.fulfill({ response: answer });
+      });
+      const scene = async (id) => (await api("GET", `/scenes/${id}`)).body;
+      const placement = async (id, pid) => (await scene(id)).scene.placements.find((p) => p.id === pid);
+      await select(c, "neck");
+      // `]` then D at once: the copy has the rotation the window shows (the burst's), not the stored one.
+      const neck0 = await placement(s1, "neck");
+      await c.keyboard.press("]");
+      await c.keyboard.press("d");
+      const copy = await until(async () => { const d = (await scene(s1)).scene; return d.placements.length === 19 && d.placements[18]; }, "the copy on the server");
+      const neck1 = await placement(s1, "neck");
+      assert.notEqual(neck1.rotation, neck0.rotation, "the burst turned the neck");
+      assert.equal(copy.rotation, neck1.rotation, "the copy is turned as the neck was shown");
+      // Alt+↓ twice within one answer's time: the row moves two places.
+      await until(async () => (await state(c)).revision === (await scene(s1)).revision && !(await c.evaluate(() => window.dermisEditor.store.busy)), "the window settled");
+      const ids0 = (await scene(s1)).scene.placements.map((p) => p.id);
+      await c.focus(`#placementList li[data-placement="${ids0[0]}"] .name`);
+      await c.keyboard.press("Alt+ArrowDown");
+      await c.keyboard.press("Alt+ArrowDown");
+      const ids1 = await until(async () => { const ids = (await scene(s1)).scene.placements.map((p) => p.id); return ids[2] === ids0[0] && ids; }, "moved down two places");
+      assert.deepEqual(ids1.slice(0, 2), ids0.slice(1, 3));
+      // A key burst still waiting when another scene is opened goes to the scene it was made in.
+      await until(async () => !(await c.evaluate(() => window.dermisEditor.store.busy)), "the window settled");
+      const before2 = await scene(s2);
+      await select(c, "neck");
+      const neckBefore = await placement(s1, "neck");
+      await c.keyboard.press("]");
+      await c.selectOption("#scene", s2);
+      await until(async () => (await state(c)).sceneId === s2, "the other scene open");
+      const neckAfter = await until(async () => { const p = await placement(s1, "neck"); return p.rotation !== neckBefore.rotation && p; }, "the burst on the first scene");
+      assert.ok(Math.abs((((neckAfter.rotation - neckBefore.rotation) % 360) + 360) % 360 - 5) < 1e-6, `turned once, on its own scene (${neckBefore.rotation} → ${neckAfter.rotation})`);
+      assert.deepEqual(await scene(s2), before2, "the other scene is untouched");
+      // Its undo steps stayed behind: Ctrl+Z here has nothing to undo.
+      await c.focus("#uv");
+      await c.keyboard.press("Control+z");
+      await c.waitForSelector('#notices .notice:has-text("Nothing to undo")', { timeout: 5000 });
+      assert.equal((await scene(s2)).revision, before2.revision);
+      // A deletion's Undo notice, clicked after another scene was opened, does not touch that scene.
+      await c.selectOption("#scene", s1);
+      await until(async () => (await state(c)).sceneId === s1, "back on the first scene");
+      await select(c, "knee_l");
+      await c.keyboard.press("Delete");
+      const undoButton = await c.waitForSelector('#notices .notice:has-text("Deleted \\"knee_l\\"") button.action', { timeout: 10000 });
+      await until(async () => !(await placement(s1, "knee_l")), "knee_l deleted");
+      await c.selectOption("#scene", s2);
+      await until(async () => (await state(c)).sceneId === s2, "the other scene open again");
+      await undoButton.click();
+      await c.waitForSelector('#notices .notice:has-text("deletion was in another scene")', { timeout: 5000 });
+      await sleep(1500);
+      assert.deepEqual(await scene(s2), before2, "the other scene is still untouched");
+      assert.deepEqual(c.errors, []);
+      await c.close();
     }],
     ["no script errors", async () => { assert.deepEqual(a.errors, []); assert.deepEqual(b.errors, []); }],
   ]);

@@ -4,7 +4,9 @@
 // Checks: dropping a PNG uploads it, dropping a text file shows an error and posts nothing;
 // parameter edits change the server document and the response plot; a joint slider and the clip
 // scrubber change the frame; view modes; compare split / flicker / diff; the place tool adds a
-// placement at the clicked skin with the suggested driver; the activation strip jumps in time;
+// placement at the clicked skin with the suggested driver; a click on the model selects the
+// placement there, and a click whose pick answers late does not undo a later choice in the list;
+// Alt+↓ reorders; the activation strip jumps in time;
 // the sweep dialog; a server error appears on screen. Then 100 pointer moves of a drag are timed
 // to the frame on screen (p50/p95, JSON on stdout and in $DERMIS_TEST_OUT/editor-drag-bench.json).
 import assert from "node:assert/strict";
@@ -178,6 +180,18 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       const side = Math.min(box[2], box[3]);
       await page.mouse.click(box[0] + (box[2] - side) / 2 + ((target.x + 0.5) / 512) * side, box[1] + (box[3] - side) / 2 + ((target.y + 0.5) / 512) * side);
       await until(async () => (await state(page)).selection[0] === target.id, `${target.id} selected by a click in 3D`);
+      // A click whose pick answers late (1 s) after another placement was chosen in the list: the
+      // list's choice stands (the late pick does not take the selection back).
+      const late = (url) => url.pathname.endsWith("/pick") && url.searchParams.has("x");
+      await page.route(late, async (route) => { const answer = await route.fetch(); await sleep(1000); await route.fulfill({ response: answer }); });
+      await page.keyboard.press("Escape");
+      await page.mouse.click(box[0] + (box[2] - side) / 2 + ((target.x + 0.5) / 512) * side, box[1] + (box[3] - side) / 2 + ((target.y + 0.5) / 512) * side);
+      const other = (await doc()).placements.find((p) => p.id !== target.id).id;
+      await page.click(`#placementList li[data-placement="${other}"] .name`);
+      await sleep(1500);
+      await page.unroute(late);
+      assert.deepEqual((await state(page)).selection, [other], "the list's later choice stands");
+      await page.mouse.move(box[0] + box[2] / 2, box[1] + box[3] / 2); // back over the 3D view for the wheel
       const d0 = (await state(page)).camera.distance;
       await page.mouse.wheel(0, 300);
       await until(async () => { const d = (await state(page)).camera.distance; return d !== null && d !== d0; }, "the wheel set a distance");

@@ -8,7 +8,8 @@
 // and a decal the brush wide, selected and outlined on the skin; the texture view draws its
 // outline in the generated layout (every piece) with its anchor, selects it by a click there, and
 // a drag there slides it over the body (anchor moved, one undo step that puts it back); + and ]
-// scale its size in model units and turn it; the parameters panel shows size and depth; in the 3D
+// scale its size in model units and turn it; three quick arrows move it three texels over the body (each
+// answer held back 1 s); the parameters panel shows size and depth; in the 3D
 // view a drag that starts on the selected decal moves it (anchor changed, camera not turned);
 // "Place as: in the texture" adds a UV placement instead.
 // Screenshots: editor-surface-brush.png, editor-surface-placed.png, editor-surface-texture.png.
@@ -167,6 +168,40 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       assert.ok(Math.abs(after.size[0] / before.size[0] - 1.05) < 1e-3, `${after.size} vs ${before.size}`);
       assert.equal(after.rotation, before.rotation + 5);
       assert.equal(after.center === undefined || JSON.stringify(after.center) === JSON.stringify(before.center), true, "no UV centre invented");
+    }],
+    ["three quick arrows on the body move it three texels, each from where the one before left it (answers held 1 s)", async () => {
+      const size = (await doc()).heightmap?.size?.[0] || 1024;
+      const r0 = (await api("GET", `/scenes/${sceneId}`)).body.revision;
+      const o0 = (await api("GET", `/scenes/${sceneId}/placements/${placedId}/outline`)).body;
+      // An arrow whose next three texels all lie on the body (a generated layout's charts end somewhere).
+      const arrows = { ArrowRight: [1, 0], ArrowLeft: [-1, 0], ArrowDown: [0, 1], ArrowUp: [0, -1] };
+      let key = null;
+      for (const [k, [du, dv]] of Object.entries(arrows)) {
+        let on = true;
+        for (let n = 1; n <= 3 && on; ++n) {
+          const u = o0.anchor_uv[0] + (n * du) / size, v = o0.anchor_uv[1] + (n * dv) / size;
+          on = (await api("GET", `/scenes/${sceneId}/pick?u=${u}&v=${v}`)).body.hit;
+        }
+        if (on) { key = k; break; }
+      }
+      assert.ok(key, "an arrow with three texels of body beside the anchor");
+      const patchPath = `/api/v1/scenes/${sceneId}/placements/${encodeURIComponent(placedId)}`;
+      const late = (url) => url.pathname === patchPath;
+      await page.route(late, async (route) => {
+        if (route.request().method() !== "PATCH") return route.continue();
+        const answer = await route.fetch();
+        await sleep(1000);
+        await route.fulfill({ response: answer });
+      });
+      await page.focus("#uv");
+      for (let k = 0; k < 3; ++k) await page.keyboard.press(key);
+      await until(async () => (await api("GET", `/scenes/${sceneId}`)).body.revision >= r0 + 3, "three moves on the server", 20000);
+      await until(async () => !(await page.evaluate(() => window.dermisEditor.store.busy)), "every answer in");
+      await page.unroute(late);
+      const o1 = (await api("GET", `/scenes/${sceneId}/placements/${placedId}/outline`)).body;
+      const [du, dv] = arrows[key];
+      const texels = ((o1.anchor_uv[0] - o0.anchor_uv[0]) * du + (o1.anchor_uv[1] - o0.anchor_uv[1]) * dv) * size;
+      assert.ok(texels > 2.5 && texels < 3.5, `${key} ×3 moved it ${texels.toFixed(2)} texels (not one: each nudge reads the anchor the one before left)`);
     }],
     ["in the 3D view a drag that starts on the selected decal moves it, and the camera stays", async () => {
       const before = (await doc()).placements.find((p) => p.id === placedId);

@@ -169,11 +169,22 @@ export function initCamera(stage, theApi, ctx) {
     drag = { x: e.clientX, y: e.clientY, button: e.button, pan, from: explicitCamera(), moved: false, pivot: null };
     const decal = !pan && e.button === 0 && !ctx.placeTool() && decalUnder(ctx.framePixel(e));
     if (decal) drag.decal = startDecalDrag(decal);
-    else if (!pan) orbitPivot(ctx).then((p) => { if (drag) drag.pivot = p; });
+    else if (!pan) {
+      // The pivot (the body point under the view's centre) may come after the orbit has begun:
+      // the orbit so far is kept (it restarts from the camera it reached) and only this drag's.
+      const d = drag;
+      orbitPivot(ctx).then((p) => {
+        if (drag !== d) return;
+        if (d.moved) { d.from = explicitCamera(); d.x = d.lastX; d.y = d.lastY; }
+        d.pivot = p;
+      });
+    }
     stage.setPointerCapture(e.pointerId);
   });
   stage.addEventListener("pointermove", (e) => {
     if (!drag) { hoverAt(e, ctx); return; }
+    drag.lastX = e.clientX;
+    drag.lastY = e.clientY;
     const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
     if (!drag.moved && Math.hypot(dx, dy) < 4) return;
     if (!drag.moved) { drag.moved = true; stage.classList.add(drag.decal ? "moving" : drag.pan ? "panning" : "orbiting"); }

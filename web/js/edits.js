@@ -18,8 +18,8 @@ import { trace } from "./trace.js";
 import { inWords } from "./messages.js";
 
 let api = null;
-const undoStack = []; // {revision, what}: the document before one of my edits, and that edit in words
-const redoStack = []; // {revision, what}: revisions to go forward to
+const undoStack = []; // {revision, what, scene}: the document before one of my edits, that edit in words, its scene
+const redoStack = []; // {revision, what, scene}: revisions to go forward to
 let reloadScene = async () => {};
 
 export function initEdits(theApi, reload) {
@@ -31,9 +31,10 @@ export const canUndo = () => undoStack.length > 0;
 export const canRedo = () => redoStack.length > 0;
 export function clearUndo() { undoStack.length = 0; redoStack.length = 0; emit(Topic.UNDO); }
 
-/// Records an undo step: going back to `revision` undoes `what` (words, e.g. 'move "elbow L"').
+/// Records an undo step of the open scene: going back to `revision` undoes `what` (words, e.g.
+/// 'move "elbow L"').
 export function pushUndo(revision, what) {
-  undoStack.push({ revision, what });
+  undoStack.push({ revision, what, scene: store.sceneId });
   redoStack.length = 0;
   emit(Topic.UNDO);
 }
@@ -53,8 +54,9 @@ export function committingChange(work) {
 }
 
 /// Resolves once every change this editor has made is answered and on the undo stack: a waiting
-/// key burst sent, no change committing, no edit queued or in flight.
-async function ownChangesAnswered() {
+/// key burst sent, no change committing, no edit queued or in flight. Undo and redo wait for it,
+/// and so does opening another scene (the changes go to the scene they were made in).
+export async function ownChangesAnswered() {
   for (;;) {
     await beforeEdit();
     await Promise.allSettled([...committing]);
@@ -82,24 +84,27 @@ let queue = Promise.resolve(); // this editor's edits, one at a time, in order
 /// the order asked, each with the revision its predecessor left; `body` may be a function of the
 /// current document, called when the edit's turn comes (so quick key repeats add up). Resolves to
 /// the answer, or null when the server refused it (the notice is shown) or `body` gave null.
-/// `undoable` records it for undo.
+/// `undoable` records it for undo. An edit belongs to the scene open when it is asked for: one
+/// whose turn comes after another scene was opened is dropped (null).
 export function edit(method, path, body, opts = {}) {
   beforeEdit();
   set({ busy: store.busy + 1 });
-  const run = queue.then(() => send(method, path, body, opts)).finally(() => set({ busy: store.busy - 1 }));
+  const scene = store.sceneId;
+  const run = queue.then(() => (scene === store.sceneId ? send(method, path, body, opts) : null)).finally(() => set({ busy: store.busy - 1 }));
   queue = run.catch(() => {});
   return run;
 }
 
 async function send(method, path, body, { undoable = true, quiet = false, what = null, onRefused = null } = {}) {
-  const before = store.revision;
+  const before = store.revision, scene = store.sceneId;
   const payload = typeof body === "function" ? body(store.doc) : body;
   if (payload === null) return null;
   const words = undoable ? what || describeEdit(method, path, payload) : null; // before the answer changes the document
   try {
     const sentAt = performance.now();
-    const answer = await api.send(method, scenePath(store.sceneId, path), payload, before);
+    const answer = await api.send(method, scenePath(scene, path), payload, before);
     if (trace.on) trace.acks.push({ sentAt, ackAt: performance.now() });
+    if (scene !== store.sceneId) return answer; // another scene is open now: nothing of this one to show or undo
     accept(answer);
     if (store.saveError !== null) set({ saveError: null });
     if (undoable) pushUndo(before, words);
@@ -159,7 +164,9 @@ export async function removePlacements(ids) {
   if (!gone.length) return;
   const before = Math.min(...answers.filter(Boolean).map((a) => a.revision)) - 1;
   const what = gone.length === 1 ? `"${names.get(gone[0])}"` : `${gone.length} placements`;
+  const scene = store.sceneId;
   notify(`Deleted ${what}.`, "info", { label: "Undo", run: async () => {
+    if (scene !== store.sceneId) return notify(`That deletion was in another scene: open it again to bring ${what} back (History).`, "warn");
     if (await revert(before, { what: `bring back ${what}` })) set({ selection: gone.filter((id) => store.doc.placements.some((p) => p.id === id)) });
   } });
 }
@@ -192,11 +199,12 @@ export async function revert(revision, { undoable = true, what = null } = {}) {
 /// back as its button.
 async function travel(from, to, nothing, verb, back) {
   await ownChangesAnswered(); // a key burst still waiting, an edit on its way: each becomes the step undone first
+  while (from.length && from[from.length - 1].scene !== store.sceneId) from.pop(); // steps of a scene left
   if (!from.length) return notify(nothing, "info");
   const step = from.pop();
   const here = store.revision;
   if (await revert(step.revision, { undoable: false })) {
-    to.push({ revision: here, what: step.what });
+    to.push({ revision: here, what: step.what, scene: step.scene });
     notify(`${verb}: ${step.what || `revision ${step.revision}`}.`, "info", back, "undo");
   } else from.push(step);
   emit(Topic.UNDO);
@@ -223,6 +231,7 @@ export class Stream {
     this.sent = 0;
     this.ok = 0;
     this.before = store.revision;
+    this.scene = store.sceneId;
     this.timer = null;
     this.done = false;
     set({ gestures: store.gestures + 1 }, []); // not told: nothing shows otherwise until the gesture changes something
@@ -266,7 +275,7 @@ export class Stream {
       await this.go(value);
     }
     this.end();
-    if (this.ok > 0) {
+    if (this.ok > 0 && this.scene === store.sceneId) {
       const what = typeof this.what === "function" ? this.what(this.last) : this.what;
       pushUndo(this.before, what);
     }

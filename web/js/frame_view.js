@@ -540,18 +540,26 @@ export function pickAt(x, y) {
                                            pitch: p.pitch, distance: p.distance, target: p.target, time: p.time }));
 }
 
+let clicks = 0; // clicks picked (see click)
+
+/// A click on the frame: the pick there, then a new placement (place tool, Alt) or a selection.
+/// A selection pick whose answer comes after a newer click, or after the selection changed some
+/// other way meanwhile (the list, a key), is dropped: the newer choice stands.
 async function click(e) {
   const px = framePixel(e);
   if (!px || !store.doc) return;
+  const n = ++clicks, selection = store.selection;
   let hit;
   try { hit = await pickAt(px[0], px[1]); } catch (err) { notify(`Pick: ${err.message}`, "error"); return; }
-  if (!hit.hit) { if (!placeTool && !e.altKey) set({ selection: [] }); return; }
+  const current = n === clicks && store.selection === selection;
+  if (!hit.hit) { if (!placeTool && !e.altKey && current) set({ selection: [] }); return; }
   if (placeTool || e.altKey) {
     emit(Topic.PLACE_AT, { uv: hit.uv, suggested: hit.suggested, anchor: hit.anchor });
     if (placeAs === "surface" && hit.anchor) await placeOnBody(hit.anchor, hit.suggested);
     else await placeAt(hit.uv, hit.suggested);
     return;
   }
+  if (!current) return;
   const p = geo.hitPick(store.doc.placements, hit);
   if (p) set({ selection: [p.id] });
   else notify(`No placement at UV (${hit.uv[0].toFixed(3)}, ${hit.uv[1].toFixed(3)}); skin of ${hit.joints.map((j) => j.name).join(", ")}. Use the place tool (P) to add one here.`, "info");

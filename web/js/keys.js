@@ -5,7 +5,7 @@ import { store, set, placementById, heightmapSize } from "./store.js";
 import { pickUVPath, outlinePath } from "./scene_resource.js";
 import * as geo from "./geometry.js";
 import { removePlacements, mirrorPlacement, addPlacement, patchPlacement, undo, redo, committingChange } from "./edits.js";
-import { nudge } from "./pending.js";
+import { nudge, withPending } from "./pending.js";
 import { cancelDrag, dragging, viewCentreUV, zoomBy, panBy } from "./texture_view.js";
 import { setPlaceTool, placeToolOn, resizeBrush } from "./frame_view.js";
 import { cancelDecalDrag } from "./camera3d.js";
@@ -97,7 +97,7 @@ function onKey(e, { dlg, fitTexture }) {
     const uvSel = sel.filter((id) => geo.inTexture(placementById(id)));
     if (uvSel.length) nudge(uvSel, (q) => ({ center: [geo.round4(q.center[0] + d[0]), geo.round4(q.center[1] + d[1])] }), "move");
     const onBody = sel.filter((id) => !geo.inTexture(placementById(id)));
-    if (onBody.length) committingChange(() => nudgeOnBody(onBody, d));
+    if (onBody.length) committingChange(() => (bodyNudges = bodyNudges.then(() => nudgeOnBody(onBody, d))));
   } else if (k.startsWith("Arrow") && inTextureView()) {
     const step = e.shiftKey ? 200 : 40; // css px; nothing is selected: the arrows pan
     panBy(...ARROWS[k].map((c) => c * step));
@@ -193,7 +193,7 @@ export function setKeysApi(theApi) { api = theApi; }
 async function duplicate(ids) {
   const added = [];
   for (const id of ids) {
-    const p = placementById(id);
+    const p = withPending(placementById(id)); // as shown: a key burst's change is in the copy too
     if (!p) continue;
     const { id: _omit, ...copy } = p;
     if (geo.inTexture(p)) copy.center = [geo.round4(p.center[0] + p.scale[0] * 0.25), geo.round4(p.center[1] + p.scale[1] * 0.25)];
@@ -208,6 +208,10 @@ async function duplicate(ids) {
 }
 
 export { currentPattern };
+
+// Arrow nudges on the body run one after another: each reads the anchor the one before left, so
+// quick presses add up (at the same time they would all start from the same stored anchor).
+let bodyNudges = Promise.resolve();
 
 /// Slides placements on the body (SPEC §8) by `d` in the texture: each anchor goes to the body point
 /// at the texel beside its own (GET outline's anchor_uv, then pick by UV), its tangent kept; one

@@ -10,7 +10,7 @@ import { SCENES_PATH, scenePath, lintPath, heightmapsPath } from "./scene_resour
 import { signIn } from "./signin.js";
 import { notify } from "./notice.js";
 import { initImages, forget } from "./images.js";
-import { initEdits, accept, clearUndo, canUndo, canRedo, putScene, undo, redo, revert } from "./edits.js";
+import { initEdits, accept, clearUndo, canUndo, canRedo, putScene, undo, redo, revert, ownChangesAnswered } from "./edits.js";
 import { initTextureView, fit, screenGeometry, dragPreview, labelLayout, panBy } from "./texture_view.js";
 import { initFrameView, setPatternSource, setPreviewSource, setFrameSize, frameStats, frameUrl, pickAt } from "./frame_view.js";
 import { initLibrary, currentPattern, uploadPattern } from "./panels/library.js";
@@ -57,14 +57,23 @@ async function loadLint() {
   if (read === lintReads && id === store.sceneId) set({ lint });
 }
 
+let opening = 0; // scene opens started (see openScene)
+
 /// Opens scene `id`; `link` (a permalink's fields) sets revision, time, camera and selection.
+/// This window's changes to the scene it leaves are sent and answered there first. Opens can
+/// overlap (arrow keys on the scene menu): only the newest one opens its scene.
 async function openScene(id, link = {}) {
+  const ticket = ++opening;
+  await ownChangesAnswered();
   const answer = await api.get(scenePath(id));
+  if (ticket !== opening) return;
   const model = await api.get(`/models/${encodeURIComponent(answer.scene.model)}`);
+  if (ticket !== opening) return;
   // The height-map layout the scene uses (SPEC §8: its own UVs, or the generated layout where
   // they are missing or shared); null where there is none to draw (uv_layout "model" without UVs).
   const layoutMode = encodeURIComponent(answer.scene.uv_layout || "auto");
   const layout = await api.get(`/models/${encodeURIComponent(model.id)}/uv-layout?layout=${layoutMode}`).catch(() => null);
+  if (ticket !== opening) return;
   clearUndo();
   const camera = { yaw: link.yaw ?? 0, pitch: link.pitch ?? 10, distance: link.distance ?? null, target: link.target ?? null };
   if (link.yaw === undefined && answer.scene.render && answer.scene.render.camera) {

@@ -6,7 +6,7 @@
 
 import { store, on, set, whenIdle, Topic } from "../store.js";
 import { patternImagePath } from "../images.js";
-import { patchPlacement, putScene } from "../edits.js";
+import { patchPlacement, putOrder } from "../edits.js";
 import { escapeHtml } from "./library.js";
 import { rowForListKey } from "../list_keys.js";
 import { addsToSelection } from "../selection.js";
@@ -43,15 +43,32 @@ export function toggleSolo(ids) {
   set({ solo: [...solo] });
 }
 
-/// Moves placement `id` before `beforeId` (end when null): the document with the new order.
+/// Moves placement `id` before `beforeId` (end when null): the document with the new order, made
+/// from the document as it is when the edit's turn comes (quick moves add up; an edit still on
+/// its way is not undone by an older copy of the document).
 export async function reorder(id, beforeId) {
-  const ps = [...store.doc.placements];
-  const from = ps.findIndex((p) => p.id === id);
-  if (from < 0) return;
-  const [moved] = ps.splice(from, 1);
-  const to = beforeId === null ? ps.length : ps.findIndex((p) => p.id === beforeId);
-  ps.splice(to < 0 ? ps.length : to, 0, moved);
-  await putScene({ ...store.doc, placements: ps });
+  await putOrder((doc) => {
+    const ps = [...doc.placements];
+    const from = ps.findIndex((p) => p.id === id);
+    if (from < 0) return null;
+    const [moved] = ps.splice(from, 1);
+    const to = beforeId === null ? ps.length : ps.findIndex((p) => p.id === beforeId);
+    ps.splice(to < 0 ? ps.length : to, 0, moved);
+    return { ...doc, placements: ps };
+  });
+}
+
+/// Moves placement `id` by `delta` places (Alt+↑/↓), counted in the document as it is when the
+/// edit's turn comes: two quick presses move it two places.
+async function moveBy(id, delta) {
+  await putOrder((doc) => {
+    const ps = [...doc.placements];
+    const i = ps.findIndex((p) => p.id === id), j = i + delta;
+    if (i < 0 || j < 0 || j >= ps.length) return null;
+    const [moved] = ps.splice(i, 1);
+    ps.splice(j, 0, moved);
+    return { ...doc, placements: ps };
+  });
 }
 
 /// ↑/↓, Home and End on a row: the row before/after (first/last) is selected and focused.
@@ -109,10 +126,7 @@ function render() {
       if (!e.altKey || (e.key !== "ArrowUp" && e.key !== "ArrowDown")) return;
       e.preventDefault();
       e.stopPropagation();
-      const ps = store.doc.placements, i = ps.findIndex((q) => q.id === p.id);
-      const j = e.key === "ArrowUp" ? i - 1 : i + 2;
-      if (j < 0 || j > ps.length) return;
-      reorder(p.id, j === ps.length ? null : ps[j].id);
+      moveBy(p.id, e.key === "ArrowUp" ? -1 : 1);
     });
     list.append(li);
   }
