@@ -207,3 +207,19 @@ TEST(EnvironmentsServiceTest, UploadsSurviveARestart) {
     doc["render"]["environment"] = id;
     EXPECT_TRUE((*svc)->createScene(doc, {})) << "a scene names the restored environment";
 }
+
+TEST(EnvironmentsUploadLimitHttpTest, AnEnvironmentUploadHasTheUploadLimitNotTheJsonOne) {
+    // JSON bodies capped at 1 MiB, uploads at kMaxUpload (8 MiB): an environment is an upload.
+    ApiOptions opt;
+    opt.maxJsonBytes = 1u << 20;
+    std::string error;
+    auto server = LiveServer::start(mainLimits(), "", error, opt);
+    ASSERT_TRUE(server && error.empty()) << error;
+    Http h(server->port());
+    std::vector<std::uint8_t> bytes(2u << 20, 0x7f); // 2 MiB: over the JSON limit, under the upload limit; no image
+    expectError(h.upload("/environments", bytes, "image/vnd.radiance"), 415, "body"); // read whole, then refused as no environment
+    bytes.resize(kMaxUpload + 1024, 0x7f);
+    EXPECT_EQ(h.upload("/environments", bytes, "image/vnd.radiance").status, 413);
+    // Scene documents keep the JSON limit.
+    EXPECT_EQ(h.post("/scenes", json{{"model", "builtin:default"}, {"pad", std::string(2u << 20, 'x')}}).status, 413);
+}

@@ -138,6 +138,7 @@ TEST_F(EventsHttpTest, EventStreamsCannotTakeEveryHttpThread) {
     std::condition_variable cv;
     std::vector<int> statuses(kStreams, 0);
     std::vector<std::string> retryAfter(kStreams);
+    std::vector<std::size_t> retryAfters(kStreams, 0); // how many Retry-After headers
     std::atomic<bool> stop{false};
     std::vector<std::thread> readers;
     for (int i = 0; i < kStreams; ++i)
@@ -151,6 +152,7 @@ TEST_F(EventsHttpTest, EventStreamsCannotTakeEveryHttpThread) {
                         std::lock_guard<std::mutex> lock(mutex);
                         statuses[static_cast<std::size_t>(i)] = r.status;
                         retryAfter[static_cast<std::size_t>(i)] = r.get_header_value("Retry-After");
+                        retryAfters[static_cast<std::size_t>(i)] = r.get_header_value_count("Retry-After");
                     }
                     cv.notify_all();
                     return true;
@@ -185,6 +187,7 @@ TEST_F(EventsHttpTest, EventStreamsCannotTakeEveryHttpThread) {
         else if (statuses[static_cast<std::size_t>(i)] == 503) {
             ++refused;
             EXPECT_FALSE(retryAfter[static_cast<std::size_t>(i)].empty());
+            EXPECT_EQ(retryAfters[static_cast<std::size_t>(i)], 1u) << "one Retry-After";
         } else
             ADD_FAILURE() << "stream " << i << ": status " << statuses[static_cast<std::size_t>(i)];
     }

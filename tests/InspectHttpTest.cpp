@@ -183,7 +183,13 @@ TEST_F(InspectHttpTest, MirrorAddsTheTwinOnTheOtherSide) {
 
     // A footprint centre on no UV chart cannot be mirrored; an unknown placement is 404.
     ASSERT_EQ(h.patch(s + "/placements/stomach", {{"center", {0.995, 0.995}}, {"scale", {0.005, 0.005}}}).status, 200);
-    expectError(h.call("POST", s + "/placements/stomach/mirror", "", "", {}), 422, "center");
+    int stomachAt = -1; // the field names the placement's member in the document
+    const json ps = h.get(s).js()["scene"]["placements"];
+    for (std::size_t k = 0; k < ps.size(); ++k)
+        if (ps[k]["id"] == "stomach") stomachAt = static_cast<int>(k);
+    ASSERT_GE(stomachAt, 0);
+    expectError(h.call("POST", s + "/placements/stomach/mirror", "", "", {}), 422,
+                "/placements/" + std::to_string(stomachAt) + "/center");
     expectError(h.call("POST", s + "/placements/nope/mirror", "", "", {}), 404, "pid");
     ASSERT_EQ(h.del(s).status, 204);
 }
@@ -242,7 +248,7 @@ TEST_F(InspectHttpTest, CompareFramesAndDiffs) {
     expectError(h.get(s + "/frame?revision=0"), 422, "revision");
     expectError(h.get(s + "/frame-diff?" + size), 422, "against");
     expectError(h.get(s + "/frame-diff?against=abc"), 422, "against");
-    expectError(h.get(s + "/frame-diff?against=77"), 404, "revision");
+    expectError(h.get(s + "/frame-diff?against=77"), 404, "against"); // the revision compared against
     ASSERT_EQ(h.del(s).status, 204);
 }
 

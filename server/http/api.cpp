@@ -53,7 +53,7 @@ void sendJson(Res& res, int status, const json& body) {
 
 void sendError(Res& res, int status, const std::string& code, const std::string& message,
                const std::string& field) {
-    if (status == 503) res.set_header("Retry-After", "1");
+    if (status == 503 && !res.has_header("Retry-After")) res.set_header("Retry-After", "1"); // one: a route may have set its own
     sendJson(res, status, {{"error", {{"code", code}, {"message", message}, {"field", field}}}});
 }
 
@@ -367,9 +367,11 @@ bool Api::Impl::isOpen(const std::string& method, const std::string& path) const
 
 std::size_t Api::Impl::bodyLimitOf(const Req& req) const {
     const std::size_t upload = svc.limits().maxUploadBytes;
-    // Uploads, and batches that carry their content (multipart, SPEC §7), at the upload limit.
+    // Uploads (patterns, models, environments), and batches that carry their content (multipart,
+    // SPEC §7), at the upload limit.
     const bool isUpload = req.method == "POST" &&
                           (req.path == kPrefix + "/patterns" || req.path == kPrefix + "/models" ||
+                           req.path == kPrefix + "/environments" ||
                            (req.path == kPrefix + "/render" && hasContentType(req, {"multipart/form-data"})));
     return isUpload ? upload : std::min(upload, opt.maxJsonBytes);
 }

@@ -38,7 +38,8 @@ struct ApiOptions {
     int maxConnectionsPerAddress = 256;
     int headSeconds = 10;
     /// Bodies of JSON routes: at most this (and at most the upload limit); uploads (POST /models,
-    /// POST /patterns) at most ServerLimits::maxUploadBytes. Enforced while the body streams.
+    /// POST /patterns, POST /environments, a multipart POST /render) at most
+    /// ServerLimits::maxUploadBytes. Enforced while the body streams.
     std::size_t maxJsonBytes = 8u << 20;
     int maxSessions = 256; ///< browser sessions kept at once; the oldest is forgotten beyond
     int sessionMaxAgeSeconds = 12 * 3600; ///< a session's lifetime (and its cookie's Max-Age)

@@ -22,7 +22,11 @@ void installModelRoutes(RouteTable& t) {
             }
             bool existing = false;
             auto r = a.svc.addModelFiles(files, gltfName, req.get_param_value("name"), &existing);
-            if (!r) return sendError(res, r.error());
+            if (!r) {
+                Error e = r.error();
+                if (e.field.empty() && !gltfName.empty()) e.field = "files/" + gltfName; // the .gltf's part
+                return sendError(res, e);
+            }
             return sendJson(res, existing ? 200 : 201, *r); // 200: these bytes were uploaded before
         }
         if (!hasContentType(req, {"model/gltf-binary", "application/octet-stream"}))

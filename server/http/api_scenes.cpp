@@ -157,9 +157,10 @@ void installHistoryRoutes(RouteTable& t) {
                   rev->get<std::uint64_t>() == 0)
                   return makeError(ErrorCode::InvalidArgument, "dermis::Api", "/revision",
                                    "the body must be {\"revision\": N} with N >= 1");
-              if (body.size() != 1)
-                  return makeError(ErrorCode::InvalidArgument, "dermis::Api", "",
-                                   "only \"revision\" may be given");
+              for (auto it = body.begin(); it != body.end(); ++it)
+                  if (it.key() != "revision")
+                      return makeError(ErrorCode::InvalidArgument, "dermis::Api", "/" + it.key(),
+                                       "only \"revision\" may be given");
               return s.revert(req.matches[1], rev->get<std::uint64_t>(), ctx);
           }));
     t.add("POST", "/scenes/{id}/presence", [](Api::Impl& a, const Req& req, Res& res) {

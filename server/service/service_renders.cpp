@@ -246,6 +246,7 @@ Error asParamError(Error e, const FrameParams& p) {
     } map[] = {{"/render/size/0", "width", p.width.has_value()},
                {"/render/size/1", "height", p.height.has_value()},
                {"/render/msaa", "msaa", p.msaa.has_value()},
+               {"/render/exposure", "exposure", p.exposure.has_value()},
                {"/render/camera/yaw", "yaw", p.yaw.has_value()},
                {"/render/camera/pitch", "pitch", p.pitch.has_value()},
                {"/render/camera/distance", "distance", p.distance.has_value()},
@@ -309,7 +310,11 @@ Result<EncodedImage> Service::frameDiff(const std::string& id, const FrameParams
     auto a = state_->frameSnapshot(id, p);
     if (!a) return a.error();
     auto b = state_->frameSnapshot(id, other);
-    if (!b) return b.error();
+    if (!b) { // the revision compared against is `against` (this request has no `revision` of its own there)
+        Error e = b.error();
+        if (e.field == "revision" && against != "off") e.field = "against";
+        return e;
+    }
     std::optional<std::array<double, 4>> camera;
     auto ia = state_->renderImage(*a, p, &camera);
     if (!ia) return asParamError(ia.error(), p);

@@ -182,6 +182,8 @@ Result<json> Service::createScene(const json& body, const EditContext& ctx) {
         const bool wanted = dp->get<bool>();
         doc.erase("default_patterns");
         if (wanted) {
+            if (auto m = doc.find("model"); m != doc.end() && !m->is_string())
+                return bad("/model", "must be a string (a model id)");
             if (doc.value("model", std::string(kBuiltinDefault)) != kBuiltinDefault)
                 return bad("/default_patterns", "the default pattern set exists only for builtin:default");
             if (!state_->defaultSceneDoc.is_object())
@@ -324,6 +326,8 @@ Result<json> Service::mirrorPlacement(const std::string& id, const std::string& 
         if (!twin) {
             Error e = twin.error();
             e.code = ErrorCode::InvalidArgument; // the placement cannot be mirrored: 422
+            // Fields of the placement (or of the layout its maps live in) in the scene document.
+            e.field = e.field == "/uvs" ? "/uv_layout" : "/placements/" + std::to_string(at) + "/" + e.field;
             return e;
         }
         // Mirroring twice stacks nothing: a placement that already is the twin answers 409.
