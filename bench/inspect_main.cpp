@@ -260,11 +260,11 @@ int main(int argc, char** argv) {
     std::vector<std::pair<std::string, std::string>> cases; // label, path ("" = built-in)
     if (models.empty()) {
         cases.emplace_back("builtin:default", "");
-        const std::string models = dermis::build::testModelsDir();
+        const std::string dir = dermis::build::testModelsDir();
         for (auto [label, rel] :
              {std::pair{"CesiumMan", "/CesiumMan/CesiumMan.glb"},
               std::pair{"KayKitBarbarian", "/KayKitBarbarian/Barbarian.glb"}})
-            if (std::filesystem::exists(models + rel)) cases.emplace_back(label, models + rel);
+            if (std::filesystem::exists(dir + rel)) cases.emplace_back(label, dir + rel);
     } else {
         for (const std::string& m : models)
             cases.emplace_back(std::filesystem::path(m).stem().string(), m);
