@@ -15,7 +15,7 @@
 // editor-3d-sweep-zoom.png.
 import assert from "node:assert/strict";
 import { createHash } from "node:crypto";
-import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, sleep, settledFrameHash } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, sleep, settledFrameHash, holdAnswers } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-3d-");
 const api = apiClient(server.base);
@@ -168,6 +168,48 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       const p0 = project(c0, on.hit.position, n), p1 = project(c1, on.hit.position, n);
       assert.ok(Math.hypot(p1[0] - p0[0], p1[1] - p0[1]) < 2.5, `the point under the cursor stays: ${p0} → ${p1}`);
       assert.notDeepEqual(c1.target, c0.target, "the target moved towards the cursor");
+    }],
+    ["a wheel tick right after a pick answered for the camera before the last tick still keeps the skin under the pointer", async () => {
+      // Picks answer 1.5 s late: the pointer's pick (camera 0) lands after tick A moved the camera;
+      // tick B must zoom about the skin under the pointer now, not about that pick's point (which
+      // shows elsewhere after tick A: zooming about it drifts the picture under the pointer).
+      const n = await size();
+      await settledFrameHash(page);
+      const far = await page.evaluate(async () => {
+        const ed = window.dermisEditor, n = (await import("/js/frame_view.js")).frameParams().width;
+        let best = null;
+        for (let y = Math.floor(n * 0.1); y < n * 0.9; y += Math.floor(n / 16))
+          for (let x = Math.floor(n * 0.1); x < n * 0.9; x += Math.floor(n / 16)) {
+            const d = Math.hypot(x - n / 2, y - n / 2);
+            if (best && d <= best.d) continue;
+            const hit = await ed.pickAt(x, y);
+            if (hit.hit) best = { px: [x, y], d };
+          }
+        return best;
+      });
+      assert.ok(far && far.d > n * 0.15, `a pixel on the skin off the centre (${JSON.stringify(far)})`);
+      const slow = await holdAnswers(page, (url) => url.pathname.endsWith("/pick"), { ms: 1500 });
+      const [x, y] = await client(far.px);
+      await page.mouse.move(x, y);
+      await sleep(100);
+      const c0 = await camera();
+      await page.mouse.wheel(0, -200); // tick A: no pick at this pixel yet: about the target
+      const cA = await until(async () => { const c = await camera(); return c.distance < c0.distance && c; }, "tick A zoomed");
+      await until(() => page.evaluate((px) => import("/js/camera3d.js").then((m) => {
+        const last = m.pointer.last;
+        return !!(last && last.hit && Math.hypot(last.px[0] - px[0], last.px[1] - px[1]) <= 3);
+      }), far.px), "the pointer's pick (made before tick A) landed", 5000);
+      // The skin under the pointer with tick A's camera, asked directly (not held).
+      const p = await page.evaluate((px) => import("/js/frame_view.js").then((m) => ({ ...m.frameParams(), x: px[0], y: px[1] })), far.px);
+      const q = new URLSearchParams();
+      for (const k of ["x", "y", "width", "height", "yaw", "pitch", "distance", "target", "time"]) if (p[k] !== undefined) q.set(k, p[k]);
+      const under = (await api("GET", `/scenes/${sceneId}/pick?${q}`)).body;
+      assert.ok(under.hit, "skin under the pointer after tick A");
+      await page.mouse.wheel(0, -200); // tick B, before the pick with tick A's camera answers
+      const cB = await until(async () => { const c = await camera(); return c.distance < cA.distance && c; }, "tick B zoomed");
+      await slow.stop();
+      const pA = project(cA, under.position, n), pB = project(cB, under.position, n);
+      assert.ok(Math.hypot(pB[0] - pA[0], pB[1] - pA[1]) < 2.5, `the skin under the pointer stays: ${pA} → ${pB}`);
     }],
     ["hovering a placement outlines it; the place tool shows its brush", async () => {
       await page.evaluate(async () => { const m = await import("/js/store.js"); m.set({ selection: [] }); });

@@ -14,7 +14,7 @@
 // undo steps left behind), and a deletion's Undo clicked in another scene does not touch it.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
-import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, runSuite, until, sleep } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, runSuite, until, sleep, selectPlacement, holdAnswers } from "./editor_lib.mjs";
 
 const exe = process.argv[2];
 let server = await startServer(exe, [], "dermis-editor-collab-");
@@ -26,7 +26,7 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
   const sceneId = (await state(a)).sceneId;
   const b = await openEditor(ctxB, `${server.base}/?scene=${sceneId}`);
   const serverPlacement = async (id) => (await api("GET", `/scenes/${sceneId}`)).body.scene.placements.find((p) => p.id === id);
-  const select = async (page, id) => { await page.click(`#placementList li[data-placement="${id}"] .name`); await page.focus("#uv"); };
+  const select = async (page, id) => { await selectPlacement(page, id); await page.focus("#uv"); };
 
   let failures = await runChecks("WebEditorCollabBrowserTest", [
     ["an edit in one context appears in the other (the delay printed)", async () => {
@@ -160,13 +160,7 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       // Each change event starts a read of the scene; here the first read's answer (the older
       // revision) is held back until after the second one's. The editor must end at the newest.
       const path = new URL(`${server.base}/api/v1/scenes/${sceneId}`).pathname;
-      let held = 0;
-      await b.route((url) => url.pathname === path, async (route) => {
-        if (route.request().method() !== "GET" || held++ > 0) return route.continue();
-        const answer = await route.fetch(); // read now (the older revision), delivered late
-        await sleep(1000);
-        await route.fulfill({ response: answer });
-      });
+      const reads = await holdAnswers(b, (url) => url.pathname === path, { methods: ["GET"], first: 1 }); // read now (the older revision), delivered late
       const d = (await api("GET", `/scenes/${sceneId}`)).body;
       let r = d.revision;
       for (const id of ["neck", "stomach"]) {
@@ -176,11 +170,11 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
         r = answer.body.revision;
         await sleep(150); // the first event's read is on its way before the second change
       }
-      await until(async () => held >= 2, "two reads");
+      await until(async () => reads.seen >= 2, "two reads");
       await sleep(1500); // the held answer has arrived
-      await b.unroute((url) => url.pathname === path);
+      await reads.stop();
       const s = await state(b);
-      assert.equal(s.revision, r, `the editor is at the newest revision (${s.revision}, server ${r}, reads ${held})`);
+      assert.equal(s.revision, r, `the editor is at the newest revision (${s.revision}, server ${r}, reads ${reads.seen})`);
       assert.deepEqual(s.doc, (await api("GET", `/scenes/${sceneId}`)).body.scene);
     }],
     ["changes whose answers are slow stay with their scene, and add up (every PATCH, PUT and DELETE answer held 1 s)", async () => {
@@ -188,12 +182,7 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       const s1 = (await api("POST", "/scenes", { default_patterns: true })).body.id;
       const s2 = (await api("POST", "/scenes", { default_patterns: true })).body.id;
       const c = await openEditor(await browser.newContext(), `${server.base}/?scene=${s1}`);
-      await c.route((url) => url.pathname.startsWith("/api/v1/scenes/"), async (route) => {
-        if (!["PATCH", "PUT", "DELETE"].includes(route.request().method())) return route.continue();
-        const answer = await route.fetch();
-        await sleep(1000);
-        await route.fulfill({ response: answer });
-      });
+      await holdAnswers(c, (url) => url.pathname.startsWith("/api/v1/scenes/"), { methods: ["PATCH", "PUT", "DELETE"] });
       const scene = async (id) => (await api("GET", `/scenes/${id}`)).body;
       const placement = async (id, pid) => (await scene(id)).scene.placements.find((p) => p.id === pid);
       await select(c, "neck");
@@ -210,6 +199,7 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       const ids0 = (await scene(s1)).scene.placements.map((p) => p.id);
       await c.focus(`#placementList li[data-placement="${ids0[0]}"] .name`);
       await c.keyboard.press("Alt+ArrowDown");
+      await sleep(200); // the first move's local re-render comes between the presses
       await c.keyboard.press("Alt+ArrowDown");
       const ids1 = await until(async () => { const ids = (await scene(s1)).scene.placements.map((p) => p.id); return ids[2] === ids0[0] && ids; }, "moved down two places");
       assert.deepEqual(ids1.slice(0, 2), ids0.slice(1, 3));
@@ -242,6 +232,31 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       await c.waitForSelector('#notices .notice:has-text("deletion was in another scene")', { timeout: 5000 });
       await sleep(1500);
       assert.deepEqual(await scene(s2), before2, "the other scene is still untouched");
+      assert.deepEqual(c.errors, []);
+      await c.close();
+    }],
+    ["comparing against a revision, then opening another scene: the comparison is against patterns off there", async () => {
+      // A revision number is one scene's: the other scene's r1 is another picture.
+      const s1 = (await api("POST", "/scenes", { default_patterns: true })).body.id;
+      const s2 = (await api("POST", "/scenes", { default_patterns: true })).body.id;
+      const p0 = (await api("GET", `/scenes/${s1}`)).body.scene.placements[0];
+      assert.equal((await api("PATCH", `/scenes/${s1}/placements/${p0.id}`, { h: p0.h / 2 })).status, 200);
+      const c = await openEditor(await browser.newContext(), `${server.base}/?scene=${s1}`);
+      await c.selectOption("#compareMode", "diff");
+      const shown = (await state(c)).revision;
+      const r1 = String((await api("GET", `/scenes/${s1}/revisions`)).body.revisions.find((r) => r.revision !== shown).revision);
+      await c.waitForSelector(`#compareAgainst option[value="${r1}"]`, { state: "attached", timeout: 10000 });
+      await c.selectOption("#compareAgainst", r1);
+      const diffs = [];
+      c.on("request", (r) => { if (r.url().includes("/frame-diff")) diffs.push(new URL(r.url())); });
+      await until(async () => diffs.some((u) => u.searchParams.get("against") === r1), "a diff against that revision");
+      diffs.length = 0;
+      await c.selectOption("#scene", s2);
+      await until(async () => (await state(c)).sceneId === s2, "the other scene open");
+      await until(async () => diffs.some((u) => u.pathname.includes(s2)), "a diff of the other scene");
+      assert.equal(await c.evaluate(() => window.dermisEditor.store.compare.against), "off");
+      assert.equal(await c.$eval("#compareAgainst", (e) => e.value), "off");
+      for (const u of diffs.filter((x) => x.pathname.includes(s2))) assert.equal(u.searchParams.get("against"), "off", `${u}`);
       assert.deepEqual(c.errors, []);
       await c.close();
     }],

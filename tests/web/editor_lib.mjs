@@ -97,6 +97,37 @@ export const state = (page) => page.evaluate(() => {
   return { sceneId: s.sceneId, revision: s.revision, doc: s.doc, selection: s.selection, solo: s.solo, time: s.time, online: s.online, pinnedRevision: s.pinnedRevision, camera: s.camera };
 });
 
+/// Selects placement `id` by clicking its row's name in the placement list, as a person does;
+/// clicks again if the list was re-rendered under the click (an event from another client) until
+/// the editor's selection is exactly [id].
+export async function selectPlacement(page, id) {
+  const row = `#placementList li[data-placement="${id}"] .name`;
+  await until(async () => {
+    await page.click(row, { timeout: 3000 }).catch(() => {});
+    const now = await page.evaluate(() => window.dermisEditor.store.selection);
+    return now.length === 1 && now[0] === id;
+  }, `${id} selected`);
+}
+
+/// A slow link's way back: requests of `page` whose URL `match` takes (a Playwright URL matcher)
+/// and whose method is in `methods` (all when omitted) reach the server at once; their answers
+/// arrive `ms` late. Only the first `first` such requests are held. Returns { seen, held, stop }:
+/// the requests seen and held so far, and stop() — the route's removal.
+export async function holdAnswers(page, match, { methods = null, ms = 1000, first = Infinity } = {}) {
+  const h = { seen: 0, held: 0 };
+  const handler = async (route) => {
+    if (methods && !methods.includes(route.request().method())) return route.continue();
+    if (h.seen++ >= first) return route.continue();
+    const answer = await route.fetch(); // the server has it now
+    h.held++;
+    await sleep(ms);
+    await route.fulfill({ response: answer });
+  };
+  await page.route(match, handler);
+  h.stop = () => page.unroute(match, handler);
+  return h;
+}
+
 /// Screen geometry (client px) of a placement's footprint in the texture view.
 export const footprint = (page, id) => page.evaluate((pid) => {
   const g = window.dermisEditor.screenGeometry(pid);

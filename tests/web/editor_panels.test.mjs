@@ -12,7 +12,7 @@
 import assert from "node:assert/strict";
 import { writeFileSync } from "node:fs";
 import { join } from "node:path";
-import { startServer, launch, apiClient, openEditor, settledFrameHash, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep, shotDir } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, settledFrameHash, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep, shotDir, selectPlacement, holdAnswers } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-panels-");
 const api = apiClient(server.base);
@@ -22,7 +22,7 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
   const page = await openEditor(context, server.base + "/");
   const sceneId = (await state(page)).sceneId;
   const doc = async () => (await api("GET", `/scenes/${sceneId}`)).body.scene;
-  const select = async (id) => { await page.click(`#placementList li[data-placement="${id}"] .name`); };
+  const select = (id) => selectPlacement(page, id);
   const settle = () => settled(page, api);
   const uploads = [];
   page.on("request", (r) => { if (r.method() === "POST" && new URL(r.url()).pathname === "/api/v1/patterns") uploads.push(r.url()); });
@@ -183,13 +183,13 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       // A click whose pick answers late (1 s) after another placement was chosen in the list: the
       // list's choice stands (the late pick does not take the selection back).
       const late = (url) => url.pathname.endsWith("/pick") && url.searchParams.has("x");
-      await page.route(late, async (route) => { const answer = await route.fetch(); await sleep(1000); await route.fulfill({ response: answer }); });
+      const lateAnswers = await holdAnswers(page, late);
       await page.keyboard.press("Escape");
       await page.mouse.click(box[0] + (box[2] - side) / 2 + ((target.x + 0.5) / 512) * side, box[1] + (box[3] - side) / 2 + ((target.y + 0.5) / 512) * side);
       const other = (await doc()).placements.find((p) => p.id !== target.id).id;
       await page.click(`#placementList li[data-placement="${other}"] .name`);
       await sleep(1500);
-      await page.unroute(late);
+      await lateAnswers.stop();
       assert.deepEqual((await state(page)).selection, [other], "the list's later choice stands");
       await page.mouse.move(box[0] + box[2] / 2, box[1] + box[3] / 2); // back over the 3D view for the wheel
       const d0 = (await state(page)).camera.distance;

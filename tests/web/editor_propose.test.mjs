@@ -22,7 +22,7 @@ import assert from "node:assert/strict";
 import { existsSync } from "node:fs";
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
-import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, settled, settledFrameHash } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, settled, settledFrameHash, selectPlacement } from "./editor_lib.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const testModels = process.env.DERMIS_TEST_MODELS || join(here, "../models");
@@ -208,7 +208,7 @@ await runSuite("WebEditorProposeBrowserTest", async () => {
       const knee = proposals.find((p) => p.kind === "crease" && p.why.role === "left knee");
       const id = knee.placement.id;
       assert.ok(Array.isArray(knee.placement.axis), "proposals drive by a vector axis");
-      await page.click(`#placementList li[data-placement="${id}"] .name`);
+      await selectPlacement(page, id);
       await page.waitForSelector("#goMax");
       assert.equal(await page.$eval("#pAxis", (e) => e.value), "vector", "the axis field shows the vector");
       await page.click("#goMax");

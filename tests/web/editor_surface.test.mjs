@@ -17,7 +17,7 @@ import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { dirname, join } from "node:path";
 import { fileURLToPath } from "node:url";
-import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, sleep, settledFrameHash } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, state, screenshot, runChecks, runSuite, until, sleep, settledFrameHash, holdAnswers } from "./editor_lib.mjs";
 
 const here = dirname(fileURLToPath(import.meta.url));
 const barbarian = join(here, "../models/KayKitBarbarian/Barbarian.glb");
@@ -140,12 +140,7 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       // placement away — what CI once saw under ASan, where answers are slow).
       const patchPath = `/api/v1/scenes/${sceneId}/placements/${encodeURIComponent(placedId)}`;
       const late = (url) => url.pathname === patchPath;
-      await page.route(late, async (route) => {
-        if (route.request().method() !== "PATCH") return route.continue();
-        const answer = await route.fetch();
-        await sleep(1500);
-        await route.fulfill({ response: answer });
-      });
+      const lateAnswers = await holdAnswers(page, late, { methods: ["PATCH"], ms: 1500 });
       await page.mouse.move(...g.center);
       await page.mouse.down();
       await page.mouse.move(g.center[0] + step[0] / 2, g.center[1] + step[1] / 2);
@@ -157,7 +152,29 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       await page.keyboard.press("Control+z"); // while the move's answer is still on its way
       const back = await until(async () => { const d = await doc(); const p = d.placements.find((q) => q.id === placedId); return (!p || near(p.anchor.position, before.anchor.position, 1e-9)) && { p }; }, "undo puts it back");
       assert.ok(back.p, "the undo took the placement away: it undid the add, not the move");
-      await page.unroute(late);
+      await lateAnswers.stop();
+      // The same slide on a slow link (its pick and its edit answered 700 ms late): the outline
+      // stays where it was let go of until its new outline is in; it never snaps back meanwhile.
+      await until(async () => !(await page.evaluate(() => window.dermisEditor.store.busy)), "the undo answered");
+      const start = await until(() => page.evaluate((id) => window.dermisEditor.screenGeometry(id)?.center, placedId), "drawn where it was");
+      assert.ok(Math.hypot(start[0] - g.center[0], start[1] - g.center[1]) < 1, `back at its first place (${start} vs ${g.center})`);
+      const slow = await holdAnswers(page, (url) => url.pathname === patchPath || url.pathname.endsWith("/pick"), { ms: 700 });
+      const drop = [g.center[0] + step[0], g.center[1] + step[1]];
+      await page.mouse.move(...g.center);
+      await page.mouse.down();
+      await page.mouse.move(g.center[0] + step[0] / 2, g.center[1] + step[1] / 2);
+      await page.mouse.move(...drop);
+      await page.mouse.up();
+      const samples = [];
+      const t0 = Date.now();
+      while (Date.now() - t0 < 3500) {
+        samples.push(await page.evaluate((id) => window.dermisEditor.screenGeometry(id)?.center, placedId));
+        await sleep(40);
+      }
+      await slow.stop();
+      const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
+      for (const c of samples) assert.ok(c && dist(c, drop) < dist(c, g.center), `drawn near the drop (${drop}), not back at ${g.center}: ${c}`);
+      assert.ok(!near((await doc()).placements.find((q) => q.id === placedId).anchor.position, before.anchor.position, 1e-6), "and it moved on the server");
     }],
     ["+ scales its size in model units and ] turns it", async () => {
       const before = (await doc()).placements.find((p) => p.id === placedId);
@@ -187,17 +204,12 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       assert.ok(key, "an arrow with three texels of body beside the anchor");
       const patchPath = `/api/v1/scenes/${sceneId}/placements/${encodeURIComponent(placedId)}`;
       const late = (url) => url.pathname === patchPath;
-      await page.route(late, async (route) => {
-        if (route.request().method() !== "PATCH") return route.continue();
-        const answer = await route.fetch();
-        await sleep(1000);
-        await route.fulfill({ response: answer });
-      });
+      const lateAnswers = await holdAnswers(page, late, { methods: ["PATCH"], ms: 1000 });
       await page.focus("#uv");
       for (let k = 0; k < 3; ++k) await page.keyboard.press(key);
       await until(async () => (await api("GET", `/scenes/${sceneId}`)).body.revision >= r0 + 3, "three moves on the server", 20000);
       await until(async () => !(await page.evaluate(() => window.dermisEditor.store.busy)), "every answer in");
-      await page.unroute(late);
+      await lateAnswers.stop();
       const o1 = (await api("GET", `/scenes/${sceneId}/placements/${placedId}/outline`)).body;
       const [du, dv] = arrows[key];
       const texels = ((o1.anchor_uv[0] - o0.anchor_uv[0]) * du + (o1.anchor_uv[1] - o0.anchor_uv[1]) * dv) * size;

@@ -10,7 +10,7 @@
 // H sends enabled:false and zeroes that region of the bump map; S solos; M mirrors.
 import assert from "node:assert/strict";
 import { startServer, launch, apiClient, openEditor, waitFrame, settledFrameHash, state, footprint, screenshot,
-         runChecks, runSuite, settled, countEdits, until, sleep } from "./editor_lib.mjs";
+         runChecks, runSuite, settled, countEdits, until, sleep, selectPlacement, holdAnswers } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-tex-");
 const api = apiClient(server.base);
@@ -23,7 +23,7 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
   const serverPlacement = async (id) => (await api("GET", `/scenes/${sceneId}`)).body.scene.placements.find((p) => p.id === id);
   const texel = 1 / 1024;
   const select = async (id) => {
-    await page.click(`#placementList li[data-placement="${id}"] .name`);
+    await selectPlacement(page, id);
     await page.focus("#uv");
   };
   const settle = () => settled(page, api);
@@ -192,12 +192,7 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
       const scene = async () => (await api("GET", `/scenes/${sceneId}`)).body.scene;
       // Every PATCH answer comes back 1.5 s late (the server has applied it by then).
       const late = (url) => url.pathname.startsWith(`/api/v1/scenes/${sceneId}/placements/`);
-      await page.route(late, async (route) => {
-        if (route.request().method() !== "PATCH") return route.continue();
-        const answer = await route.fetch();
-        await sleep(1500);
-        await route.fulfill({ response: answer });
-      });
+      const lateAnswers = await holdAnswers(page, late, { methods: ["PATCH"], ms: 1500 });
       try {
         const before = await scene();
         const p0 = before.placements.find((p) => p.id === "stomach");
@@ -220,7 +215,7 @@ await runSuite("WebEditorTextureBrowserTest", async () => {
         await settle();
         assert.deepEqual(await scene(), before, "and no earlier edit went with it");
       } finally {
-        await page.unroute(late);
+        await lateAnswers.stop();
       }
     }],
     ["Delete, then undo restores it and redo removes it again (server state)", async () => {

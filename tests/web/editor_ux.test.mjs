@@ -16,7 +16,7 @@
 // editor-place-tool.png, editor-undo-notice.png, editor-labels.png, editor-labels-1920.png,
 // editor-3d-more.png.
 import assert from "node:assert/strict";
-import { startServer, launch, apiClient, openEditor, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep } from "./editor_lib.mjs";
+import { startServer, launch, apiClient, openEditor, state, footprint, screenshot, runChecks, runSuite, settled, until, sleep, selectPlacement } from "./editor_lib.mjs";
 
 const server = await startServer(process.argv[2], [], "dermis-editor-ux-");
 const api = apiClient(server.base);
@@ -250,7 +250,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       assert.ok(l.shown.length >= ids.length / 2, `most labels show (${l.shown.length} of ${ids.length})`);
       // The crowded middle of the default scene: each of them, selected, shows its label.
       for (const id of ["ribs_l", "stomach", "waist_l", "waist_r"]) {
-        await page.click(`#placementList li[data-placement="${id}"] .name`);
+        await selectPlacement(page, id);
         // The layout drawn for this selection (it is drawn on the next animation frame).
         l = await until(async () => { const x = await labels(page); return x.selection === id && x.shown.some((b) => b.id === id) && x; }, `${id}'s label shows when selected`);
         assert.deepEqual(overlaps(l.shown), [], `no overlap with ${id} selected`);

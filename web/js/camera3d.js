@@ -94,6 +94,17 @@ export function zoomAbout(factor, point) {
   setCamera({ target, distance: from.distance * factor });
 }
 
+/// The world point under frame pixel `px` (of a square frame `size` pixels wide) that lies as far
+/// along the view as world point `at`, for camera `from` (explicitCamera's numbers).
+export function underPixelAtDepth(from, px, size, at) {
+  const { dir, right, up } = basis(from.yaw, from.pitch);
+  const eye = add(from.target, mul(dir, from.distance));
+  const z = -dot(sub(at, eye), dir); // depth along the view (the camera looks along -dir)
+  const t = Math.tan(FOV_Y / 2);
+  const sx = ((px[0] + 0.5) / size) * 2 - 1, sy = 1 - ((px[1] + 0.5) / size) * 2;
+  return add(eye, add(mul(dir, -z), add(mul(right, sx * t * z), mul(up, sy * t * z))));
+}
+
 /// Orbits from camera `from` to (yaw, pitch) about world point `pivot`: the pivot keeps its place
 /// in the picture (the target turns about it with the camera).
 export function orbitAbout(from, yaw, pitch, pivot) {
@@ -136,7 +147,7 @@ export async function frameSelection(params) {
 
 /// Hover and brush state the frames outline: {hover: pid | null, brush: {uv: [u, v, su, sv, rot]}
 /// | {surface: [x, y, z, nx, ny, nz, diameter]} | null}.
-export const pointer = { hover: null, brush: null, last: null /* {px, hit} of the last pick */ };
+export const pointer = { hover: null, brush: null, last: null /* {px, hit, camera} of the last pick */ };
 
 /// Wires the stage's pointer. `ctx`: {framePixel(e), displaySide(), pick(x, y), params(),
 /// placeTool(), brushFor(pick), onClick(e), onChange(), onError(err)} from frame_view.js.
@@ -217,8 +228,17 @@ export function initCamera(stage, theApi, ctx) {
     const factor = Math.exp(Math.max(-300, Math.min(300, e.deltaY)) * 0.001);
     const px = ctx.framePixel(e);
     const near = pointer.last && px && Math.hypot(pointer.last.px[0] - px[0], pointer.last.px[1] - px[1]) <= 3;
-    zoomAbout(factor, near && pointer.last.hit ? pointer.last.hit.position : null);
-    if (!near) hoverAt(e, ctx); // the next tick zooms about the skin there
+    // The zoom turns about the point under the pointer at the depth of the skin the last pick hit
+    // there: that pick's own point when it was made with the camera shown now; after a camera
+    // change (a pick answered after a newer tick) the point under the pointer now at that depth,
+    // so that the zoom does not drift towards where the old point shows.
+    const from = explicitCamera();
+    const fresh = near && pointer.last.camera === cameraKey(ctx);
+    const point = !near || !pointer.last.hit ? null : fresh || !from ? pointer.last.hit.position
+      : underPixelAtDepth(from, px, ctx.params().width, pointer.last.hit.position);
+    zoomAbout(factor, point);
+    if (fresh) pointer.last.camera = cameraKey(ctx); // zooming about it keeps it under the pointer
+    else hoverAt(e, ctx); // a pick with this camera for the next tick
   }, { passive: false });
   document.addEventListener("keydown", (e) => {
     if (e.key !== "f" && e.key !== "F") return;
@@ -254,10 +274,11 @@ async function pumpPick(ctx) {
   wantedPick = null;
   picking = true;
   const generation = leaveGeneration;
+  const camera = cameraKey(ctx);
   try {
     const hit = await ctx.pick(job.px[0], job.px[1]);
     if (generation !== leaveGeneration) return;
-    pointer.last = { px: job.px, hit: hit.hit ? hit : null };
+    pointer.last = { px: job.px, hit: hit.hit ? hit : null, camera };
     if (!hit.hit) setHover(null, null, ctx);
     else {
       const p = geo.hitPick(store.doc.placements.map(withPending), hit);
@@ -269,6 +290,12 @@ async function pumpPick(ctx) {
     picking = false;
     if (wantedPick) setTimeout(() => pumpPick(ctx), 40); // at most ~25 picks a second
   }
+}
+
+/// The camera a pick is made with, as a comparable string.
+function cameraKey(ctx) {
+  const p = ctx.params();
+  return JSON.stringify([p.yaw, p.pitch, p.distance, p.target]);
 }
 
 function setHover(pid, brush, ctx) {

@@ -321,6 +321,7 @@ export function initFrameView(section, theApi) {
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
     $("compareAgainstLabel").hidden = store.compare.mode === "off"; // "against" means nothing until comparing
+    if ($("compareAgainst").value !== store.compare.against && store.compare.against === "off") $("compareAgainst").value = "off";
     refresh();
   });
   on(Topic.REVISION, () => whenIdle("compare-list", fillAgainst, 400));
@@ -505,13 +506,18 @@ function layoutCompare() {
 
 async function fillAgainst() {
   const sel = document.getElementById("compareAgainst");
-  const keep = sel.value;
+  const scene = store.sceneId;
   try {
-    const list = await fetchRevisions(api, store.sceneId);
+    const list = await fetchRevisions(api, scene);
+    if (scene !== store.sceneId) return; // a late answer for the scene shown before
     sel.innerHTML = `<option value="off">patterns off</option>` +
       list.revisions.filter((r) => r.revision !== store.revision)
         .map((r) => `<option value="${r.revision}">r${r.revision} ${escapeHtml(r.op)}</option>`).join("");
-    sel.value = [...sel.options].some((o) => o.value === keep) ? keep : "off";
+    const keep = store.compare.against;
+    const listed = [...sel.options].some((o) => o.value === keep);
+    sel.value = listed ? keep : "off";
+    // The menu and what the frame compares against stay one thing.
+    if (!listed && keep !== "off") set({ compare: { ...store.compare, against: "off" } });
   } catch { /* the history panel shows errors */ }
 }
 

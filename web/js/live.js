@@ -60,7 +60,7 @@ export function connect() {
     else if (wasOffline) reload();
     everOpen = true;
     announce();
-    api.get(presencePath(id)).then((answer) => changePresence((presence) => {
+    api.get(presencePath(id)).then((answer) => store.sceneId === id && changePresence((presence) => {
       for (const who of answer.presence || [])
         if (who.client !== api.client)
           presence.set(who.client, { selection: who.selection, color: who.color, until: Date.now() + 1000 * who.expires_in });

@@ -89,8 +89,10 @@ async function openScene(id, link = {}) {
     time: link.time ?? null, view: link.view || "shaded", pinnedRevision: pinned,
     selection: (link.selection || []).filter((s) => answer.scene.placements.some((p) => p.id === s)), solo: [],
     presence: new Map(),
+    // A revision to compare against is the old scene's: another scene compares against patterns off.
+    compare: id === store.sceneId ? store.compare : { ...store.compare, against: "off" },
   }, [Topic.SCENE, Topic.DOC, Topic.REVISION, Topic.MODEL, Topic.LAYOUT, Topic.CAMERA, Topic.TIME, Topic.VIEW, Topic.PINNED_REVISION,
-      Topic.SELECTION, Topic.SOLO, Topic.PRESENCE]);
+      Topic.SELECTION, Topic.SOLO, Topic.PRESENCE, Topic.COMPARE]);
   $("scene").value = id;
   connect();
   fit();

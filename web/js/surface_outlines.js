@@ -18,17 +18,26 @@ export function initSurfaceOutlines(theApi, loaded) {
 /// The outline answer of stored surface placement `p` ({segments, bounds, anchor_uv, …}), or null
 /// while it loads (it is asked for then) or when it could not be had.
 export function outlineOf(p) {
-  const key = JSON.stringify([store.sceneId, store.layout ? store.layout.layout : null, p]);
+  const key = keyOf(p);
   const hit = cache.get(p.id);
   if (hit && hit.key === key) return hit.answer;
   const entry = { key, answer: hit ? hit.answer : null, loading: true }; // the old outline until the new one lands
   cache.set(p.id, entry);
   api.get(outlinePath(store.sceneId, p.id))
-    .then((a) => { if (cache.get(p.id) === entry) { entry.answer = a; onLoaded(); } })
+    .then((a) => { if (cache.get(p.id) === entry) { entry.answer = a; entry.loading = false; onLoaded(); } })
     .catch(() => { if (cache.get(p.id) === entry) { entry.answer = null; } })
     .finally(() => { entry.loading = false; });
   return entry.answer;
 }
+
+/// Whether the outline held for stored placement `p` is p's as it is now (loaded, not the previous
+/// one shown while p's own is on its way).
+export function outlineCurrent(p) {
+  const hit = cache.get(p.id);
+  return !!hit && hit.key === keyOf(p) && !hit.loading;
+}
+
+const keyOf = (p) => JSON.stringify([store.sceneId, store.layout ? store.layout.layout : null, p]);
 
 /// The topmost surface placement of `placements` with a piece whose bounds (grown by `margin` UV)
 /// hold `uv`; of several, the one with the smallest such piece.

@@ -22,7 +22,7 @@ import { Stream, patchPlacement, committingChange } from "./edits.js";
 import { withPending, pendingPreview, hold, release } from "./pending.js";
 import { trace } from "./trace.js";
 import { addsToSelection } from "./selection.js";
-import { initSurfaceOutlines, outlineOf, hitOutline, strokeOutline } from "./surface_outlines.js";
+import { initSurfaceOutlines, outlineOf, outlineCurrent, hitOutline, strokeOutline } from "./surface_outlines.js";
 import { notify } from "./notice.js";
 
 const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26, ZOOM_MIN = 0.2, ZOOM_MAX = 40;
@@ -30,6 +30,7 @@ const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26, ZOOM_MIN = 0.2, ZOOM_MAX = 40;
 let api, canvas, ctx, stage, overlaySelect, zoomText;
 let zoom = 1, ox = 0, oy = 0, fitted = false; // uv → css px: x = ox + u·zoom·S
 let drag = null;  // {kind: move|scale|rotate|pan, id, start, orig, value, stream, corner}
+const settling = new Map(); // id → {delta, done, moved}: a surface placement let go of after a slide (surfaceOffset)
 let hover = null; // id under the pointer
 let dirty = false;
 let labels = { shown: [], hidden: [] }; // the last draw's label layout (css px in the canvas)
@@ -217,7 +218,7 @@ function drawGhosts() {
 /// A surface placement's decal outline (all pieces), a cross at its anchor and its label there.
 function drawSurfaceOutline(p, soloed) {
   const selected = store.selection.includes(p.id), hovered = hover === p.id;
-  const off = drag && drag.kind === "smove" && drag.id === p.id ? drag.delta : [0, 0];
+  const off = surfaceOffset(p);
   ctx.globalAlpha = !p.enabled || (soloed.size && !soloed.has(p.id)) ? 0.35 : 1;
   ctx.strokeStyle = selected ? "#ffffff" : hovered ? "#c8e1ff" : targetColor(p);
   ctx.lineWidth = selected || hovered ? 2 : 1.4;
@@ -234,6 +235,19 @@ function drawSurfaceOutline(p, soloed) {
     ctx.fillText(p.label || p.id, x + 6, y - 6);
   }
   ctx.globalAlpha = 1;
+}
+
+/// How far (UV) stored surface placement `p`'s outline is drawn from where it is stored: the drag's
+/// offset while it slides; after, until its new outline is in (the pick, the edit and the outline
+/// read take three round trips), where it was let go of, so that it does not snap back meanwhile.
+function surfaceOffset(p) {
+  if (drag && drag.kind === "smove" && drag.id === p.id) return drag.delta;
+  const s = settling.get(p.id);
+  if (!s) return [0, 0];
+  // Done: the moved placement's own outline is in, or it has changed since (an undo, another
+  // person's edit) and its outline is not where it was let go of.
+  if (s.done && (outlineCurrent(p) || JSON.stringify(p) !== s.moved)) { settling.delete(p.id); return [0, 0]; }
+  return s.delta;
 }
 
 function outline(p, color, width, dash = []) {
@@ -504,7 +518,12 @@ async function pointerUp(e) {
   const d = drag;
   drag = null;
   if (d.kind === "pan") return;
-  if (d.kind === "smove") { await committingChange(() => slideOnBody(d)); return; }
+  if (d.kind === "smove") {
+    const s = { delta: d.delta, done: false };
+    settling.set(d.id, s);
+    await committingChange(() => slideOnBody(d, s));
+    return;
+  }
   if (!d.value) { d.stream.done = true; d.stream.end(); return; }
   await d.stream.finish(); // one edit: the gesture's last value
   release(d.id, d.value);
@@ -526,16 +545,21 @@ export function cancelDrag() {
 /// Ends a drag of surface placement d.id by d.delta UV: its anchor goes to the body point at its
 /// anchor's texel moved by the drag (pick by UV), its tangent kept; one edit, one undo step. Off
 /// the charts it stays where it was (and says so).
-async function slideOnBody(d) {
+async function slideOnBody(d, settle) {
   const p = placementById(d.id);
   const o = p && outlineOf(p);
-  if (!p || !o || !o.anchor_uv || Math.hypot(...d.delta) < 1e-6) { redraw(); return; }
+  const stays = () => { if (settling.get(d.id) === settle) settling.delete(d.id); redraw(); };
+  if (!p || !o || !o.anchor_uv || Math.hypot(...d.delta) < 1e-6) { stays(); return; }
   const uv = [o.anchor_uv[0] + d.delta[0], o.anchor_uv[1] + d.delta[1]];
+  let moved = false;
   try {
     const hit = uv.every((x) => x >= 0 && x <= 1) ? await api.get(pickUVPath(store.sceneId, uv)) : { hit: false };
     if (!hit.hit || !hit.anchor) notify(`"${p.label || p.id}" stays: no body under that point of the layout.`, "warn");
-    else await patchPlacement(d.id, { anchor: geo.anchorNear(p, hit.anchor) }, { what: `move "${p.label || p.id}"` });
-  } finally { redraw(); }
+    else moved = !!(await patchPlacement(d.id, { anchor: geo.anchorNear(p, hit.anchor) }, { what: `move "${p.label || p.id}"` }));
+  } finally {
+    if (moved) { settle.moved = JSON.stringify(placementById(d.id)); settle.done = true; redraw(); }
+    else stays(); // off the body or refused: back where it is
+  }
 }
 
 function wheel(e) {
@@ -568,7 +592,8 @@ export function panBy(dx, dy) {
 }
 
 /// Where placement `id` is on screen (client px): centre, corners, rotation handle — for tests
-/// and for scripted use; null when it is not drawn.
+/// and for scripted use; null when it is not drawn. A surface placement's centre is its anchor's
+/// texel where it is drawn (during and just after a slide too).
 export function screenGeometry(id) {
   const p0 = placementById(id);
   if (!p0 || !canvas) return null;
@@ -576,8 +601,8 @@ export function screenGeometry(id) {
   const r = canvas.getBoundingClientRect();
   const abs = ([x, y]) => [r.left + x, r.top + y];
   if (!geo.inTexture(p)) { // a surface placement: its anchor's texel and its pieces' bounds
-    const o = outlineOf(p0);
-    return o && o.anchor_uv ? { center: abs(toScreen(o.anchor_uv)), bounds: (o.bounds || []).map((b) => [...abs(toScreen([b[0], b[1]])), ...abs(toScreen([b[2], b[3]]))]),
+    const o = outlineOf(p0), off = surfaceOffset(p0);
+    return o && o.anchor_uv ? { center: abs(toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]])), bounds: (o.bounds || []).map((b) => [...abs(toScreen([b[0], b[1]])), ...abs(toScreen([b[2], b[3]]))]),
                                 segments: o.segments.length, pxPerUV: zoom * S(), uvAt: (x, y) => toUV(x - r.left, y - r.top) } : null;
   }
   const hp = handlePoints(p);

@@ -46,7 +46,11 @@ async function load() {
     const answer = await api.get(activationPath(store.sceneId, clip, 30));
     if (k !== key) return;
     data = answer;
-  } catch (e) { data = null; notify(`Activation: ${e.message}`, "error"); }
+  } catch (e) {
+    if (k !== key) return; // an older read's failure: a newer read owns the curves
+    data = null;
+    notify(`Activation: ${e.message}`, "error");
+  }
   draw();
 }
 

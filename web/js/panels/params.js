@@ -39,7 +39,7 @@ async function loadDrivers() {
     drivers = new Map(answer.placements.map((d) => [d.placement, d]));
     set({ liveCamera: answer.camera });
     drawLive();
-  } catch (e) { drivers = new Map(); }
+  } catch (e) { if (key === driversKey) drivers = new Map(); } // an older read's failure leaves a newer read's answer
 }
 export const driverOf = (id) => drivers.get(id);
 

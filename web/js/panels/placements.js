@@ -83,6 +83,9 @@ function onListKey(e) {
 function render() {
   if (!store.doc) return;
   const hadFocus = list.contains(document.activeElement);
+  // The row that had the focus keeps it through a re-render (a move's local answer may re-render
+  // the list between two Alt+↓ presses: the second must move the same row).
+  const focusedId = hadFocus ? document.activeElement.closest("li")?.dataset.placement : null;
   const lintCount = new Map();
   for (const f of store.lint) if (f.placement) lintCount.set(f.placement, (lintCount.get(f.placement) || 0) + 1);
   count.textContent = String(store.doc.placements.length);
@@ -135,7 +138,8 @@ function render() {
   const stop = (list.querySelector("li.selected") || list.querySelector("li"));
   for (const b of list.querySelectorAll("button")) b.tabIndex = -1;
   if (stop) stop.querySelector(".name").tabIndex = 0;
-  if (hadFocus && stop) stop.querySelector(".name").focus();
+  const focusRow = (focusedId && list.querySelector(`li[data-placement="${CSS.escape(focusedId)}"]`)) || stop;
+  if (hadFocus && focusRow) focusRow.querySelector(".name").focus();
   const sel = list.querySelector("li.selected");
   if (sel) sel.scrollIntoView({ block: "nearest" });
 }
