@@ -321,7 +321,7 @@ export function initFrameView(section, theApi) {
     $("compareMode").value = store.compare.mode;
     $("split").hidden = store.compare.mode !== "split";
     $("compareAgainstLabel").hidden = store.compare.mode === "off"; // "against" means nothing until comparing
-    if ($("compareAgainst").value !== store.compare.against && store.compare.against === "off") $("compareAgainst").value = "off";
+    if (store.compare.against === "off") $("compareAgainst").value = "off"; // a revision shows once fillAgainst lists it
     refresh();
   });
   on(Topic.REVISION, () => whenIdle("compare-list", fillAgainst, 400));
