@@ -169,12 +169,19 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       const samples = [];
       const t0 = Date.now();
       while (Date.now() - t0 < 3500) {
-        samples.push(await page.evaluate((id) => window.dermisEditor.screenGeometry(id)?.center, placedId));
+        const s = await page.evaluate((id) => { const s = window.dermisEditor.screenGeometry(id); return s && { c: s.center, b: s.bounds[0] }; }, placedId);
+        samples.push(s && { ...s, early: Date.now() - t0 < 600 }); // the pick is held 700 ms: still the old outline
         await sleep(40);
       }
       await slow.stop();
       const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
-      for (const c of samples) assert.ok(c && dist(c, drop) < dist(c, g.center), `drawn near the drop (${drop}), not back at ${g.center}: ${c}`);
+      for (const s of samples) {
+        assert.ok(s && dist(s.c, drop) < dist(s.c, g.center), `drawn near the drop (${drop}), not back at ${g.center}: ${s && s.c}`);
+        // Its pieces' bounds (what a press hits) move with what is drawn: the pointer finds it there.
+        if (s.early) assert.ok(dist([s.b[0] - g.bounds[0][0], s.b[1] - g.bounds[0][1]], [s.c[0] - g.center[0], s.c[1] - g.center[1]]) < 0.5,
+                               `bounds ${s.b} moved as the centre ${s.c} (from ${g.bounds[0]}, ${g.center})`);
+      }
+      assert.ok(samples.some((s) => s.early), "sampled before the pick was answered");
       await until(async () => !near((await doc()).placements.find((q) => q.id === placedId).anchor.position, before.anchor.position, 1e-6), "and it moved on the server");
     }],
     ["+ scales its size in model units and ] turns it", async () => {

@@ -95,11 +95,13 @@ export function zoomAbout(factor, point) {
 }
 
 /// The world point under frame pixel `px` (of a square frame `size` pixels wide) that lies as far
-/// along the view as world point `at`, for camera `from` (explicitCamera's numbers).
+/// along the view as world point `at`, for camera `from` (explicitCamera's numbers); null when `at`
+/// lies behind the camera.
 export function underPixelAtDepth(from, px, size, at) {
   const { dir, right, up } = basis(from.yaw, from.pitch);
   const eye = add(from.target, mul(dir, from.distance));
   const z = -dot(sub(at, eye), dir); // depth along the view (the camera looks along -dir)
+  if (!(z > 0)) return null; // behind the camera now: nothing under the pixel at that depth
   const t = Math.tan(FOV_Y / 2);
   const sx = ((px[0] + 0.5) / size) * 2 - 1, sy = 1 - ((px[1] + 0.5) / size) * 2;
   return add(eye, add(mul(dir, -z), add(mul(right, sx * t * z), mul(up, sy * t * z))));

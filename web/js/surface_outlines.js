@@ -25,7 +25,7 @@ export function outlineOf(p) {
   cache.set(p.id, entry);
   api.get(outlinePath(store.sceneId, p.id))
     .then((a) => { if (cache.get(p.id) === entry) { entry.answer = a; entry.loading = false; onLoaded(); } })
-    .catch(() => { if (cache.get(p.id) === entry) { entry.answer = null; } })
+    .catch(() => { if (cache.get(p.id) === entry) { entry.answer = null; entry.loading = false; onLoaded(); } })
     .finally(() => { entry.loading = false; });
   return entry.answer;
 }
@@ -39,16 +39,19 @@ export function outlineCurrent(p) {
 
 const keyOf = (p) => JSON.stringify([store.sceneId, store.layout ? store.layout.layout : null, p]);
 
-/// The topmost surface placement of `placements` with a piece whose bounds (grown by `margin` UV)
-/// hold `uv`; of several, the one with the smallest such piece.
-export function hitOutline(placements, uv, margin = 0) {
+/// The topmost surface placement of `placements` with a piece whose bounds (grown by `margin` UV,
+/// shifted by `offsetOf(p)` UV where it is drawn away from where it is stored) hold `uv`; of
+/// several, the one with the smallest such piece.
+export function hitOutline(placements, uv, margin = 0, offsetOf = () => [0, 0]) {
   let best = null, bestArea = Infinity;
   for (let i = placements.length - 1; i >= 0; --i) {
     const p = placements[i];
     if (p.projection !== "surface") continue;
     const o = outlineOf(p);
     if (!o) continue;
-    for (const b of o.bounds || []) {
+    const [du, dv] = offsetOf(p);
+    for (const b0 of o.bounds || []) {
+      const b = [b0[0] + du, b0[1] + dv, b0[2] + du, b0[3] + dv];
       if (uv[0] < b[0] - margin || uv[0] > b[2] + margin || uv[1] < b[1] - margin || uv[1] > b[3] + margin) continue;
       const area = (b[2] - b[0]) * (b[3] - b[1]);
       if (area < bestArea) { best = p; bestArea = area; }

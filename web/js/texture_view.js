@@ -30,7 +30,7 @@ const HANDLE_PX = 7, ROTATE_OFFSET_PX = 26, ZOOM_MIN = 0.2, ZOOM_MAX = 40;
 let api, canvas, ctx, stage, overlaySelect, zoomText;
 let zoom = 1, ox = 0, oy = 0, fitted = false; // uv → css px: x = ox + u·zoom·S
 let drag = null;  // {kind: move|scale|rotate|pan, id, start, orig, value, stream, corner}
-const settling = new Map(); // id → {delta, done, moved}: a surface placement let go of after a slide (surfaceOffset)
+const settling = new Map(); // id → {delta, done, moved, scene}: a surface placement let go of after a slide (surfaceOffset)
 let hover = null; // id under the pointer
 let dirty = false;
 let labels = { shown: [], hidden: [] }; // the last draw's label layout (css px in the canvas)
@@ -244,6 +244,7 @@ function surfaceOffset(p) {
   if (drag && drag.kind === "smove" && drag.id === p.id) return drag.delta;
   const s = settling.get(p.id);
   if (!s) return [0, 0];
+  if (s.scene !== store.sceneId) { settling.delete(p.id); return [0, 0]; } // another scene's placement of that id
   // Done: the moved placement's own outline is in, or it has changed since (an undo, another
   // person's edit) and its outline is not where it was let go of.
   if (s.done && (outlineCurrent(p) || JSON.stringify(p) !== s.moved)) { settling.delete(p.id); return [0, 0]; }
@@ -421,7 +422,7 @@ function under(x, y) {
   }
   const p = geo.hit(store.doc.placements.map(shown), toUV(x, y));
   if (p) return { kind: "move", id: p.id };
-  const q = hitOutline(store.doc.placements, toUV(x, y), pxToUV(3));
+  const q = hitOutline(store.doc.placements, toUV(x, y), pxToUV(3), surfaceOffset);
   return q ? { kind: "smove", id: q.id } : null;
 }
 
@@ -519,7 +520,7 @@ async function pointerUp(e) {
   drag = null;
   if (d.kind === "pan") return;
   if (d.kind === "smove") {
-    const s = { delta: d.delta, done: false };
+    const s = { delta: d.delta, done: false, scene: store.sceneId };
     settling.set(d.id, s);
     await committingChange(() => slideOnBody(d, s));
     return;
@@ -602,7 +603,7 @@ export function screenGeometry(id) {
   const abs = ([x, y]) => [r.left + x, r.top + y];
   if (!geo.inTexture(p)) { // a surface placement: its anchor's texel and its pieces' bounds
     const o = outlineOf(p0), off = surfaceOffset(p0);
-    return o && o.anchor_uv ? { center: abs(toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]])), bounds: (o.bounds || []).map((b) => [...abs(toScreen([b[0], b[1]])), ...abs(toScreen([b[2], b[3]]))]),
+    return o && o.anchor_uv ? { center: abs(toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]])), bounds: (o.bounds || []).map((b) => [...abs(toScreen([b[0] + off[0], b[1] + off[1]])), ...abs(toScreen([b[2] + off[0], b[3] + off[1]]))]),
                                 segments: o.segments.length, pxPerUV: zoom * S(), uvAt: (x, y) => toUV(x - r.left, y - r.top) } : null;
   }
   const hp = handlePoints(p);
