@@ -112,4 +112,27 @@ inline ::testing::AssertionResult compareImages(const Image8& actual, const Imag
     return ::testing::AssertionFailure() << msg.str();
 }
 
+/// Fraction of pixels of `img` whose colour differs from its top-left (background) pixel by more
+/// than 8 in a channel.
+inline double coverage(const Image8& img) {
+    std::size_t n = 0;
+    const std::size_t pixels = static_cast<std::size_t>(img.width) * img.height;
+    for (std::size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(int(img.rgba[p * 4 + c]) - int(img.rgba[c])) > 8) {
+                ++n;
+                break;
+            }
+    return pixels ? static_cast<double>(n) / static_cast<double>(pixels) : 0.0;
+}
+
+/// Mean absolute difference over all channels of two images of one size (1e9 when their sizes
+/// differ or they are empty).
+inline double meanAbsDiff(const Image8& a, const Image8& b) {
+    if (a.rgba.size() != b.rgba.size() || a.rgba.empty()) return 1e9;
+    double s = 0.0;
+    for (std::size_t i = 0; i < a.rgba.size(); ++i) s += std::abs(int(a.rgba[i]) - int(b.rgba[i]));
+    return s / static_cast<double>(a.rgba.size());
+}
+
 } // namespace dermis::test

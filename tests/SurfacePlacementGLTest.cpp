@@ -16,6 +16,7 @@
 #include "io/gltf_loader.hpp"
 #include "io/scene_files.hpp"
 
+#include "ImageCompare.hpp"
 #include "RendererSuite.hpp"
 #include "SceneFrame.hpp"
 
@@ -191,13 +192,6 @@ TextureLayout transposedModelLayout(const Model& m) {
     for (PartLayout& p : l.parts)
         for (glm::vec2& uv : p.uvs) uv = glm::vec2(0.05f + 0.9f * uv.y, 0.05f + 0.9f * uv.x);
     return l;
-}
-
-double meanAbsDiff(const Image8& a, const Image8& b) {
-    if (a.rgba.size() != b.rgba.size() || a.rgba.empty()) return 1e9;
-    double s = 0.0;
-    for (std::size_t i = 0; i < a.rgba.size(); ++i) s += std::abs(int(a.rgba[i]) - int(b.rgba[i]));
-    return s / static_cast<double>(a.rgba.size());
 }
 
 /// Pixels whose colour differs by more than `threshold` in a channel: count and their bounds.
