@@ -199,7 +199,8 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       const ids0 = (await scene(s1)).scene.placements.map((p) => p.id);
       await c.focus(`#placementList li[data-placement="${ids0[0]}"] .name`);
       await c.keyboard.press("Alt+ArrowDown");
-      await sleep(200); // the first move's local re-render comes between the presses
+      // The first move's re-render comes between the presses (the list shows it one place down).
+      await until(() => c.evaluate((id) => [...document.querySelectorAll("#placementList li")].findIndex((li) => li.dataset.placement === id) === 1, ids0[0]), "the list re-rendered with the first move");
       await c.keyboard.press("Alt+ArrowDown");
       const ids1 = await until(async () => { const ids = (await scene(s1)).scene.placements.map((p) => p.id); return ids[2] === ids0[0] && ids; }, "moved down two places");
       assert.deepEqual(ids1.slice(0, 2), ids0.slice(1, 3));
