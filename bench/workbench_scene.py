@@ -22,9 +22,9 @@ if not hasattr(numpy, "bool"):  # Debian 12's numpy 1.24 against Blender 3.4's g
 import bpy
 import mathutils
 
-glb, out, clip, frames = sys.argv[sys.argv.index("--") + 1:][:4]
-size = int((sys.argv[sys.argv.index("--") + 1:] + ["1024"])[4])
-frames = int(frames)
+args = sys.argv[sys.argv.index("--") + 1:] + ["1024"]  # SIZE is optional
+glb, out, clip = args[:3]
+frames, size = int(args[3]), int(args[4])
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 scene.render.fps = 50  # before the import, which keys the clip at the scene's rate

@@ -24,9 +24,8 @@ export function outlineOf(p) {
   const entry = { key, answer: hit ? hit.answer : null, loading: true }; // the old outline until the new one lands
   cache.set(p.id, entry);
   api.get(outlinePath(store.sceneId, p.id))
-    .then((a) => { if (cache.get(p.id) === entry) { entry.answer = a; entry.loading = false; onLoaded(); } })
-    .catch(() => { if (cache.get(p.id) === entry) { entry.answer = null; entry.loading = false; onLoaded(); } })
-    .finally(() => { entry.loading = false; });
+    .then((a) => { entry.answer = a; }, () => { entry.answer = null; })
+    .finally(() => { entry.loading = false; if (cache.get(p.id) === entry) onLoaded(); });
   return entry.answer;
 }
 

@@ -137,14 +137,11 @@ function render() {
   // by H and S (their buttons stay clickable and labelled).
   const stop = (list.querySelector("li.selected") || list.querySelector("li"));
   for (const b of list.querySelectorAll("button")) b.tabIndex = -1;
-  if (stop) stop.querySelector(".name").tabIndex = 0;
-  const focusRow = (focusedId && list.querySelector(`li[data-placement="${CSS.escape(focusedId)}"]`)) || stop;
-  if (hadFocus && focusRow) {
-    // The focused row keeps the tab stop (roving tabindex): Tab out and Shift+Tab back return to it.
-    if (stop && focusRow !== stop) stop.querySelector(".name").tabIndex = -1;
-    focusRow.querySelector(".name").tabIndex = 0;
-    focusRow.querySelector(".name").focus();
-  }
+  // The row that had the focus keeps it and the tab stop (roving tabindex: Tab out and Shift+Tab
+  // back return to it).
+  const focusRow = hadFocus ? (focusedId && list.querySelector(`li[data-placement="${CSS.escape(focusedId)}"]`)) || stop : stop;
+  if (focusRow) focusRow.querySelector(".name").tabIndex = 0;
+  if (hadFocus && focusRow) focusRow.querySelector(".name").focus();
   const sel = list.querySelector("li.selected");
   if (sel) sel.scrollIntoView({ block: "nearest" });
 }
