@@ -1,8 +1,9 @@
 // dermis-bench — prints JSON figures (median milliseconds) for the paper's headline scenario.
 // Usage: dermis-bench [--repeat N] [--gl auto|egl-device|egl-surfaceless|osmesa] [--no-gpu]
-//                     [--no-cpu] [--scaling | --only-scaling]
+//                     [--no-cpu] [--scaling | --only-scaling] [--frame SHADING/SIZE/AA]
 //   (--no-gpu: only the CPU cases; --no-cpu: only the frames; default 15 repetitions after one
-//   warm-up run; --scaling adds part 4, --only-scaling runs only part 4)
+//   warm-up run; --scaling adds part 4, --only-scaling runs only part 4; --frame runs only that
+//   case of part 2 with GPU maps and no key light, e.g. pbr/1024/post, and nothing else)
 //
 // 1. cpu_heightmaps: 15 placements in texture space, CPU height maps at 1024² and 2048², one
 //    thread and all threads. Patterns are synthetic 512² smooth height fields (the built-in
@@ -43,6 +44,8 @@
 #include <random>
 #include <string_view>
 #include <thread>
+
+#include <sys/resource.h>
 
 using namespace dermis;
 using namespace dermis::bench;
@@ -85,8 +88,26 @@ Result<DefaultScene> dermis::bench::loadDefaultScene() {
 
 namespace {
 
+/// CPU time of the whole process so far (every thread: llvmpipe's raster threads too), ms.
+double processCpuMs() {
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    const auto ms = [](const timeval& t) {
+        return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_usec) / 1e3;
+    };
+    return ms(ru.ru_utime) + ms(ru.ru_stime);
+}
+
+/// One case of part 2 ("--frame pbr/1024/post"); empty: all of them.
+struct FrameFilter {
+    std::string shading, aa;
+    int size = 0;
+    bool empty() const { return size == 0; }
+};
+
 /// The per-frame loop on the default character; appends one result per configuration.
-int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann::json& cases) {
+int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, const FrameFilter& only,
+                nlohmann::json& cases) {
     Scene scene = ds.scene;
     const auto& model = ds.model;
     const double duration = ds.clipDuration;
@@ -106,6 +127,9 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                 const std::string_view keyName(key);
                 const bool orbit = keyName.size() > 6 && keyName.substr(keyName.size() - 6) == "_orbit";
                 if (keyLight && (shading == Shading::Legacy || size != 1024 || aa != AntiAliasing::None)) continue;
+                if (!only.empty() && (cpuMaps || keyLight || toString(shading) != only.shading ||
+                                      size != only.size || toString(aa) != only.aa))
+                    continue;
                 scene.render.keyLight.reset();
                 if (keyLight) {
                     scene.render.keyLight = KeyLight{};
@@ -118,6 +142,7 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                 scene.render.msaa = msaa;
                 scene.render.aa = aa;
                 std::vector<double> height, skinMs, postAa, readback, encode, staged, total;
+                double cpuStart = 0.0, cpuMs = 0.0; // the unprofiled loop's process CPU time
                 // Two loops: with glFinish between stages (per-stage figures), then without
                 // (the frame time a client sees: pose → encoded frame).
                 for (bool profile : {true, false})
@@ -153,9 +178,13 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                             std::cerr << png.error().message << "\n";
                             return 1;
                         }
-                        if (r == 0) continue; // warm-up: uploads, allocation
+                        if (r == 0) { // warm-up: uploads, allocation
+                            if (!profile) cpuStart = processCpuMs();
+                            continue;
+                        }
                         if (!profile) {
                             total.push_back(msSince(t0));
+                            if (r == repeat) cpuMs = processCpuMs() - cpuStart;
                             continue;
                         }
                         height.push_back(cpuMaps ? cpuBakeMs + result->timings.heightMs
@@ -185,8 +214,14 @@ int benchFrames(Renderer& renderer, const DefaultScene& ds, int repeat, nlohmann
                                  {"png_encode_ms", round2(medianMs(encode))},
                                  {"total_ms", round2(medianMs(total))},
                                  {"total_with_stage_syncs_ms", round2(medianMs(staged))},
+                                 {"cpu_ms_per_frame", round2(cpuMs / std::max(1, repeat))},
                                  {"repetitions", total.size()}});
             }
+    if (!only.empty() && cases.empty()) {
+        std::cerr << "dermis-bench: --frame " << only.shading << "/" << only.size << "/" << only.aa
+                  << " names no case (shading legacy|pbr|skin, size 512|1024, aa none|post|msaa)\n";
+        return 2;
+    }
     return 0;
 }
 
@@ -231,6 +266,7 @@ int benchAaQuality(Renderer& renderer, const DefaultScene& ds, nlohmann::json& o
 int main(int argc, char** argv) {
     int repeat = 15;
     bool gpu = true, cpu = true, scaling = false;
+    FrameFilter only;
     GlBackend backend = GlBackend::Auto;
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
@@ -251,9 +287,18 @@ int main(int argc, char** argv) {
         } else if (std::strcmp(argv[i], "--only-scaling") == 0) {
             scaling = true;
             gpu = cpu = false;
+        } else if (std::strcmp(argv[i], "--frame") == 0 && i + 1 < argc) {
+            const std::string spec = argv[++i];
+            const auto a = spec.find('/'), b = spec.rfind('/');
+            if (a == std::string::npos || a == b || std::atoi(spec.c_str() + a + 1) <= 0) {
+                std::cerr << "dermis-bench: --frame wants SHADING/SIZE/AA, e.g. pbr/1024/post\n";
+                return 2;
+            }
+            only = {spec.substr(0, a), spec.substr(b + 1), std::atoi(spec.c_str() + a + 1)};
+            cpu = false;
         } else {
             std::cerr << "usage: dermis-bench [--repeat N] [--gl BACKEND] [--no-gpu] [--no-cpu] "
-                         "[--scaling | --only-scaling]\n";
+                         "[--scaling | --only-scaling] [--frame SHADING/SIZE/AA]\n";
             return 2;
         }
     }
@@ -321,7 +366,9 @@ int main(int argc, char** argv) {
             return 1;
         }
         if (gpu) {
-            if (int rc = benchFrames(**renderer, *ds, repeat, cases); rc != 0) return rc;
+            if (int rc = benchFrames(**renderer, *ds, repeat, only, cases); rc != 0) return rc;
+        }
+        if (gpu && only.empty()) {
             if (int rc = benchAaQuality(**renderer, *ds, aaQuality); rc != 0) return rc;
             encoders = nlohmann::json::array();
             if (int rc = benchEncoders(**renderer, *ds, std::max(5, repeat), encoders); rc != 0)

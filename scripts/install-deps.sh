@@ -7,7 +7,7 @@ PKGS=(
   cmake g++ make ninja-build pkg-config ccache
   libglm-dev libtinygltf-dev nlohmann-json3-dev libcli11-dev
   libopenimageio-dev
-  libpng-dev zlib1g-dev libturbojpeg0-dev libwebp-dev
+  libpng-dev zlib1g-dev libisal-dev libturbojpeg0-dev libwebp-dev
   python3-matplotlib
   python3-glad libegl-dev libegl-mesa0 libgl1-mesa-dri libosmesa6
   libcpp-httplib-dev libssl-dev nginx bsdutils

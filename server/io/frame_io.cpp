@@ -1,21 +1,23 @@
-// Frame encoders (zlib for PNG, libjpeg-turbo, the OpenImageIO module for EXR) and file writing. See frame_io.hpp
-// for the formats and failure modes.
+// Frame encoders (ISA-L's igzip for PNG, libjpeg-turbo, the OpenImageIO module for EXR) and file
+// writing. See frame_io.hpp for the formats and failure modes.
 //
 // PNG settings, measured on 1024² RGBA frames on the 2-core development machine (median of 7):
-// zlib level 1 with zlib's Z_RLE strategy and the fixed SUB filter. On a rendered-looking frame
-// (smooth gradients, a shaded body, ±4 noise, opaque) that is 45 ms for 1.87 MB, against 60 ms /
-// 2.21 MB at level 1 with the default strategy (UP within 2% of SUB there), 93 ms with libpng's
-// adaptive filtering, and 589 ms / 1.95 MB for OpenImageIO's default PNG write (level 6, all
-// filters). Over the other frames tried (transparent background, no noise, ±12 noise, a
-// photographic texture) Z_RLE was always faster and smaller than the default strategy, SUB as fast
-// as or faster than UP (20% faster and 15% smaller without noise), and the result 4–7× faster
-// than OpenImageIO's write and 4–10% smaller, except the noise-free frame (48% larger).
+// the fixed SUB filter and a fast deflate. On a rendered-looking frame (smooth gradients, a
+// shaded body, ±4 noise, opaque) zlib level 1 with its Z_RLE strategy took 45 ms for 1.87 MB,
+// against 60 ms / 2.21 MB at level 1 with the default strategy (UP within 2% of SUB there), 93 ms
+// with libpng's adaptive filtering, and 589 ms / 1.95 MB for OpenImageIO's default PNG write
+// (level 6, all filters); SUB was as fast as or faster than UP over every frame tried. Since
+// 2026-12-03 the deflate is ISA-L's igzip at level 1: on a range frame of the default scene
+// (1024², RGB, 3.1 MB of filtered rows) 0.8 ms for 152 KB against zlib's Z_RLE level 1 at
+// 6.9–12 ms for 146 KB (libdeflate level 1–2, tried before, was 12–15 ms): the 60-frame range
+// used ≈ 1 s less CPU (docs/benchmarks.md).
 #include "frame_io.hpp"
 
 #include "io/atomic_file.hpp"
 #include "io/oiio_loader.hpp"
 #include "io/webp_encode.hpp"
 
+#include <isa-l/igzip_lib.h>
 #include <png.h>
 #include <turbojpeg.h>
 #include <zlib.h>
@@ -27,7 +29,6 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
-#include <thread>
 
 namespace dermis {
 namespace {
@@ -55,13 +56,17 @@ Status checkFrame(const char* where, const Image8& img) {
 
 // --- PNG -------------------------------------------------------------------------------------
 
-constexpr int kPngZlibLevel = 1;
-constexpr int kPngZlibStrategy = Z_RLE;
+constexpr int kPngDeflateLevel = 1;       // ISA-L's igzip level 1
 constexpr std::uint8_t kPngFilterSub = 1; // PNG filter type 1: each byte minus the one bpp before
 
 void putU32(std::vector<std::uint8_t>& out, std::uint32_t v) {
     for (int shift = 24; shift >= 0; shift -= 8)
         out.push_back(static_cast<std::uint8_t>(v >> shift));
+}
+
+void setU32(std::uint8_t* at, std::uint32_t v) {
+    for (int k = 0; k < 4; ++k)
+        at[k] = static_cast<std::uint8_t>(v >> (24 - 8 * k));
 }
 
 /// Appends a PNG chunk: length, type, data, CRC-32 of type and data (zlib's crc32).
@@ -74,19 +79,6 @@ void putChunk(std::vector<std::uint8_t>& out, const char type[4], const std::uin
     const uLong crc = crc32(0L, out.data() + typeAt, static_cast<uInt>(4 + size));
     putU32(out, static_cast<std::uint32_t>(crc));
 }
-
-/// One strip of rows [y0, y1): SUB-filtered scanlines compressed as raw deflate (no zlib
-/// header), ending with a sync flush (byte aligned, not final) or, for the last strip, the final
-/// block. Concatenated strips form one valid deflate stream (the approach of pigz).
-struct Strip {
-    int y0 = 0, y1 = 0;
-    bool last = false;
-    std::unique_ptr<std::uint8_t[]> deflated; // not zeroed: deflate writes what is kept
-    std::size_t deflatedBytes = 0;
-    uLong adler = 1;
-    std::size_t filteredBytes = 0;
-    bool ok = false;
-};
 
 /// One scanline with PNG filter type 1 (SUB): the filter byte, then each byte minus the one a
 /// pixel before (0 before the first pixel), from RGBA8 `src` keeping `channels` (4, or 3: alpha
@@ -109,38 +101,45 @@ void subFilterRow(const std::uint8_t* __restrict src, std::uint8_t* __restrict l
             dst[3 * x + c] = static_cast<std::uint8_t>(src[4 * x + c] - src[4 * (x - 1) + c]);
 }
 
-void compressStrip(const Image8& img, int channels, Strip& strip) {
+/// Appends the zlib stream of `img`'s SUB-filtered scanlines to `out` (ISA-L's igzip at
+/// kPngDeflateLevel with its zlib wrapper: header, deflate, Adler-32). Rows are filtered and
+/// handed over a batch at a time (≈ 64 KB: cache-sized). False when igzip reports an error.
+bool deflateScanlines(const Image8& img, int channels, std::vector<std::uint8_t>& out) {
     const std::size_t w = static_cast<std::size_t>(img.width);
     const std::size_t lineBytes = 1 + w * static_cast<std::size_t>(channels);
-    // Rows are filtered and handed to zlib a batch at a time (≈ 64 KB: fewer calls, cache-sized).
     const int batchRows = static_cast<int>(std::max<std::size_t>(1, 65536 / lineBytes));
-    std::vector<std::uint8_t> batch(lineBytes * static_cast<std::size_t>(batchRows));
-    z_stream zs{};
-    if (deflateInit2(&zs, kPngZlibLevel, Z_DEFLATED, -15, 8, kPngZlibStrategy) != Z_OK) return;
-    const std::size_t rows = static_cast<std::size_t>(strip.y1 - strip.y0);
-    const std::size_t capacity = deflateBound(&zs, static_cast<uLong>(rows * lineBytes)) + 64;
-    strip.deflated.reset(new std::uint8_t[capacity]);
-    zs.next_out = strip.deflated.get();
-    zs.avail_out = static_cast<uInt>(capacity);
-    bool ok = true;
-    for (int y = strip.y0; y < strip.y1 && ok; y += batchRows) {
-        const int n = std::min(batchRows, strip.y1 - y);
+    std::unique_ptr<std::uint8_t[]> batch(new std::uint8_t[lineBytes * static_cast<std::size_t>(batchRows)]);
+    // igzip's level-1 hash tables and token buffer (≈ 300 KB), kept per thread.
+    thread_local std::unique_ptr<std::uint8_t[]> levelBuf(new std::uint8_t[ISAL_DEF_LVL1_DEFAULT]);
+    isal_zstream zs;
+    isal_deflate_init(&zs);
+    zs.level = kPngDeflateLevel;
+    zs.level_buf = levelBuf.get();
+    zs.level_buf_size = ISAL_DEF_LVL1_DEFAULT;
+    zs.gzip_flag = IGZIP_ZLIB;
+    zs.flush = NO_FLUSH;
+    // Output grows in steps of an eighth of the filtered size (a rendered frame compresses 15–20×).
+    const std::size_t step = std::max<std::size_t>(65536, lineBytes * static_cast<std::size_t>(img.height) / 8);
+    for (int y = 0; y < img.height; y += batchRows) {
+        const int n = std::min(batchRows, img.height - y);
         for (int r = 0; r < n; ++r)
             subFilterRow(img.rgba.data() + static_cast<std::size_t>(y + r) * w * 4,
-                         batch.data() + static_cast<std::size_t>(r) * lineBytes, w, channels);
-        const std::size_t bytes = static_cast<std::size_t>(n) * lineBytes;
-        strip.adler = adler32(strip.adler, batch.data(), static_cast<uInt>(bytes));
-        zs.next_in = batch.data();
-        zs.avail_in = static_cast<uInt>(bytes);
-        const bool lastBatch = y + n == strip.y1;
-        const int flush = lastBatch ? (strip.last ? Z_FINISH : Z_SYNC_FLUSH) : Z_NO_FLUSH;
-        const int rc = deflate(&zs, flush);
-        ok = (rc == Z_OK || rc == Z_STREAM_END || rc == Z_BUF_ERROR) && zs.avail_in == 0;
+                         batch.get() + static_cast<std::size_t>(r) * lineBytes, w, channels);
+        zs.next_in = batch.get();
+        zs.avail_in = static_cast<std::uint32_t>(static_cast<std::size_t>(n) * lineBytes);
+        zs.end_of_stream = y + n == img.height ? 1 : 0;
+        do { // until igzip has taken the batch and (at the end) written everything
+            if (out.capacity() - out.size() < 4096) out.reserve(out.capacity() + step);
+            const std::size_t at = out.size();
+            out.resize(out.capacity());
+            zs.next_out = out.data() + at;
+            zs.avail_out = static_cast<std::uint32_t>(out.size() - at);
+            const int rc = isal_deflate(&zs);
+            out.resize(out.size() - zs.avail_out);
+            if (rc != COMP_OK) return false;
+        } while (zs.avail_in > 0 || (zs.end_of_stream && zs.internal_state.state != ZSTATE_END));
     }
-    strip.deflatedBytes = capacity - zs.avail_out;
-    strip.filteredBytes = rows * lineBytes;
-    deflateEnd(&zs);
-    strip.ok = ok;
+    return true;
 }
 
 // --- JPEG ------------------------------------------------------------------------------------
@@ -207,41 +206,8 @@ std::optional<FrameFormat> frameFormatFromPath(const std::string& path) {
 Result<std::vector<std::uint8_t>> encodePng(const Image8& img, bool keepAlpha) {
     const char* where = "dermis::encodePng";
     if (auto s = checkFrame(where, img); !s) return s.error();
-    const int channels = keepAlpha ? 4 : 3;
-    // Strips of at least 64 rows, one per core (at most 8), compressed in parallel.
-    const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    const int nStrips = std::clamp(img.height / 64, 1, std::min(cores, 8));
-    std::vector<Strip> strips(static_cast<std::size_t>(nStrips));
-    for (int k = 0; k < nStrips; ++k) {
-        strips[static_cast<std::size_t>(k)].y0 = img.height * k / nStrips;
-        strips[static_cast<std::size_t>(k)].y1 = img.height * (k + 1) / nStrips;
-        strips[static_cast<std::size_t>(k)].last = k + 1 == nStrips;
-    }
-    try {
-        std::vector<std::thread> workers;
-        for (std::size_t k = 1; k < strips.size(); ++k)
-            workers.emplace_back(compressStrip, std::cref(img), channels, std::ref(strips[k]));
-        compressStrip(img, channels, strips[0]);
-        for (std::thread& t : workers)
-            t.join();
-    } catch (const std::exception& e) {
-        return makeError(ErrorCode::Io, where, "", std::string("cannot compress: ") + e.what());
-    }
-    std::vector<std::uint8_t> zdata = {0x78, 0x01}; // zlib header: deflate, 32K window, fastest
-    std::size_t deflatedBytes = 0;
-    for (const Strip& st : strips)
-        deflatedBytes += st.deflatedBytes;
-    zdata.reserve(2 + deflatedBytes + 4);
-    uLong adler = 1;
-    for (const Strip& st : strips) {
-        if (!st.ok) return makeError(ErrorCode::Io, where, "", "zlib failed to compress the frame");
-        zdata.insert(zdata.end(), st.deflated.get(), st.deflated.get() + st.deflatedBytes);
-        adler = adler32_combine(adler, st.adler, static_cast<z_off_t>(st.filteredBytes));
-    }
-    putU32(zdata, static_cast<std::uint32_t>(adler));
-
     std::vector<std::uint8_t> out = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    out.reserve(zdata.size() + 64);
+    out.reserve(64 + static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) / 4);
     std::vector<std::uint8_t> ihdr;
     putU32(ihdr, static_cast<std::uint32_t>(img.width));
     putU32(ihdr, static_cast<std::uint32_t>(img.height));
@@ -250,7 +216,19 @@ Result<std::vector<std::uint8_t>> encodePng(const Image8& img, bool keepAlpha) {
                            std::uint8_t{0}, std::uint8_t{0}})
         ihdr.push_back(b);
     putChunk(out, "IHDR", ihdr.data(), ihdr.size());
-    putChunk(out, "IDAT", zdata.data(), zdata.size());
+    // IDAT, written in place: its length once the stream is complete, then its CRC.
+    const std::size_t idatAt = out.size();
+    putU32(out, 0);
+    out.insert(out.end(), {'I', 'D', 'A', 'T'});
+    try {
+        if (!deflateScanlines(img, keepAlpha ? 4 : 3, out))
+            return makeError(ErrorCode::Io, where, "", "igzip failed to compress the frame");
+    } catch (const std::exception& e) {
+        return makeError(ErrorCode::Io, where, "", std::string("cannot compress: ") + e.what());
+    }
+    const std::size_t dataBytes = out.size() - idatAt - 8;
+    setU32(out.data() + idatAt, static_cast<std::uint32_t>(dataBytes));
+    putU32(out, static_cast<std::uint32_t>(crc32(0L, out.data() + idatAt + 4, static_cast<uInt>(4 + dataBytes))));
     putChunk(out, "IEND", nullptr, 0);
     return out;
 }
