@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <system_error>
+#include <thread>
 
 namespace dermis {
 namespace {
@@ -221,21 +223,37 @@ EnvironmentImage specularLevel(const MipChain& chain, float roughness, int w, in
         specularSamples(roughness, std::clamp(kLevelLookups / (w * h), kMinSamples, kMaxSamples),
                         chain.mips[0].width, chain.mips[0].height);
     EnvironmentImage out = blank(w, h);
-    for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i) {
-            const glm::vec3 n = texelDirection(i, j, w, h);
-            // Texel centres are never at a pole, so Y up gives a frame.
-            const glm::vec3 t = glm::normalize(glm::cross(glm::vec3(0.0f, 1.0f, 0.0f), n));
-            const glm::vec3 b = glm::cross(n, t);
-            glm::vec3 sum(0.0f);
-            float wsum = 0.0f;
-            for (const SpecularSample& s : samples) {
-                const glm::vec3 l = s.l.x * t + s.l.y * b + s.l.z * n;
-                sum += s.weight * chain.lookup(equirectUv(l), s.lod);
-                wsum += s.weight;
+    const auto rows = [&](int j0, int j1) {
+        for (int j = j0; j < j1; ++j)
+            for (int i = 0; i < w; ++i) {
+                const glm::vec3 n = texelDirection(i, j, w, h);
+                // Texel centres are never at a pole, so Y up gives a frame.
+                const glm::vec3 t = glm::normalize(glm::cross(glm::vec3(0.0f, 1.0f, 0.0f), n));
+                const glm::vec3 b = glm::cross(n, t);
+                glm::vec3 sum(0.0f);
+                float wsum = 0.0f;
+                for (const SpecularSample& s : samples) {
+                    const glm::vec3 l = s.l.x * t + s.l.y * b + s.l.z * n;
+                    sum += s.weight * chain.lookup(equirectUv(l), s.lod);
+                    wsum += s.weight;
+                }
+                out.texels[texelCount(w, j) + i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
             }
-            out.texels[texelCount(w, j) + i] = wsum > 0.0f ? sum / wsum : glm::vec3(0.0f);
-        }
+    };
+    // Rows are independent: bands of them on up to 8 threads (the same texels as one thread).
+    const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::min(8, h));
+    std::vector<std::thread> workers;
+    try {
+        for (int k = 1; k < threads; ++k)
+            workers.emplace_back(rows, h * k / threads, h * (k + 1) / threads);
+    } catch (const std::system_error&) { // no thread: this one does those rows too
+    }
+    const int done = workers.empty() ? h : h / threads;
+    rows(0, done);
+    for (std::thread& t : workers)
+        t.join();
+    if (workers.size() + 1 < static_cast<std::size_t>(threads))
+        rows(h * static_cast<int>(workers.size() + 1) / threads, h);
     return out;
 }
 

@@ -116,7 +116,9 @@ struct PrefilteredEnvironment {
 /// Levels are clamped to [1, 16] and baseWidth to [8, 16384]; `levels` = 1 gives the mirror
 /// level only. Cost: O(source texels) for the SH and the mips, plus texels × n trilinear lookups
 /// per level ≥ 1 (≈ 2^18; more for a level over 2048 texels, fewer under 128): ≈ 0.1 s on one
-/// core for studioEnvironment(256) and the defaults.
+/// core for studioEnvironment(256) and the defaults. A level's rows are shared by up to 8
+/// threads (hardware_concurrency; one when no thread can start); the result does not depend on
+/// their number.
 /// Does not fail: an `env` that fails validateEnvironment gives an empty result (all SH zero,
 /// no specular levels) — validate first to learn why.
 PrefilteredEnvironment prefilterEnvironment(const EnvironmentImage& env, int levels = 6,

@@ -58,7 +58,20 @@ const PrefilteredEnvironment& studioPrefiltered() {
     return pre;
 }
 
+constexpr int kBrdfLutSize = 32;
+
+/// The split-sum DFG table (core brdfLut), once per process like studioPrefiltered.
+const std::vector<glm::vec2>& defaultBrdfLut() {
+    static const std::vector<glm::vec2> lut = brdfLut(kBrdfLutSize);
+    return lut;
+}
+
 } // namespace
+
+void gl::warmStudioLighting() {
+    defaultBrdfLut();
+    studioPrefiltered();
+}
 
 const Material* gl::materialOf(const Model& model, const GpuModel::Part& gp) {
     if (gp.material < 0 || static_cast<std::size_t>(gp.material) >= model.materials.size())
@@ -69,8 +82,8 @@ const Material* gl::materialOf(const Model& model, const GpuModel::Part& gp) {
 Result<const Renderer::Impl::EnvironmentLight*>
 Renderer::Impl::environmentLight(const std::shared_ptr<const EnvironmentImage>& env) {
     if (!brdfLutTexture) {
-        const int lutSize = 32;
-        const std::vector<glm::vec2> lut = brdfLut(lutSize);
+        const int lutSize = kBrdfLutSize;
+        const std::vector<glm::vec2>& lut = defaultBrdfLut();
         glGenTextures(1, &brdfLutTexture);
         glBindTexture(GL_TEXTURE_2D, brdfLutTexture);
         glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG16F, lutSize, lutSize);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <system_error>
 #include <utility>
 
 namespace dermis {
@@ -386,6 +387,12 @@ Result<std::unique_ptr<Renderer>> Renderer::create(GlBackend backend, const Rend
     impl->softwareCpuBakeCoverage = options.softwareCpuBakeCoverage;
     impl->checkBindings = options.checkBindings;
     impl->publishCacheStats();
+    // The default light's CPU tables beside the context's start (EGL, shaders): ≈ 0.1 s a first
+    // pbr frame would otherwise wait for. Without a thread for it the first frame computes them.
+    try {
+        impl->lightingWarm = std::async(std::launch::async, gl::warmStudioLighting);
+    } catch (const std::system_error&) {
+    }
     std::promise<Status> started;
     std::future<Status> startedFuture = started.get_future();
     Impl* raw = impl.get();

@@ -211,6 +211,11 @@ void bindMaterialTextures(const Model& model, const GpuModel& gm, const GpuModel
 /// skin(model, world), indexed like parts).
 std::vector<std::size_t> pbrDrawOrder(const Model& model, const std::vector<GpuModel::Part>& parts,
                                       const std::vector<SkinnedPart>& posed, glm::vec3 eye);
+/// Computes the process-wide CPU tables of the pbr shading's default light — the studio
+/// environment prefiltered and the split-sum DFG table, ≈ 0.1 s of CPU — unless done: any thread,
+/// pure CPU (no GL). Renderer::create runs it beside the context's start, so that a process's
+/// first pbr frame does not wait for it.
+void warmStudioLighting();
 
 } // namespace dermis::gl
 
@@ -219,6 +224,8 @@ namespace dermis {
 struct Renderer::Impl {
     // --- job queue (any thread) ----------------------------------------------------------------
     std::thread thread;
+    /// gl::warmStudioLighting on a helper thread from create (its future joins it on destruction).
+    std::future<void> lightingWarm;
     std::mutex mutex;
     std::condition_variable cv;
     std::deque<std::function<void()>> jobs;
