@@ -336,11 +336,11 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
     // does, and with MSAA the prepass tests every sample twice (docs/benchmarks.md).
     const bool prepass = !tess && pbrOrder && samples == 1;
     if (prepass) {
-        glUseProgram(depthProgram);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         glDepthMask(GL_TRUE);
         for (std::size_t pi = 0; pi < parts.size(); ++pi) {
             if (parts[pi].indexCount == 0 || blended(parts[pi])) continue;
+            glUseProgram(depthProgramFor(model, parts[pi]));
             bindPart(pi);
             checkDrawBindings("depth prepass");
             glDrawElements(GL_TRIANGLES, parts[pi].indexCount, GL_UNSIGNED_INT, nullptr);

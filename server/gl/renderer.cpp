@@ -181,6 +181,9 @@ Status Renderer::Impl::buildPrograms() {
         {&depthProgram,
          {{{GL_VERTEX_SHADER, "skin.vert"}, {GL_FRAGMENT_SHADER, "shadow.frag"}}, {"DERMIS_PBR"}, {},
           {{GL_FRAGMENT_SHADER, "pbr.glsl"}}}},
+        {&depthMaskProgram,
+         {{{GL_VERTEX_SHADER, "skin.vert"}, {GL_FRAGMENT_SHADER, "shadow.frag"}}, {"DERMIS_PBR", "DERMIS_MASK"}, {},
+          {{GL_FRAGMENT_SHADER, "pbr.glsl"}}}},
     };
     for (Build& b : builds) {
         auto p = buildProgram(b.desc);
@@ -314,6 +317,8 @@ void Renderer::Impl::shutdown() {
     pbrPrograms.clear();
     glDeleteProgram(depthProgram);
     depthProgram = 0;
+    glDeleteProgram(depthMaskProgram);
+    depthMaskProgram = 0;
     shadowMap.destroy();
     glDeleteTextures(1, &noShadowTexture);
     noShadowTexture = 0;

@@ -147,13 +147,13 @@ Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_
     glPolygonOffset(1.1f, 2.0f);
     const float one = 1.0f;
     glClearBufferfv(GL_DEPTH, 0, &one);
-    glUseProgram(depthProgram);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, heightSource.texture);
     for (std::size_t pi = 0; pi < parts.size(); ++pi) {
         const GpuModel::Part& gp = parts[pi];
         if (gp.indexCount == 0) continue;
         if (const Material* m = materialOf(model, gp); m && m->alphaMode == AlphaMode::Blend) continue;
+        glUseProgram(depthProgramFor(model, gp));
         glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
                           static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));
         bindMaterialTextures(model, gm, gp, whiteTexture);

@@ -296,9 +296,15 @@ struct Renderer::Impl {
     /// before the frame's draws, and kept.
     enum PbrVariant : unsigned { kPbrTess = 1, kPbrSkin = 2, kPbrKeyLight = 4, kPbrMaps = 8, kPbrViews = 16 };
     std::map<unsigned, GLuint> pbrPrograms;
-    /// The depth-only program (skin.vert with DERMIS_PBR + shadow.frag) of the key light's shadow
-    /// map and of the skin pass's depth prepass (built at start).
-    GLuint depthProgram = 0;
+    /// The depth-only programs (skin.vert with DERMIS_PBR + shadow.frag) of the key light's shadow
+    /// map and of the skin pass's depth prepass (built at start): depthProgramFor chooses.
+    GLuint depthProgram = 0;     ///< shadow.frag: opaque parts' depth (shadow map, depth prepass)
+    GLuint depthMaskProgram = 0; ///< shadow.frag with DERMIS_MASK: glTF MASK parts' depth
+    /// depthMaskProgram for a part whose material is a glTF MASK, else depthProgram.
+    GLuint depthProgramFor(const Model& model, const gl::GpuModel::Part& gp) const {
+        const Material* m = gl::materialOf(model, gp);
+        return m && m->alphaMode == AlphaMode::Mask ? depthMaskProgram : depthProgram;
+    }
     gl::ShadowTarget shadowMap;
     /// What `shadowMap` holds (drawn from); reset when the target is made anew.
     std::optional<gl::ShadowInputs> lastShadow;
