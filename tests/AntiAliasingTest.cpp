@@ -119,6 +119,27 @@ TEST(AntiAliasingTest, TheEdgePassDoesNotDependOnTheThreadCount) {
     EXPECT_EQ(one.rgba, five.rgba);
 }
 
+// The pass looks for edges only where the luma differs from the corner's (the background of a
+// rendered frame) in a row or the rows beside it: elsewhere a pixel and its neighbours are flat.
+// Exact: with the corner pixel changed — so that nearly every pixel differs from its luma and
+// every row is searched whole — the result away from that corner is the same.
+TEST(AntiAliasingTest, SkippingTheFlatBackgroundChangesNoPixel) {
+    const Image8 aliased = raster(300, 257, 1, shapes);
+    Image8 skipping = aliased, whole = aliased;
+    whole.rgba[0] = 250; // pixel (0, 0): another luma than the background's
+    antiAliasEdges(skipping, 2);
+    antiAliasEdges(whole, 2);
+    EXPECT_NE(skipping.rgba, aliased.rgba);
+    int compared = 0;
+    for (int y = 32; y < aliased.height; ++y)
+        for (int x = 32; x < aliased.width; ++x)
+            for (int c = 0; c < 4; ++c, ++compared) {
+                const std::size_t i = (static_cast<std::size_t>(y) * aliased.width + x) * 4 + c;
+                ASSERT_EQ(skipping.rgba[i], whole.rgba[i]) << "pixel " << x << "," << y;
+            }
+    EXPECT_GT(compared, 200000);
+}
+
 TEST(AntiAliasingTest, SsimIsOneForTheSameImageLowerForOthersAndChecksSizes) {
     const Image8 a = raster(64, 64, 1, shapes);
     const Image8 b = raster(64, 64, 4, shapes);

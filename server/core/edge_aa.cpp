@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace dermis {
@@ -21,6 +22,9 @@ constexpr float kStepScale[kSteps] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.5f, 2.0f, 
 struct LumaImage {
     int w = 0, h = 0;
     std::vector<std::uint8_t> l;
+    /// Per row, the first and last x whose luma differs from `flat` (first > last: none).
+    std::vector<std::pair<int, int>> spans;
+    std::uint8_t flat = 0; ///< the luma of pixel (0, 0): the background's in a rendered frame
 
     const std::uint8_t* row(int y) const { return l.data() + static_cast<std::size_t>(y) * static_cast<std::size_t>(w); }
     float at(int x, int y) const {
@@ -45,6 +49,17 @@ void computeLuma(const std::vector<std::uint8_t>& rgba, LumaImage& luma, int y0,
     std::uint8_t* out = luma.l.data() + static_cast<std::size_t>(y0) * static_cast<std::size_t>(luma.w);
     for (std::size_t i = 0; i < n; ++i)
         out[i] = static_cast<std::uint8_t>((77u * p[4 * i] + 150u * p[4 * i + 1] + 29u * p[4 * i + 2] + 128u) >> 8);
+}
+
+/// luma.spans of rows [y0, y1) (luma.l and luma.flat set).
+void computeSpans(LumaImage& luma, int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+        const std::uint8_t* m = luma.row(y);
+        int a = 0, b = luma.w - 1;
+        while (a < luma.w && m[a] == luma.flat) ++a;
+        while (b > a && m[b] == luma.flat) --b;
+        luma.spans[static_cast<std::size_t>(y)] = {a, b};
+    }
 }
 
 /// A changed pixel: its byte offset and new colour (applied after every band has read `rgba`).
@@ -149,13 +164,26 @@ void edgeRows(const std::vector<std::uint8_t>& rgba, const LumaImage& L, int y0,
         const std::uint8_t* __restrict m = L.row(y);
         const std::uint8_t* __restrict s = L.row(std::min(y + 1, h - 1));
         std::uint8_t* __restrict f = flags.data();
-        // The early test over the row's inner pixels without branches (vectorised), then the
+        // Outside the spans of this row and the two beside it, widened by a pixel, a pixel and
+        // its four neighbours all have the flat luma: no edge there (range 0).
+        int x0 = w, x1 = -1;
+        for (int r = std::max(y - 1, 0); r <= std::min(y + 1, h - 1); ++r) {
+            const auto [a, b] = L.spans[static_cast<std::size_t>(r)];
+            if (a > b) continue;
+            x0 = std::min(x0, a - 1);
+            x1 = std::max(x1, b + 1);
+        }
+        x0 = std::max(x0, 0);
+        x1 = std::min(x1, w - 1);
+        if (x0 > x1) continue;
+        // The early test over the span's inner pixels without branches (vectorised), then the
         // search at the few edges.
-        for (int x = 1; x + 1 < w; ++x)
+        const int i0 = std::max(x0, 1), i1 = std::min(x1, w - 2);
+        for (int x = i0; x <= i1; ++x)
             f[x] = isEdge(m[x], n[x], s[x], m[x - 1], m[x + 1]);
         flags[0] = isEdge(m[0], n[0], s[0], m[0], m[1]);
         flags[static_cast<std::size_t>(w - 1)] = isEdge(m[w - 1], n[w - 1], s[w - 1], m[w - 2], m[w - 1]);
-        for (int x = 0; x < w; ++x)
+        for (int x = x0; x <= x1; ++x)
             if (flags[static_cast<std::size_t>(x)]) edgePixel(rgba, L, x, y, changes);
     }
 }
@@ -185,8 +213,11 @@ void antiAliasEdges(Image8& image, int threads) {
     luma.w = w;
     luma.h = h;
     luma.l.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+    luma.spans.resize(static_cast<std::size_t>(h));
     std::vector<std::vector<Change>> changes(static_cast<std::size_t>(threads));
     overRows(h, threads, [&](int, int y0, int y1) { computeLuma(image.rgba, luma, y0, y1); });
+    luma.flat = luma.l[0];
+    overRows(h, threads, [&](int, int y0, int y1) { computeSpans(luma, y0, y1); });
     overRows(h, threads, [&](int band, int y0, int y1) {
         edgeRows(image.rgba, luma, y0, y1, changes[static_cast<std::size_t>(band)]);
     });
