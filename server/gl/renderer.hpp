@@ -116,7 +116,7 @@ struct FrameTimings {
     double heightMs = 0.0;   ///< height pass (or upload of CPU maps)
     double skinMs = 0.0;     ///< skin pass incl. MSAA resolve
     double postAaMs = 0.0;   ///< post-process AA on the read-back frame (render.aa "post")
-    double readbackMs = 0.0; ///< pixel-pack readback into the frame
+    double readbackMs = 0.0; ///< glReadPixels into the frame
 };
 
 /// An outline drawn on the skin: the editor's selection, hover and place brush. A band about 2

@@ -147,11 +147,10 @@ struct ResolvedPatterns {
     std::uint64_t restId = 0;
 };
 
-/// Multisampled colour + depth, the single-sampled resolve target, and the pixel-pack buffer.
+/// Multisampled colour + depth and the single-sampled resolve target.
 struct FrameTargets {
-    GLuint fbo = 0, color = 0, depth = 0, resolveFbo = 0, resolveColor = 0, pbo = 0;
+    GLuint fbo = 0, color = 0, depth = 0, resolveFbo = 0, resolveColor = 0;
     int width = 0, height = 0, samples = 0;
-    std::size_t pboSize = 0;
 
     void destroy();
 };
