@@ -120,6 +120,9 @@ bool deflateScanlines(const Image8& img, int channels, std::vector<std::uint8_t>
     zs.flush = NO_FLUSH;
     // Output grows in steps of an eighth of the filtered size (a rendered frame compresses 15–20×).
     const std::size_t step = std::max<std::size_t>(65536, lineBytes * static_cast<std::size_t>(img.height) / 8);
+    // `out` is grown (zero-filled once per step) ahead of igzip; `written` is what it holds.
+    std::size_t written = out.size();
+    out.resize(std::max(out.capacity(), written + step));
     for (int y = 0; y < img.height; y += batchRows) {
         const int n = std::min(batchRows, img.height - y);
         for (int r = 0; r < n; ++r)
@@ -129,16 +132,18 @@ bool deflateScanlines(const Image8& img, int channels, std::vector<std::uint8_t>
         zs.avail_in = static_cast<std::uint32_t>(static_cast<std::size_t>(n) * lineBytes);
         zs.end_of_stream = y + n == img.height ? 1 : 0;
         do { // until igzip has taken the batch and (at the end) written everything
-            if (out.capacity() - out.size() < 4096) out.reserve(out.capacity() + step);
-            const std::size_t at = out.size();
-            out.resize(out.capacity());
-            zs.next_out = out.data() + at;
-            zs.avail_out = static_cast<std::uint32_t>(out.size() - at);
+            if (out.size() - written < 4096) out.resize(out.size() + step);
+            zs.next_out = out.data() + written;
+            zs.avail_out = static_cast<std::uint32_t>(out.size() - written);
             const int rc = isal_deflate(&zs);
-            out.resize(out.size() - zs.avail_out);
-            if (rc != COMP_OK) return false;
+            written = out.size() - zs.avail_out;
+            if (rc != COMP_OK) {
+                out.resize(written);
+                return false;
+            }
         } while (zs.avail_in > 0 || (zs.end_of_stream && zs.internal_state.state != ZSTATE_END));
     }
+    out.resize(written);
     return true;
 }
 
