@@ -247,9 +247,10 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       const shown = (await state(c)).revision;
       const r1 = String((await api("GET", `/scenes/${s1}/revisions`)).body.revisions.find((r) => r.revision !== shown).revision);
       await c.waitForSelector(`#compareAgainst option[value="${r1}"]`, { state: "attached", timeout: 10000 });
-      await c.selectOption("#compareAgainst", r1);
+      // Listen before choosing: the change handler may send the diff before selectOption returns.
       const diffs = [];
       c.on("request", (r) => { if (r.url().includes("/frame-diff")) diffs.push(new URL(r.url())); });
+      await c.selectOption("#compareAgainst", r1);
       await until(async () => diffs.some((u) => u.searchParams.get("against") === r1), "a diff against that revision");
       diffs.length = 0;
       await c.selectOption("#scene", s2);
