@@ -1,9 +1,10 @@
 #include "edge_aa.hpp"
 
+#include "row_bands.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -188,26 +189,13 @@ void edgeRows(const std::vector<std::uint8_t>& rgba, const LumaImage& L, int y0,
     }
 }
 
-/// Runs f(band, y0, y1) over [0, h) split into `threads` bands (the last on this thread).
-template <class F>
-void overRows(int h, int threads, F f) {
-    std::vector<std::thread> pool;
-    for (int k = 0; k + 1 < threads; ++k)
-        pool.emplace_back(f, k, h * k / threads, h * (k + 1) / threads);
-    f(threads - 1, h * (threads - 1) / threads, h);
-    for (std::thread& t : pool) t.join();
-}
-
 } // namespace
 
 void antiAliasEdges(Image8& image, int threads) {
     const int w = image.width, h = image.height;
     if (w < 3 || h < 3) return;
     if (image.rgba.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 4) return;
-    if (threads <= 0) {
-        const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-        threads = static_cast<long long>(w) * h < 256 * 256 ? 1 : std::min(2, cores);
-    }
+    if (threads <= 0) threads = static_cast<long long>(w) * h < 256 * 256 ? 1 : std::min(2, automaticThreadCount());
     threads = std::clamp(threads, 1, h);
     LumaImage luma;
     luma.w = w;
@@ -215,10 +203,10 @@ void antiAliasEdges(Image8& image, int threads) {
     luma.l.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
     luma.spans.resize(static_cast<std::size_t>(h));
     std::vector<std::vector<Change>> changes(static_cast<std::size_t>(threads));
-    overRows(h, threads, [&](int, int y0, int y1) { computeLuma(image.rgba, luma, y0, y1); });
+    forRowBands(h, threads, [&](int, int y0, int y1) { computeLuma(image.rgba, luma, y0, y1); });
     luma.flat = luma.l[0];
-    overRows(h, threads, [&](int, int y0, int y1) { computeSpans(luma, y0, y1); });
-    overRows(h, threads, [&](int band, int y0, int y1) {
+    forRowBands(h, threads, [&](int, int y0, int y1) { computeSpans(luma, y0, y1); });
+    forRowBands(h, threads, [&](int band, int y0, int y1) {
         edgeRows(image.rgba, luma, y0, y1, changes[static_cast<std::size_t>(band)]);
     });
     for (const std::vector<Change>& band : changes)

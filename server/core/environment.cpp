@@ -1,12 +1,12 @@
 // Image-based lighting on the CPU. See environment.hpp for the conventions and the methods.
 #include "environment.hpp"
 
+#include "row_bands.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
-#include <system_error>
-#include <thread>
 
 namespace dermis {
 namespace {
@@ -241,19 +241,7 @@ EnvironmentImage specularLevel(const MipChain& chain, float roughness, int w, in
             }
     };
     // Rows are independent: bands of them on up to 8 threads (the same texels as one thread).
-    const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, std::min(8, h));
-    std::vector<std::thread> workers;
-    try {
-        for (int k = 1; k < threads; ++k)
-            workers.emplace_back(rows, h * k / threads, h * (k + 1) / threads);
-    } catch (const std::system_error&) { // no thread: this one does those rows too
-    }
-    const int done = workers.empty() ? h : h / threads;
-    rows(0, done);
-    for (std::thread& t : workers)
-        t.join();
-    if (workers.size() + 1 < static_cast<std::size_t>(threads))
-        rows(h * static_cast<int>(workers.size() + 1) / threads, h);
+    forRowBands(h, std::min(8, automaticThreadCount()), [&](int, int y0, int y1) { rows(y0, y1); });
     return out;
 }
 

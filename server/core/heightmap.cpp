@@ -8,6 +8,7 @@
 // bilinear weights; HeightmapTest checks this against a straightforward per-texel evaluation.
 #include "heightmap.hpp"
 
+#include "row_bands.hpp"
 #include "texture_layout.hpp"
 
 #include <algorithm>
@@ -16,7 +17,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <thread>
 #include <tuple>
 
 namespace dermis {
@@ -528,22 +528,8 @@ Status bakeHeightMapsInto(const std::vector<BakePlacement>& placements,
         }
     };
 
-    int threads = settings.threads > 0 ? settings.threads
-                                       : static_cast<int>(std::thread::hardware_concurrency());
-    threads = std::clamp(threads, 1, std::max(1, H));
-    if (threads == 1) {
-        bakeRows(0, H);
-    } else {
-        std::vector<std::thread> pool;
-        pool.reserve(threads);
-        for (int t = 0; t < threads; ++t) {
-            const int y0 = static_cast<int>(static_cast<long long>(H) * t / threads);
-            const int y1 = static_cast<int>(static_cast<long long>(H) * (t + 1) / threads);
-            pool.emplace_back(bakeRows, y0, y1);
-        }
-        for (auto& th : pool)
-            th.join();
-    }
+    const int threads = settings.threads > 0 ? settings.threads : automaticThreadCount();
+    forRowBands(H, threads, [&](int, int y0, int y1) { bakeRows(y0, y1); });
     return Ok{};
 }
 

@@ -10,13 +10,12 @@
 #include "texture_layout.hpp"
 
 #include "heightmap.hpp"
+#include "row_bands.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <functional>
 #include <limits>
-#include <thread>
 
 namespace dermis {
 
@@ -83,24 +82,6 @@ std::vector<RasterTriangle> rasterTriangles(const Model& model, const TextureLay
     return out;
 }
 
-/// Runs body(y0, y1) over [0, H) split into `threads` bands, and waits.
-void forRowBands(int H, int threads, const std::function<void(int, int)>& body) {
-    threads = std::clamp(threads, 1, std::max(1, H / 16));
-    if (threads == 1) {
-        body(0, H);
-        return;
-    }
-    std::vector<std::thread> pool;
-    pool.reserve(static_cast<std::size_t>(threads));
-    for (int t = 0; t < threads; ++t) {
-        const int y0 = static_cast<int>(static_cast<long long>(H) * t / threads);
-        const int y1 = static_cast<int>(static_cast<long long>(H) * (t + 1) / threads);
-        pool.emplace_back(body, y0, y1);
-    }
-    for (std::thread& th : pool)
-        th.join();
-}
-
 } // namespace
 
 RestSurfaceMap bakeRestSurface(const Model& model, const TextureLayout& layout, int W, int H,
@@ -115,13 +96,14 @@ RestSurfaceMap bakeRestSurface(const Model& model, const TextureLayout& layout, 
     m.position.assign(n, glm::vec3(0.0f));
     m.normal.assign(n, glm::vec3(0.0f));
     m.coverage.assign(n, 0);
-    if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
+    if (threads <= 0) threads = automaticThreadCount();
     threads = std::clamp(threads, 1, 64);
+    const int bands = std::min(threads, std::max(1, H / 16)); // bands of at least 16 rows
     dilate = std::max(0, dilate);
 
     // Pass 1: rasterise.
     const std::vector<RasterTriangle> tris = rasterTriangles(model, layout, W, H);
-    forRowBands(H, threads, [&](int y0, int y1) {
+    forRowBands(H, bands, [&](int, int y0, int y1) {
         for (const RasterTriangle& r : tris) {
             const int j0 = std::max(y0, r.y0), j1 = std::min(y1, r.y1);
             if (j0 >= j1) continue;
@@ -167,7 +149,7 @@ RestSurfaceMap bakeRestSurface(const Model& model, const TextureLayout& layout, 
     constexpr int kNone = std::numeric_limits<int>::max();
     std::vector<int> nearestInRow(dilate > 0 ? n : 0, kNone);
     if (dilate > 0)
-        forRowBands(H, threads, [&](int y0, int y1) {
+        forRowBands(H, bands, [&](int, int y0, int y1) {
             for (int j = y0; j < y1; ++j) {
                 const std::uint8_t* cov = &m.coverage[static_cast<std::size_t>(j) * W];
                 int* out = &nearestInRow[static_cast<std::size_t>(j) * W];
@@ -187,7 +169,7 @@ RestSurfaceMap bakeRestSurface(const Model& model, const TextureLayout& layout, 
 
     // Pass 3: the gutters, from pass 1's covered texels only.
     if (dilate > 0)
-        forRowBands(H, threads, [&](int y0, int y1) {
+        forRowBands(H, bands, [&](int, int y0, int y1) {
             const long long limit = static_cast<long long>(dilate) * dilate;
             for (int j = y0; j < y1; ++j)
                 for (int i = 0; i < W; ++i) {

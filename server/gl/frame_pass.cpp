@@ -332,9 +332,11 @@ GLuint Renderer::Impl::drawSkinPass(const Model& model, const GpuModel& gm,
     if (prepass) {
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         glDepthMask(GL_TRUE);
+        GLuint inUse = 0;
         for (std::size_t pi = 0; pi < parts.size(); ++pi) {
             if (parts[pi].indexCount == 0 || blended(parts[pi])) continue;
-            glUseProgram(depthProgramFor(model, parts[pi]));
+            const GLuint wanted = depthProgramFor(model, parts[pi]);
+            if (wanted != inUse) glUseProgram(inUse = wanted);
             bindPart(pi);
             checkDrawBindings("depth prepass");
             glDrawElements(GL_TRIANGLES, parts[pi].indexCount, GL_UNSIGNED_INT, nullptr);

@@ -149,11 +149,13 @@ Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_
     glClearBufferfv(GL_DEPTH, 0, &one);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, heightSource.texture);
+    GLuint program = 0;
     for (std::size_t pi = 0; pi < parts.size(); ++pi) {
         const GpuModel::Part& gp = parts[pi];
         if (gp.indexCount == 0) continue;
         if (const Material* m = materialOf(model, gp); m && m->alphaMode == AlphaMode::Blend) continue;
-        glUseProgram(depthProgramFor(model, gp));
+        const GLuint wanted = depthProgramFor(model, gp);
+        if (wanted != program) glUseProgram(program = wanted);
         glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
                           static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));
         bindMaterialTextures(model, gm, gp, whiteTexture);
