@@ -166,6 +166,17 @@ TEST(FrameIoTest, PngWithoutAlpha) {
     auto rgba = encodePng(img, true);
     ASSERT_TRUE(rgba.ok());
     EXPECT_LT(png->size() * 5, rgba->size() * 4);
+    // Narrow rows: the RGB filter's word-at-a-time middle is empty or one pixel wide.
+    for (int width : {1, 2, 3}) {
+        const Image8 narrow = noiseImage(width, 5, 3 + width);
+        auto bytes = encodePng(narrow, false);
+        ASSERT_TRUE(bytes.ok()) << bytes.error().message;
+        auto decoded = decodeFrame(*bytes);
+        ASSERT_TRUE(decoded.ok()) << decoded.error().message;
+        std::vector<std::uint8_t> want = narrow.rgba;
+        for (std::size_t p = 3; p < want.size(); p += 4) want[p] = 255;
+        EXPECT_EQ(decoded->rgba, want) << "width " << width;
+    }
 }
 
 TEST(FrameIoTest, PngCompressesSmoothImages) {
