@@ -26,7 +26,8 @@
 // band about 2 pixels wide where the surface lies on their border — selected
 // (orange, with a faint tint inside and a dark rim outside), hovered (pale blue), the place brush
 // (dashed cyan). With u_outlineCount.x = 0 nothing runs and the frame is exactly the one without
-// outlines.
+// outlines. The legacy programs always have them (DERMIS_OUTLINES); the pbr ones only in the
+// variant a frame with outlines asks for.
 //
 // Two UVs (SPEC §8): v_uv is the model's TEXCOORD_0 (base colour), v_mapUv the UV of the height
 // maps' layout (heights, bump gradient, outlines) — the same values when the layout is the model's.
@@ -87,8 +88,14 @@ vec3 pictureValue(vec3 c) {
 const vec3 kOutlineColor[3] = vec3[3](vec3(1.0, 0.402, 0.021), vec3(0.578, 0.753, 1.0),
                                       vec3(0.045, 0.610, 1.0));
 
-// `color` with every outline drawn over it.
+// `color` with every outline drawn over it. Without DERMIS_OUTLINES (the pbr programs of frames
+// that have none: ranges, farms, the editor with nothing selected) it is `color`, and the
+// outline inputs are not read, so the linker drops them: on llvmpipe the empty loop and the two
+// extra interpolated vectors cost ≈ 12 % of a 1024² pbr frame's CPU (docs/benchmarks.md).
 vec3 outlined(vec3 color) {
+#ifndef DERMIS_OUTLINES
+    return color;
+#else
     for (int i = 0; i < u_outlineCount.x; ++i) {
         vec4 r = u_outlineRect[i];
         vec4 st = u_outlineStyle[i];
@@ -130,6 +137,7 @@ vec3 outlined(vec3 color) {
         color = mix(color, c, band);
     }
     return color;
+#endif
 }
 
 void main() {

@@ -166,7 +166,8 @@ Result<FrameResult> Renderer::Impl::renderFrame(const FrameRequest& req) {
             !s)
             return s.error();
     const auto program = skinProgram(rs.displacement == DisplacementMode::Tessellated, req.view, pbr,
-                                     skinShading, keyLight, pbr && needsMaterialMaps(model, **gm, **parts));
+                                     skinShading, keyLight, pbr && needsMaterialMaps(model, **gm, **parts),
+                                     !req.outlines.empty());
     if (!program) return program.error();
     std::vector<std::size_t> order(parts.value()->size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;

@@ -200,12 +200,13 @@ Status Renderer::Impl::buildPrograms() {
 }
 
 Result<GLuint> Renderer::Impl::skinProgram(bool tess, FrameView view, bool pbr, bool skinShading,
-                                           bool keyLight, bool maps) {
+                                           bool keyLight, bool maps, bool outlines) {
     if (!pbr) return skinPrograms[tess ? 1 : 0][static_cast<int>(view)];
     // The skin shading's program draws its shaded view only; its other views are pbr's.
     const unsigned variant = (tess ? kPbrTess : 0u) | (skinShading ? kPbrSkin : 0u) |
                              (keyLight ? kPbrKeyLight : 0u) | (maps ? kPbrMaps : 0u) |
-                             (view != FrameView::Shaded ? kPbrViews : 0u);
+                             (view != FrameView::Shaded ? kPbrViews : 0u) |
+                             (outlines ? kPbrOutlines : 0u);
     GLuint& p = pbrPrograms[variant];
     if (!p) {
         auto built = buildSkinProgram(tess, FrameView::Shaded, true, variant);
@@ -225,6 +226,7 @@ Result<GLuint> Renderer::Impl::buildSkinProgram(bool tess, FrameView view, bool 
     }
     desc.stages.push_back({GL_FRAGMENT_SHADER, "skin.frag"});
     desc.defines.push_back("DERMIS_VIEW " + std::to_string(static_cast<int>(view)));
+    if (!pbr || (variant & kPbrOutlines)) desc.defines.push_back("DERMIS_OUTLINES");
     if (!pbr) return buildProgram(desc);
     desc.defines.push_back("DERMIS_PBR");
     desc.includes.push_back({GL_FRAGMENT_SHADER, "pbr.glsl"});
@@ -341,11 +343,11 @@ void Renderer::Impl::shutdown() {
 }
 
 Result<Renderer::BlockLayout> Renderer::Impl::blockLayout(const std::string& block) {
-    // The tessellated PBR program with the material's maps and views uses every member of the
-    // skin pass's blocks; its key light variant declares the KeyLightBlock.
+    // The tessellated PBR program with the material's maps, views and outlines uses every member
+    // of the skin pass's blocks; its key light variant declares the KeyLightBlock.
     GLuint program = heightProgram;
     if (block != "HeightPassBlock") {
-        auto p = skinProgram(true, FrameView::Lighting, true, false, block == "KeyLightBlock", true);
+        auto p = skinProgram(true, FrameView::Lighting, true, false, block == "KeyLightBlock", true, true);
         if (!p) return p.error();
         program = *p;
     }

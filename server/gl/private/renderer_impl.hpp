@@ -288,12 +288,15 @@ struct Renderer::Impl {
     /// built with: tessellated; DERMIS_SKIN, the shaded view with `render.shading` skin;
     /// DERMIS_KEY_LIGHT (`render.key_light`); DERMIS_PBR_MAPS, for materials with textures
     /// besides the base colour; DERMIS_PBR_VIEWS, for the material views (basecolor, lighting,
-    /// normal) besides the shaded one. Each variant leaves out code that a software rasterizer
+    /// normal) besides the shaded one; DERMIS_OUTLINES, for frames with outlines (the editor's
+    /// selection, hover, brush). Each variant leaves out code that a software rasterizer
     /// would otherwise run for every pixel (1024² pbr skin pass on llvmpipe, default scene:
     /// docs/benchmarks.md). The plain shaded ones (vertex and tessellated: the default shading)
     /// are built at start; any other on the first frame that asks for it, on the render thread
     /// before the frame's draws, and kept.
-    enum PbrVariant : unsigned { kPbrTess = 1, kPbrSkin = 2, kPbrKeyLight = 4, kPbrMaps = 8, kPbrViews = 16 };
+    enum PbrVariant : unsigned {
+        kPbrTess = 1, kPbrSkin = 2, kPbrKeyLight = 4, kPbrMaps = 8, kPbrViews = 16, kPbrOutlines = 32
+    };
     std::map<unsigned, GLuint> pbrPrograms;
     /// The depth-only programs (skin.vert with DERMIS_PBR + shadow.frag) of the key light's shadow
     /// map and of the skin pass's depth prepass (built at start): depthProgramFor chooses.
@@ -367,16 +370,18 @@ struct Renderer::Impl {
     /// (+ DERMIS_PBR and pbr.glsl when `pbr`, with the defines of the PbrVariant bits in
     /// `variant`: kPbrSkin the skin shading's (DERMIS_SKIN, its constants from
     /// core/render_settings.hpp as defines), kPbrKeyLight DERMIS_KEY_LIGHT, kPbrMaps
-    /// DERMIS_PBR_MAPS, kPbrViews DERMIS_PBR_VIEWS); fails with the GL's log. Called by
+    /// DERMIS_PBR_MAPS, kPbrViews DERMIS_PBR_VIEWS, kPbrOutlines DERMIS_OUTLINES, which the
+    /// programs without `pbr` always have); fails with the GL's log. Called by
     /// buildPrograms and skinProgram, on the render thread, never between a frame's draws.
     Result<GLuint> buildSkinProgram(bool tess, FrameView view, bool pbr = false, unsigned variant = 0);
     /// The skin program of a frame: with `pbr`, the pbr variant (pbrPrograms) for `view` (the
     /// shaded view or a material view, chosen in the shader by PartBlock's u_part.w), the skin
     /// shading's with `skinShading`, the key light's with `keyLight`, sampling the material's
-    /// other textures with `maps`; without, skinPrograms' for `view`. Links a variant the first
-    /// time it is asked for (fails with the GL's log).
+    /// other textures with `maps`, drawing the frame's outlines with `outlines`; without, skinPrograms'
+    /// for `view` (which always draw outlines). Links a variant the first time it is asked for
+    /// (fails with the GL's log).
     Result<GLuint> skinProgram(bool tess, FrameView view, bool pbr = false, bool skinShading = false,
-                               bool keyLight = false, bool maps = false);
+                               bool keyLight = false, bool maps = false, bool outlines = false);
     /// The light of `env` (null: the default studio environment), prefiltered on the CPU the
     /// first time a frame asks for it (legacy frames never pay for it) and kept: the studio's for
     /// the renderer's life, a custom one until another replaces it or its owner is gone. Fails
