@@ -249,6 +249,13 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       assert.ok(options.every((o) => !/^s[-_]?[0-9a-f]{6,}/i.test(o)), `no bare ids in the menu (${options})`);
       const bar = await box(page, ".toolbar");
       assert.ok(bar.height < 44, `the toolbar is one row at 1600 px (${bar.height} px)`);
+      // With the longest name the editor makes and a five-digit revision too: this check failed
+      // once in CI on a long random name (the row wrapped at 1401–1560 px then).
+      const [me, rev] = await page.evaluate(() => [document.getElementById("me").textContent, document.getElementById("revision").textContent]);
+      await page.evaluate(() => { document.getElementById("me").textContent = "nimble-marten-wwww"; document.getElementById("revision").textContent = "r88888"; });
+      const longBar = await box(page, ".toolbar"), help = await box(page, "#helpButton");
+      assert.ok(longBar.height < 44 && help.right <= 1600, `one row with the longest name (${longBar.height} px, ? ends at ${help.right})`);
+      await page.evaluate(([n, r]) => { document.getElementById("me").textContent = n; document.getElementById("revision").textContent = r; }, [me, rev]);
       await screenshot(page, "editor-artist-1600.png");
       assert.deepEqual(page.errors, []);
     }],

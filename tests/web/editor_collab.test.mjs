@@ -12,6 +12,9 @@
 // back 1 s: D right after `]` copies the turned placement, two quick Alt+↓ move a row two places, a
 // key burst waiting when another scene is opened goes to its own scene (the other untouched, its
 // undo steps left behind), and a deletion's Undo clicked in another scene does not touch it.
+// Eight people on a scene at 1280×720 and 1450×900: the toolbar stays one row, the page the
+// window's width, the chips show initials (the name in the title), none is cut, a "+N" chip counts
+// the rest. Screenshot: editor-collab-people-1450.png.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { startServer, launch, apiClient, openEditor, settledFrameHash, state, screenshot, runChecks, runSuite, until, sleep, selectPlacement, holdAnswers } from "./editor_lib.mjs";
@@ -45,6 +48,44 @@ await runSuite("WebEditorCollabBrowserTest", async () => {
       await b.waitForFunction((who) => { const p = window.dermisEditor.store.presence.get(who); return p && p.selection.includes("stomach"); }, meA, { timeout: 5000 });
       const chip = await b.$eval(`#people .person[data-client="${meA}"]`, (e) => e.title);
       assert.match(chip, /stomach/);
+    }],
+    ["eight people on a scene at 1280×720 and 1450×900: the chips give way, the page stays the window's width", async () => {
+      // Before the fix, the chips' row widened the page's one grid column: at 1280 px the
+      // parameters panel left the window; and 1401–1560 px wrapped the toolbar to two rows.
+      const others = ["merry-wren-q1", "lucid-heron-q2", "keen-puma-q3", "eager-ibex-q4", "fleet-lynx-q5", "calm-koi-q6", "deft-finch-q7"];
+      for (const client of others)
+        assert.equal((await api("POST", `/scenes/${sceneId}/presence`, { client, selection: ["neck"], color: "#7fd0ff" })).status, 200);
+      const p = await openEditor(ctxB, `${server.base}/?scene=${sceneId}`, { width: 1280, height: 720 });
+      for (const [width, height] of [[1280, 720], [1450, 900]]) {
+        await p.setViewportSize({ width, height });
+        await until(async () => (await p.$$eval("#people .person", (cs) => cs.length)) >= others.length, "the chips of everyone here");
+        await p.evaluate(() => { document.getElementById("me").textContent = "nimble-marten-wwww"; });
+        const m = await p.evaluate(() => {
+          const r = (s) => document.querySelector(s).getBoundingClientRect();
+          const box = r("#people");
+          const shown = [...document.querySelectorAll("#people .person[data-client]")].filter((c) => !c.hidden);
+          const cut = shown.filter((c) => { const q = c.getBoundingClientRect(); return q.left < box.left - 0.5 || q.right > box.right + 0.5; });
+          const more = document.querySelector("#people .more");
+          return { toolbar: r(".toolbar").height, help: r("#helpButton").right, params: r("#paramsPanel").right, page: document.documentElement.scrollWidth,
+                   shown: shown.length, cut: cut.length, more: more ? +more.textContent.slice(1) : 0, moreTitle: more ? more.title : "",
+                   here: window.dermisEditor.store.presence.size };
+        });
+        assert.equal(m.cut, 0, `no chip cut at ${width} px`);
+        assert.ok(m.here >= others.length, `everyone is here (${m.here})`);
+        assert.equal(m.shown + m.more, m.here, `the chips shown (${m.shown}) and "+${m.more}" count everyone here`);
+        if (m.more) assert.match(m.moreTitle, /^Also here: /);
+        if (width >= 1450) assert.ok(m.shown >= 2, `at ${width} px two or more chips show (${m.shown})`);
+        assert.ok(m.toolbar < 44, `one toolbar row at ${width} px (${m.toolbar} px)`);
+        assert.ok(m.help <= width && m.params <= width + 0.5, `the ? button (${m.help}) and the parameters panel (${m.params}) are inside the ${width} px window`);
+        assert.ok(m.page <= width, `the page is the window's width (${m.page} px)`);
+      }
+      // Many people: initials in the chips, the whole name in the title and the accessible name.
+      const chip = await p.$eval(`#people .person[data-client="merry-wren-q1"]`, (c) => [c.textContent, c.getAttribute("aria-label"), c.title]);
+      assert.equal(chip[0], "MW");
+      assert.equal(chip[1], "merry-wren-q1");
+      assert.match(chip[2], /^merry-wren-q1 has neck selected/);
+      await screenshot(p, "editor-collab-people-1450.png");
+      await p.close();
     }],
     ["a stale edit shows the 412 notice and leaves the first change intact", async () => {
       // B stops hearing events, so it edits an old revision.

@@ -29,20 +29,59 @@ function changePresence(change) {
   set({ presence });
 }
 
-/// The people on this scene, as chips in their colour (title: what they have selected).
+/// The initials of a client name ("merry-wren-q1x9" → "MW"): a chip's text when many are here.
+export function initials(client) {
+  const words = String(client).split(/[-_\s]+/).filter((w) => /^[a-z]/i.test(w));
+  return (words.slice(0, 2).map((w) => w[0]).join("") || String(client).slice(0, 2)).toUpperCase();
+}
+
+/// The people on this scene, as chips in their colour (title: what they have selected). Up to
+/// two chips show whole names; more show initials (the name in the title), so that a room full
+/// of people still fits the toolbar's spare room, where the chips are clipped, never wrapped.
 function renderPeople() {
   const box = document.getElementById("people");
   if (!box) return;
   box.innerHTML = "";
+  const many = store.presence.size > 2;
+  box.classList.toggle("many", many);
   for (const [client, who] of store.presence) {
     const chip = document.createElement("span");
     chip.className = "person";
     chip.dataset.client = client;
     chip.style.background = who.color || "#ccc";
-    chip.textContent = client;
+    chip.textContent = many ? initials(client) : client;
+    chip.setAttribute("aria-label", client);
     chip.title = who.selection.length ? `${client} has ${who.selection.join(", ")} selected` : `${client} is here`;
     box.append(chip);
   }
+  fitPeople(box);
+  if (!peopleObserver && typeof ResizeObserver === "function") {
+    peopleObserver = new ResizeObserver(() => fitPeople(box));
+    peopleObserver.observe(box);
+  }
+}
+
+let peopleObserver = null;
+
+/// Shows as many whole chips as the box has room for and a "+N" chip for the rest (its title
+/// names them): no chip is ever cut in half. Reads layout, so call it after the chips change or
+/// the box resizes.
+function fitPeople(box) {
+  box.querySelector(".more")?.remove();
+  const chips = [...box.querySelectorAll(".person")];
+  for (const c of chips) c.hidden = false;
+  if (box.scrollWidth <= box.clientWidth + 0.5) return;
+  const more = document.createElement("span");
+  more.className = "person more";
+  box.append(more);
+  let shown = chips.length;
+  do {
+    chips[--shown].hidden = true;
+    const rest = chips.slice(shown).map((c) => c.dataset.client);
+    more.textContent = `+${rest.length}`;
+    more.title = `Also here: ${rest.join(", ")}`;
+    more.setAttribute("aria-label", `${rest.length} more: ${rest.join(", ")}`);
+  } while (shown > 0 && box.scrollWidth > box.clientWidth + 0.5);
 }
 
 /// Opens the event stream of the current scene (closing any other).
