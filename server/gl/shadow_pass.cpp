@@ -153,8 +153,9 @@ Status Renderer::Impl::keyLightStage(const FrameRequest& req, const std::shared_
     for (std::size_t pi = 0; pi < parts.size(); ++pi) {
         const GpuModel::Part& gp = parts[pi];
         if (gp.indexCount == 0) continue;
-        if (const Material* m = materialOf(model, gp); m && m->alphaMode == AlphaMode::Blend) continue;
-        const GLuint wanted = depthProgramFor(model, gp);
+        const Material* m = materialOf(model, gp);
+        if (m && m->alphaMode == AlphaMode::Blend) continue;
+        const GLuint wanted = depthProgramFor(m);
         if (wanted != program) glUseProgram(program = wanted);
         glBindBufferRange(GL_UNIFORM_BUFFER, kPartBinding, partUbo,
                           static_cast<GLintptr>(partStride * pi), sizeof(PartBlock));

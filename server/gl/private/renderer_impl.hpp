@@ -302,10 +302,13 @@ struct Renderer::Impl {
     /// map and of the skin pass's depth prepass (built at start): depthProgramFor chooses.
     GLuint depthProgram = 0;     ///< shadow.frag: opaque parts' depth (shadow map, depth prepass)
     GLuint depthMaskProgram = 0; ///< shadow.frag with DERMIS_MASK: glTF MASK parts' depth
-    /// depthMaskProgram for a part whose material is a glTF MASK, else depthProgram.
-    GLuint depthProgramFor(const Model& model, const gl::GpuModel::Part& gp) const {
-        const Material* m = gl::materialOf(model, gp);
+    /// depthMaskProgram for a part whose material `m` (gl::materialOf; null: none) is a glTF
+    /// MASK, else depthProgram.
+    GLuint depthProgramFor(const Material* m) const {
         return m && m->alphaMode == AlphaMode::Mask ? depthMaskProgram : depthProgram;
+    }
+    GLuint depthProgramFor(const Model& model, const gl::GpuModel::Part& gp) const {
+        return depthProgramFor(gl::materialOf(model, gp));
     }
     gl::ShadowTarget shadowMap;
     /// What `shadowMap` holds (drawn from); reset when the target is made anew.
