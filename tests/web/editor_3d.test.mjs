@@ -198,7 +198,7 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       await until(() => page.evaluate((px) => import("/js/camera3d.js").then((m) => {
         const last = m.pointer.last;
         return !!(last && last.hit && Math.hypot(last.px[0] - px[0], last.px[1] - px[1]) <= 3);
-      }), far.px), "the pointer's pick (made before tick A) landed", 5000);
+      }), far.px), "the pointer's pick (made before tick A) landed", 30000);
       // The skin under the pointer with tick A's camera, asked directly (not held).
       const p = await page.evaluate((px) => import("/js/frame_view.js").then((m) => ({ ...m.frameParams(), x: px[0], y: px[1] })), far.px);
       const q = new URLSearchParams();
@@ -255,8 +255,8 @@ await runSuite("WebEditor3dBrowserTest", async () => {
       await page.keyboard.press("F");
       await until(async () => (await param("target")) !== null, "a target");
       const h1 = await settledFrameHash(page);
-      await sleep(300); // the address bar follows after 150 ms
-      const link = await page.evaluate(() => location.href);
+      // The address bar follows after 150 ms (a page timer, late on a loaded machine).
+      const link = await until(() => page.evaluate(async () => { const m = await import("/js/permalink.js"); return location.href === m.currentLink() && location.href; }), "the address bar follows");
       assert.match(link, /target=/);
       const other = await openEditor(context, link, { width: 1600, height: 1000 });
       await other.click('[data-layout="3d"]');

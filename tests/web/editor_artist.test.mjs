@@ -157,7 +157,16 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       await page.focus("#uv");
       const r0 = (await doc(sceneId)).revision;
       const edits = countEdits(page);
-      for (let i = 0; i < 6; ++i) { await page.keyboard.press("ArrowRight"); await sleep(40); }
+      // The keys go in from the page itself, 40 ms apart: each Playwright press is a round trip,
+      // and one stalled past the editor's 450 ms burst window splits the burst on a loaded
+      // machine. Page timers fire in order, so a stall cannot end the burst between two keys.
+      const keys = (ks, gap) => page.evaluate(async ([ks, gap]) => {
+        for (const [key, ctrlKey] of ks) {
+          document.activeElement.dispatchEvent(new KeyboardEvent("keydown", { key, ctrlKey, bubbles: true, cancelable: true }));
+          if (gap) await new Promise((r) => setTimeout(r, gap));
+        }
+      }, [ks, gap]);
+      await keys(Array(6).fill(["ArrowRight", false]), 40);
       const shown = await page.evaluate((pid) => window.dermisEditor.shownPlacement(pid).center, id);
       assert.ok(Math.abs(shown[0] - (before[0] + 6 / size[0])) < 2e-4, `the view moved at once (${shown[0]})`);
       await settled(page, api);
@@ -170,8 +179,7 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       assert.deepEqual((await doc(sceneId)).scene.placements[4].center, before, "one undo takes the whole burst back");
       // Ctrl+Z while a burst still waits: the burst is sent, then it is what is undone.
       const r1 = (await doc(sceneId)).revision;
-      for (let i = 0; i < 3; ++i) await page.keyboard.press("ArrowDown");
-      await page.keyboard.press("Control+z");
+      await keys([["ArrowDown", false], ["ArrowDown", false], ["ArrowDown", false], ["z", true]], 0);
       await settled(page, api);
       assert.deepEqual((await doc(sceneId)).scene.placements[4].center, before, "the waiting burst was undone");
       assert.equal((await doc(sceneId)).revision, r1 + 2, "sent, then reverted");
@@ -184,8 +192,9 @@ await runSuite("WebEditorArtistBrowserTest", async () => {
       // Pan the selected footprint to the view's top-left corner.
       const g = await footprint(page, id), uv = await box(page, "#uv");
       await page.evaluate(([dx, dy]) => window.dermisEditor.panTexture(dx, dy), [g.center[0] - uv.left - 4, g.center[1] - uv.top - 4]);
-      await sleep(200);
-      const labels = await page.evaluate(() => window.dermisEditor.labelLayout());
+      // The labels are drawn on the next animation frame after the pan (two, to be sure it ran).
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      const labels = await until(async () => { const l = await page.evaluate(() => window.dermisEditor.labelLayout()); return l.selection === id && l; }, "the layout drawn with the selection");
       const mine = labels.shown.find((l) => l.id === id);
       assert.ok(mine, "the selection's label is shown");
       for (const l of labels.shown)

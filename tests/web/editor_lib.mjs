@@ -111,10 +111,11 @@ export async function selectPlacement(page, id) {
 
 /// A slow link's way back: requests of `page` whose URL `match` takes (a Playwright URL matcher)
 /// and whose method is in `methods` (all when omitted) reach the server at once; their answers
-/// arrive `ms` late. Only the first `first` such requests are held. Returns { seen, held, stop }:
-/// the requests seen and held so far, and stop() — the route's removal.
+/// arrive `ms` late. Only the first `first` such requests are held. Returns { seen, held,
+/// delivered, stop }: the requests seen, held and whose held answer has been delivered so far,
+/// and stop() — the route's removal.
 export async function holdAnswers(page, match, { methods = null, ms = 1000, first = Infinity } = {}) {
-  const h = { seen: 0, held: 0 };
+  const h = { seen: 0, held: 0, delivered: 0 };
   const handler = async (route) => {
     if (methods && !methods.includes(route.request().method())) return route.continue();
     if (h.seen++ >= first) return route.continue();
@@ -122,6 +123,7 @@ export async function holdAnswers(page, match, { methods = null, ms = 1000, firs
     h.held++;
     await sleep(ms);
     await route.fulfill({ response: answer });
+    h.delivered++;
   };
   await page.route(match, handler);
   h.stop = () => page.unroute(match, handler);

@@ -44,7 +44,7 @@ await runSuite("WebEditorPanelsBrowserTest", async () => {
       const list = await until(async () => { const l = (await api("GET", "/patterns")).body.patterns; return l.length === n0 + 1 && l; }, "one more pattern on the server");
       const added = list.find((p) => !p.builtin);
       assert.ok(added && /my_wrinkle/.test(added.name), JSON.stringify(added));
-      await page.waitForSelector(`#libraryList button[data-pattern="${added.id}"]`, { timeout: 5000 });
+      await page.waitForSelector(`#libraryList button[data-pattern="${added.id}"]`, { timeout: 15000 });
       assert.equal(uploads.length, 1);
     }],
     ["dropping a text file shows an error and posts nothing", async () => {

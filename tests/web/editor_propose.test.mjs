@@ -138,7 +138,7 @@ await runSuite("WebEditorProposeBrowserTest", async () => {
       await until(async () => (await violet()) > 50, "the texture view shows the proposals' outlines");
       await page.keyboard.press("ArrowDown");
       const next = proposals[proposals.findIndex((p) => p.placement.id === id) + 1];
-      if (next) await page.waitForFunction((pid) => document.querySelector("#proposalList li.selected")?.dataset.id === pid, next.placement.id, { timeout: 5000 });
+      if (next) await page.waitForFunction((pid) => document.querySelector("#proposalList li.selected")?.dataset.id === pid, next.placement.id, { timeout: 15000 });
       await page.keyboard.press("ArrowUp");
       await page.waitForFunction((pid) => document.getElementById("proposePreview").dataset.proposal === pid, id, { timeout: 30000 });
       // The knee crease shows from behind: "Turn 3D there" turns the view to its circle.
@@ -171,7 +171,7 @@ await runSuite("WebEditorProposeBrowserTest", async () => {
       await screenshot(page, "editor-propose-accepted.png");
       await page.focus("#proposalList");
       await page.keyboard.press("Escape");
-      await page.waitForFunction(() => document.getElementById("proposePanel").hidden, null, { timeout: 5000 });
+      await page.waitForFunction(() => document.getElementById("proposePanel").hidden, null, { timeout: 15000 });
       assert.equal(await param("surface_brush"), null, "no ghost once the panel is closed");
       await until(async () => (await page.$eval("#uv", (c) => {
         const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
@@ -201,7 +201,7 @@ await runSuite("WebEditorProposeBrowserTest", async () => {
         assert.ok(b[0] >= 0 && b[1] >= 0 && b[2] <= 1280 && b[3] <= 720 && b[3] > b[1], `${sel} in view at 1280×720: ${b}`);
       }
       await page.keyboard.press("Escape");
-      await page.waitForFunction(() => document.getElementById("proposePanel").hidden, null, { timeout: 5000 });
+      await page.waitForFunction(() => document.getElementById("proposePanel").hidden, null, { timeout: 15000 });
       await page.setViewportSize({ width: 1600, height: 1000 });
     }],
     ["Go to θmax on a proposal's vector axis poses its joint there", async () => {

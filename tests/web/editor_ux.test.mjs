@@ -133,7 +133,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
         if (route.request().method() === "PATCH") await gate;
         await route.continue();
       });
-      await page.click('#placementList li[data-placement="elbow_l"] .name');
+      await selectPlacement(page, "elbow_l");
       await page.focus("#uv");
       await page.keyboard.press("]");
       await until(() => page.$eval("#saveState", (e) => e.dataset.state === "saving" && /Saving/.test(e.textContent)), "Saving… while the edit is held");
@@ -150,7 +150,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
     ["closing the window while an edit is on its way asks first", async () => {
       const p = await openEditor(context, sceneUrl, { width: 1280, height: 720 });
       await p.route("**/api/v1/scenes/*/placements/*", () => {}); // never answered
-      await p.click('#placementList li[data-placement="elbow_l"] .name');
+      await selectPlacement(p, "elbow_l");
       await p.focus("#uv");
       await p.keyboard.press("]");
       await until(() => p.$eval("#saveState", (e) => e.dataset.state === "saving"), "an edit on its way");
@@ -161,7 +161,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
     ["Delete says what it deleted; its Undo brings the placement back, selected", async () => {
       await settled(page, api);
       const before = (await api("GET", `/scenes/${(await state(page)).sceneId}`)).body.scene;
-      await page.click('#placementList li[data-placement="knee_l"] .name');
+      await selectPlacement(page, "knee_l");
       await page.focus("#uv");
       await page.keyboard.press("Delete");
       const undoButton = await page.waitForSelector('#notices .notice:has-text("Deleted \\"knee_l\\"") button.action', { timeout: 10000 });
@@ -176,7 +176,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       await until(async () => (await state(page)).selection.join() === "knee_l", "knee_l selected again");
     }],
     ["the place tool says what a click adds; Esc leaves it and keeps the selection", async () => {
-      await page.click('#placementList li[data-placement="elbow_r"] .name');
+      await selectPlacement(page, "elbow_r");
       await page.focus("#frameStage");
       assert.equal(await visible(page, "#placeHint"), false);
       await page.keyboard.press("p");
@@ -205,7 +205,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       const id = (await state(page)).sceneId;
       const rotation = async () => (await api("GET", `/scenes/${id}`)).body.scene.placements.find((p) => p.id === "thigh_l").rotation;
       const r0 = await rotation();
-      await page.click('#placementList li[data-placement="thigh_l"] .name');
+      await selectPlacement(page, "thigh_l");
       await page.focus("#uv");
       await page.keyboard.press("]");
       await until(async () => (await rotation()) !== r0, "rotated on the server");
