@@ -11,7 +11,9 @@
 // shows (clear of its handles), a hidden one shows on hover; Ctrl+= / Ctrl+- / Ctrl+0 zoom and fit the texture view (not
 // the page, and only there) and arrows pan it when nothing is selected, all listed by ?; at
 // 1280×720 the 3D view bar is one row with Size and Reset in a ⋯ menu that Enter / ↓ opens and
-// Esc closes (focus back on ⋯), at 1920×1080 they sit in the bar.
+// Esc closes (focus back on ⋯); at 1920×1080 and 1600×1000, in every layout and compare mode, no
+// control is cut off at the bar's end (the controls fold into ⋯ exactly where the row does not
+// fit; the 3D view alone at 1920 has them in the bar).
 // Screenshots: editor-empty.png, editor-1280x720.png, editor-deleted-undo.png,
 // editor-place-tool.png, editor-undo-notice.png, editor-labels.png, editor-labels-1920.png,
 // editor-3d-more.png.
@@ -84,7 +86,7 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       await page.selectOption("#compareMode", "off");
       await screenshot(page, "editor-1280x720.png");
     }],
-    ["1280×720: the 3D view bar's ⋯ menu works by keyboard (Enter opens, Esc closes), 1920×1080 needs none", async () => {
+    ["1280×720: the 3D view bar's ⋯ menu works by keyboard (Enter opens, Esc closes); wider windows cut nothing off and fold only where the row does not fit", async () => {
       assert.ok(await visible(page, "#viewMore"), "⋯ shows on the narrow 3D view bar");
       assert.equal(await visible(page, "#resetCamera"), false, "Reset is folded into it");
       assert.equal(await page.$eval("#viewMore", (b) => b.getAttribute("aria-expanded")), "false");
@@ -115,10 +117,33 @@ await runSuite("WebEditorUxBrowserTest", async () => {
       for (let i = 0; i < 6 && await page.evaluate(() => !!document.activeElement.closest("#viewMoreMenu")); ++i) await page.keyboard.press("Tab");
       assert.equal(await page.evaluate(() => !!document.activeElement.closest("#viewMoreMenu")), false, "Tab leaves the menu");
       assert.equal(await page.$eval("#viewMore", (b) => b.getAttribute("aria-expanded")), "false", "leaving the menu closes it");
+      // Wider windows: whatever the layout, window and compare mode, no control is cut off at
+      // the bar's end (at 1920×1080 side by side, Frame and Turntable were, past the 684 px bar);
+      // where the row fits, ⋯ is hidden and the controls sit in the bar.
+      const cut = (pg) => pg.$eval("#frameView .viewbar", (bar) => {
+        const r = bar.getBoundingClientRect();
+        return [...bar.querySelectorAll("button, select, input")].filter((e) => e.getClientRects().length > 0 && e.getBoundingClientRect().right > r.right + 0.5).map((e) => e.id);
+      });
+      const frames = (pg) => pg.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
       const wide = await openEditor(context, sceneUrl, { width: 1920, height: 1080 });
-      assert.equal(await visible(wide, "#viewMore"), false, "no ⋯ where the bar has room");
-      assert.ok(await visible(wide, "#resetCamera") && await visible(wide, "#frameSize"), "Size and Reset sit in the bar");
-      assert.ok((await box(wide, "#frameView .viewbar")).height < 40, "one row");
+      for (const [layout, compare] of [["both", "off"], ["both", "split"], ["3d", "off"], ["3d", "split"], ["3d", "diff"]]) {
+        await wide.click(`[data-layout="${layout}"]`);
+        await wide.selectOption("#compareMode", compare);
+        await frames(wide);
+        assert.deepEqual(await cut(wide), [], `nothing cut off at 1920×1080, ${layout}, compare ${compare}`);
+        assert.ok((await box(wide, "#frameView .viewbar")).height < 40, `one row (${layout}, compare ${compare})`);
+        const folded = await visible(wide, "#viewMore");
+        assert.equal(await visible(wide, "#turntable"), !folded, `Turntable in the row exactly when there is no ⋯ (${layout}, compare ${compare})`);
+        if (layout === "3d" && compare === "off") {
+          assert.equal(folded, false, "no ⋯ where the bar has room");
+          assert.ok(await visible(wide, "#resetCamera") && await visible(wide, "#frameSize"), "Size and Reset sit in the bar");
+        }
+      }
+      await wide.setViewportSize({ width: 1600, height: 1000 }); // the 3D view alone, comparing: 1,049 px
+      await frames(wide);
+      assert.deepEqual(await cut(wide), [], "nothing cut off at 1600×1000, 3d, compare diff");
+      await wide.selectOption("#compareMode", "off");
+      await wide.click('[data-layout="both"]');
       await wide.close();
       assert.deepEqual(page.errors, []);
     }],

@@ -328,11 +328,22 @@ export function initFrameView(section, theApi) {
   on([Topic.CURRENT_PATTERN, Topic.PATTERNS], showPlaceHint);
 }
 
-/// The view bar's ⋯ menu (Size, Reset): where the bar is narrow (a container query in
-/// editor.css) those controls fold into it, elsewhere they sit in the bar and ⋯ is hidden. Enter,
-/// Space or ↓ on ⋯ opens it with the focus on its first control; Esc closes it (the focus back on
-/// ⋯), as do a click or the focus elsewhere.
+/// The view bar's ⋯ menu (Size, Place as, Reset, Frame, Turntable): where the bar's row does
+/// not fit its width those controls fold into it (the bar gets the class "fold"), elsewhere they
+/// sit in the bar and ⋯ is hidden. The fit is measured again whenever the bar resizes or what it
+/// shows changes (the compare extras, a label, the window's words). Enter, Space or ↓ on ⋯ opens
+/// it with the focus on its first control; Esc closes it (the focus back on ⋯), as do a click or
+/// the focus elsewhere.
 function initMoreMenu(wrap) {
+  const bar = wrap.closest(".viewbar");
+  const fit = () => {
+    bar.classList.remove("fold");
+    if (bar.scrollWidth > bar.clientWidth + 1) bar.classList.add("fold");
+  };
+  fit();
+  if (typeof ResizeObserver === "function") new ResizeObserver(fit).observe(bar);
+  // Not the bar's own class: the observer would see its own change.
+  new MutationObserver(fit).observe(bar, { subtree: true, childList: true, characterData: true, attributes: true, attributeFilter: ["hidden"] });
   const button = wrap.querySelector(".morebutton");
   const open = (yes, focusBack = false) => {
     wrap.classList.toggle("open", yes);
