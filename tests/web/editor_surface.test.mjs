@@ -11,8 +11,10 @@
 // scale its size in model units and turn it; three quick arrows move it three texels over the body (each
 // answer held back 1 s); the parameters panel shows size and depth; in the 3D
 // view a drag that starts on the selected decal moves it (anchor changed, camera not turned);
-// "Place as: in the texture" adds a UV placement instead.
-// Screenshots: editor-surface-brush.png, editor-surface-placed.png, editor-surface-texture.png.
+// "Place as: in the texture" adds a UV placement instead; after Propose…'s set on the body, every
+// surface placement's label is laid out with the others and none overlaps another.
+// Screenshots: editor-surface-brush.png, editor-surface-placed.png, editor-surface-texture.png,
+// editor-surface-labels.png.
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
 import { dirname, join } from "node:path";
@@ -251,6 +253,35 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
       const p = d.placements[d.placements.length - 1];
       assert.notEqual(p.projection, "surface");
       assert.equal(p.center.length, 2);
+      assert.deepEqual(page.errors, []);
+    }],
+    ["Propose… on the body: every surface placement's label is laid out with the others, none overlaps another", async () => {
+      // Before, a surface placement's label was written at its anchor, outside the label layout:
+      // Propose…'s fifteen on the Barbarian printed "left elbow crease" over "left elbow tip".
+      await page.keyboard.press("Escape");
+      await page.click("#propose");
+      await page.waitForSelector("#proposeAll:not([disabled])", { timeout: 60000 });
+      const n0 = (await doc()).placements.length;
+      await page.click("#proposeAll");
+      const d = await until(async () => { const s = await doc(); return s.placements.length > n0 + 5 && s; }, "the proposals added");
+      await page.keyboard.press("Escape");
+      const surface = d.placements.filter((q) => q.projection === "surface").map((q) => q.id);
+      assert.ok(surface.length > 5, `surface placements (${surface.length})`);
+      await page.evaluate(() => window.dermisEditor.select([]));
+      const l = await until(async () => {
+        const l = await page.evaluate(() => window.dermisEditor.labelLayout());
+        const laid = new Set([...l.shown.map((b) => b.id), ...l.hidden]);
+        return surface.every((id) => laid.has(id)) && l;
+      }, "every surface placement in the label layout (its outline in)", 30000);
+      const overlaps = [];
+      for (let i = 0; i < l.shown.length; ++i)
+        for (let j = i + 1; j < l.shown.length; ++j) {
+          const a = l.shown[i], b = l.shown[j];
+          if (a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h) overlaps.push(`${a.id}/${b.id}`);
+        }
+      assert.deepEqual(overlaps, [], "no two labels overlap");
+      assert.ok(l.shown.filter((b) => surface.includes(b.id)).length >= surface.length / 2, `most surface labels shown (${l.shown.length} shown, ${l.hidden.length} hidden)`);
+      await screenshot(page, "editor-surface-labels.png");
       assert.deepEqual(page.errors, []);
     }],
   ]);

@@ -8,7 +8,8 @@
 // texel moved by the drag: pick by UV); + − [ ] size and turn it as any selection. Wheel zooms about the pointer; dragging empty space (or with the
 // middle button) pans. Lint findings are drawn on the footprints they concern, other people's
 // selections in their colour. Labels are placed so that they never overlap (the selection's first,
-// then the hovered one, then document order; each tries a few spots around its footprint); a label
+// then the hovered one, then document order; each tries a few spots around its footprint, or
+// around a surface placement's anchor); a label
 // with no free spot is hidden until its placement is hovered or selected. Keys (keys.js) zoom
 // (Ctrl/Cmd+= / −) and pan (arrows with nothing selected) through zoomBy and panBy.
 //
@@ -167,8 +168,12 @@ function draw() {
     dims.set(p.id, dim);
     drawFootprint(p, { selected, dim, lint: lintBy.get(p.id) || [], hover: hover === p.id });
   }
+  for (const p of store.doc.placements) {
+    if (geo.inTexture(p)) continue;
+    dims.set(p.id, !p.enabled || (soloed.size && !soloed.has(p.id)));
+    drawSurfaceOutline(p, soloed);
+  }
   drawLabels(dims, w, h);
-  for (const p of store.doc.placements) if (!geo.inTexture(p)) drawSurfaceOutline(p, soloed);
   drawGhosts();
   // Other people's selections, in their colour.
   for (const [client, who] of store.presence) {
@@ -215,7 +220,8 @@ function drawGhosts() {
   }
 }
 
-/// A surface placement's decal outline (all pieces), a cross at its anchor and its label there.
+/// A surface placement's decal outline (all pieces) and a cross at its anchor (its label is laid
+/// out with the others: layoutLabels).
 function drawSurfaceOutline(p, soloed) {
   const selected = store.selection.includes(p.id), hovered = hover === p.id;
   const off = surfaceOffset(p);
@@ -230,11 +236,18 @@ function drawSurfaceOutline(p, soloed) {
     ctx.beginPath();
     ctx.moveTo(x - 4, y); ctx.lineTo(x + 4, y); ctx.moveTo(x, y - 4); ctx.lineTo(x, y + 4);
     ctx.stroke();
-    ctx.font = LABEL_FONT;
-    ctx.fillStyle = ctx.strokeStyle;
-    ctx.fillText(p.label || p.id, x + 6, y - 6);
   }
   ctx.globalAlpha = 1;
+}
+
+/// Where a surface placement's label goes: the screen box of the cross at its anchor (as drawn:
+/// with the slide's offset), or null while its outline is not in.
+function surfaceAnchorBox(p) {
+  const o = outlineOf(p);
+  if (!o || !o.anchor_uv) return null;
+  const off = surfaceOffset(p);
+  const [x, y] = toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]]);
+  return { x0: x - 5, y0: y - 5, x1: x + 5, y1: y + 5 };
 }
 
 /// How far (UV) stored surface placement `p`'s outline is drawn from where it is stored: the drag's
@@ -295,12 +308,14 @@ function drawFootprint(p, { selected, dim, lint, hover: hovered }) {
   }
 }
 
-/// Places every footprint's label where it overlaps no other label: the selection's first (always
+/// Places every placement's label where it overlaps no other label: the selection's first (always
 /// shown), then the hovered one (always shown), then document order; each tries above / below its
 /// footprint's box (left, then right aligned), inside it, and beside it, preferring spots inside
-/// the stage. A label with no free spot is hidden (hover or select its placement to see it).
+/// the stage. A surface placement's "footprint" is the cross at its anchor (its label first
+/// tries above right of it). A label with no free spot is hidden (hover or select its placement
+/// to see it).
 function layoutLabels(w, h) {
-  const ps = store.doc.placements.filter(geo.inTexture).map(shown);
+  const ps = store.doc.placements.map((p) => (geo.inTexture(p) ? shown(p) : p));
   const rank = (p) => { const i = store.selection.indexOf(p.id); return i >= 0 ? i : p.id === hover ? store.selection.length : Infinity; };
   const order = ps.map((p, i) => ({ p, i, r: rank(p) })).sort((a, b) => a.r - b.r || a.i - b.i);
   ctx.font = LABEL_FONT;
@@ -310,13 +325,22 @@ function layoutLabels(w, h) {
   for (const { p, r } of order) {
     const text = p.label || p.id;
     const lw = Math.ceil(ctx.measureText(text).width) + 6, lh = LABEL_H;
-    const c = geo.corners(p).map(toScreen);
-    const x0 = Math.min(...c.map((q) => q[0])), x1 = Math.max(...c.map((q) => q[0]));
-    const y0 = Math.min(...c.map((q) => q[1])), y1 = Math.max(...c.map((q) => q[1]));
+    const surface = !geo.inTexture(p);
+    let x0, x1, y0, y1;
+    if (surface) {
+      const b = surfaceAnchorBox(p);
+      if (!b) continue; // its outline is not in yet: nothing drawn for it, no label
+      ({ x0, x1, y0, y1 } = b);
+    } else {
+      const c = geo.corners(p).map(toScreen);
+      x0 = Math.min(...c.map((q) => q[0])); x1 = Math.max(...c.map((q) => q[0]));
+      y0 = Math.min(...c.map((q) => q[1])); y1 = Math.max(...c.map((q) => q[1]));
+    }
     const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
-    const m = p.id === store.selection[0] ? HANDLE_PX / 2 + 2 : 1; // clear of the selection's corner handles
-    const spots = [[x0, y0 - lh - m], [x0, y1 + m], [x1 - lw, y0 - lh - m], [x1 - lw, y1 + m],
-                   [cx - lw / 2, cy - lh / 2], [x1 + 2, cy - lh / 2], [x0 - lw - 2, cy - lh / 2]]
+    const m = p.id === store.selection[0] && !surface ? HANDLE_PX / 2 + 2 : 1; // clear of the selection's corner handles
+    const around = [[x0, y0 - lh - m], [x0, y1 + m], [x1 - lw, y0 - lh - m], [x1 - lw, y1 + m]];
+    const spots = (surface ? [[x1 + 1, y0 - lh + 2], [x1 + 1, y1 - 2], [x0 - lw - 1, y0 - lh + 2], [x0 - lw - 1, y1 - 2], ...around]
+                           : [...around, [cx - lw / 2, cy - lh / 2], [x1 + 2, cy - lh / 2], [x0 - lw - 2, cy - lh / 2]])
       .map(([x, y]) => ({ id: p.id, text, x: Math.round(x), y: Math.round(y), w: lw, h: lh }));
     const must = r !== Infinity; // selected or hovered
     // A spot that fits nowhere inside the stage is moved inside it (never cut at the view's edge).
