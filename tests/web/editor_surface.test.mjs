@@ -281,6 +281,13 @@ await runSuite("WebEditorSurfaceBrowserTest", async () => {
         }
       assert.deepEqual(overlaps, [], "no two labels overlap");
       assert.ok(l.shown.filter((b) => surface.includes(b.id)).length >= surface.length / 2, `most surface labels shown (${l.shown.length} shown, ${l.hidden.length} hidden)`);
+      // The list: each surface row is tagged ◍ (its words in the accessible name), and the tag
+      // leaves the name its room: "left elbow crease" is whole at 1600 px.
+      const rows = await page.$$eval("#placementList li", (ls) => ls.map((li) => ({ id: li.dataset.placement, tag: li.querySelector(".surfacetag")?.getAttribute("aria-label") || null,
+        name: li.querySelector(".name").textContent, cut: li.querySelector(".name").scrollWidth > li.querySelector(".name").clientWidth + 1 })));
+      for (const r of rows) assert.equal(r.tag, surface.includes(r.id) ? "on the body" : null, `the tag of ${r.id}`);
+      const elbow = rows.find((r) => r.name === "left elbow crease");
+      assert.ok(elbow && !elbow.cut, `"left elbow crease" whole in the list (${JSON.stringify(elbow)})`);
       await screenshot(page, "editor-surface-labels.png");
       assert.deepEqual(page.errors, []);
     }],

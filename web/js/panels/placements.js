@@ -99,8 +99,8 @@ function render() {
     const lint = lintCount.get(p.id);
     const findings = store.lint.filter((f) => f.placement === p.id).map((f) => f.message).join("\n");
     li.innerHTML = `<img class="thumb" alt="" src="/api/v1${patternImagePath(p.pattern)}?size=64">
-      <button type="button" class="name" aria-pressed="${store.selection.includes(p.id)}" title="${escapeHtml(p.id)} — ${escapeHtml(p.pattern)} on ${escapeHtml(p.joint)} ${p.axis}">${escapeHtml(p.label || p.id)}</button>
-      ${p.projection === "surface" ? `<span class="surfacetag" title="A decal on the body (projection: surface): it has no footprint in the texture view">on body</span>` : ""}
+      <button type="button" class="name" aria-pressed="${store.selection.includes(p.id)}" title="${p.label ? `${escapeHtml(p.label)} (${escapeHtml(p.id)})` : escapeHtml(p.id)} — ${escapeHtml(p.pattern)} on ${escapeHtml(p.joint)} ${p.axis}${p.projection === "surface" ? ", on the body" : ""}">${escapeHtml(p.label || p.id)}</button>
+      ${p.projection === "surface" ? `<span class="surfacetag" role="img" aria-label="on the body" title="On the body: a decal (projection: surface); its outline and anchor are drawn in the texture view">◍</span>` : ""}
       ${lint ? `<span class="lintbadge" title="${escapeHtml(findings)}" aria-label="${lint} lint findings">${lint}</span>` : ""}
       <button type="button" class="mini enabled" aria-pressed="${p.enabled}" aria-label="enabled ${escapeHtml(p.id)}" title="Enabled (H)">${p.enabled ? "◉" : "○"}</button>
       <button type="button" class="mini solo" aria-pressed="${store.solo.includes(p.id)}" aria-label="solo ${escapeHtml(p.id)}" title="Solo in the 3D view (S)">S</button>`;
