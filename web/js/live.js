@@ -30,7 +30,7 @@ function changePresence(change) {
 }
 
 /// The initials of a client name ("merry-wren-q1x9" → "MW"): a chip's text when many are here.
-export function initials(client) {
+function initials(client) {
   const words = String(client).split(/[-_\s]+/).filter((w) => /^[a-z]/i.test(w));
   return (words.slice(0, 2).map((w) => w[0]).join("") || String(client).slice(0, 2)).toUpperCase();
 }

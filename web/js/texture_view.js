@@ -160,19 +160,13 @@ function draw() {
   const lintBy = new Map();
   for (const f of store.lint) if (f.placement) lintBy.set(f.placement, [...(lintBy.get(f.placement) || []), f]);
   const soloed = new Set(store.solo);
-  const dims = new Map();
+  // Dimmed: hidden, or another placement soloed. Footprints first, the surface outlines over them.
+  const dims = new Map(store.doc.placements.map((p) => [p.id, !p.enabled || (soloed.size > 0 && !soloed.has(p.id))]));
   for (const raw of store.doc.placements.filter(geo.inTexture)) {
     const p = shown(raw);
-    const selected = store.selection.includes(p.id);
-    const dim = !p.enabled || (soloed.size && !soloed.has(p.id));
-    dims.set(p.id, dim);
-    drawFootprint(p, { selected, dim, lint: lintBy.get(p.id) || [], hover: hover === p.id });
+    drawFootprint(p, { selected: store.selection.includes(p.id), dim: dims.get(p.id), lint: lintBy.get(p.id) || [], hover: hover === p.id });
   }
-  for (const p of store.doc.placements) {
-    if (geo.inTexture(p)) continue;
-    dims.set(p.id, !p.enabled || (soloed.size && !soloed.has(p.id)));
-    drawSurfaceOutline(p, soloed);
-  }
+  for (const p of store.doc.placements) if (!geo.inTexture(p)) drawSurfaceOutline(p, dims.get(p.id));
   drawLabels(dims, w, h);
   drawGhosts();
   // Other people's selections, in their colour.
@@ -222,17 +216,17 @@ function drawGhosts() {
 
 /// A surface placement's decal outline (all pieces) and a cross at its anchor (its label is laid
 /// out with the others: layoutLabels).
-function drawSurfaceOutline(p, soloed) {
+function drawSurfaceOutline(p, dim) {
   const selected = store.selection.includes(p.id), hovered = hover === p.id;
-  const off = surfaceOffset(p);
-  ctx.globalAlpha = !p.enabled || (soloed.size && !soloed.has(p.id)) ? 0.35 : 1;
+  ctx.globalAlpha = dim ? 0.35 : 1;
   ctx.strokeStyle = selected ? "#ffffff" : hovered ? "#c8e1ff" : targetColor(p);
   ctx.lineWidth = selected || hovered ? 2 : 1.4;
   ctx.setLineDash(p.enabled ? [] : [4, 3]);
-  const o = strokeOutline(ctx, p, toScreen, off);
+  strokeOutline(ctx, p, toScreen, surfaceOffset(p));
   ctx.setLineDash([]);
-  if (o && o.anchor_uv) {
-    const [x, y] = toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]]);
+  const a = anchorOnScreen(p);
+  if (a) {
+    const [x, y] = a;
     ctx.beginPath();
     ctx.moveTo(x - 4, y); ctx.lineTo(x + 4, y); ctx.moveTo(x, y - 4); ctx.lineTo(x, y + 4);
     ctx.stroke();
@@ -240,14 +234,13 @@ function drawSurfaceOutline(p, soloed) {
   ctx.globalAlpha = 1;
 }
 
-/// Where a surface placement's label goes: the screen box of the cross at its anchor (as drawn:
-/// with the slide's offset), or null while its outline is not in.
-function surfaceAnchorBox(p) {
+/// Surface placement `p`'s anchor on screen (as drawn: with the slide's offset), where its cross
+/// is drawn and its label goes; null while its outline is not in.
+function anchorOnScreen(p) {
   const o = outlineOf(p);
   if (!o || !o.anchor_uv) return null;
   const off = surfaceOffset(p);
-  const [x, y] = toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]]);
-  return { x0: x - 5, y0: y - 5, x1: x + 5, y1: y + 5 };
+  return toScreen([o.anchor_uv[0] + off[0], o.anchor_uv[1] + off[1]]);
 }
 
 /// How far (UV) stored surface placement `p`'s outline is drawn from where it is stored: the drag's
@@ -328,9 +321,9 @@ function layoutLabels(w, h) {
     const surface = !geo.inTexture(p);
     let x0, x1, y0, y1;
     if (surface) {
-      const b = surfaceAnchorBox(p);
-      if (!b) continue; // its outline is not in yet: nothing drawn for it, no label
-      ({ x0, x1, y0, y1 } = b);
+      const a = anchorOnScreen(p);
+      if (!a) continue; // its outline is not in yet: nothing drawn for it, no label
+      [x0, y0, x1, y1] = [a[0] - 5, a[1] - 5, a[0] + 5, a[1] + 5]; // the cross
     } else {
       const c = geo.corners(p).map(toScreen);
       x0 = Math.min(...c.map((q) => q[0])); x1 = Math.max(...c.map((q) => q[0]));
